@@ -1,0 +1,44 @@
+/* Counter-based random numbers: value = mix(key + dimension * gamma), the SplitMix64 generator
+ * (Steele, Lea and Flood 2014) indexed by dimension instead of stepped, with the key a hash of
+ * (seed, stream, sample). Pure functions: no state, so results do not depend on threads. */
+#ifndef DWV_KERNEL_RNG_H
+#define DWV_KERNEL_RNG_H
+
+#include <stdint.h>
+
+#define DWVK_GOLDEN_GAMMA 0x9e3779b97f4a7c15ull
+
+/* Stafford's "Mix13" finaliser, the output function of SplitMix64: a bijection on 64 bits. */
+static inline uint64_t dwvk_mix64(uint64_t z)
+{
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+}
+
+/* One key per (seed, stream, sample): chained bijections, so distinct triples give distinct
+ * inputs to each stage. Hoist it out of the per-dimension loop. */
+static inline uint64_t dwvk_rng_key(uint64_t seed, uint64_t stream, uint64_t sample)
+{
+    uint64_t h = dwvk_mix64(seed + DWVK_GOLDEN_GAMMA);
+    h = dwvk_mix64(h ^ stream);
+    return dwvk_mix64(h + sample * DWVK_GOLDEN_GAMMA);
+}
+
+static inline uint64_t dwvk_rng_u64(uint64_t key, uint32_t dimension)
+{
+    return dwvk_mix64(key + (uint64_t)(dimension + 1u) * DWVK_GOLDEN_GAMMA);
+}
+
+/* The top 53 (24) bits as a multiple of 2^-53 (2^-24): uniform on [0, 1), never 1. */
+static inline double dwvk_rng_uniform_d(uint64_t key, uint32_t dimension)
+{
+    return (double)(dwvk_rng_u64(key, dimension) >> 11) * 0x1.0p-53;
+}
+
+static inline float dwvk_rng_uniform_f(uint64_t key, uint32_t dimension)
+{
+    return (float)(dwvk_rng_u64(key, dimension) >> 40) * 0x1.0p-24f;
+}
+
+#endif

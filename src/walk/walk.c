@@ -1,0 +1,298 @@
+#include "walk.h"
+
+#include <float.h>
+
+#include "kernel/classical.h"
+#include "kernel/rng.h"
+
+#define INV_TWO_PI 0.15915494309189533577
+#define DWVW_ROULETTE_THRESHOLD 0.05
+
+void dwvw_medium_init(dwvw_medium *medium, int channels, const double *sigma_t, const double *albedo, double g)
+{
+    medium->channels = channels;
+    medium->guide_channel = 0;
+    for (int c = 0; c < DWVW_MAX_CHANNELS; ++c) {
+        int source = c < channels ? c : 0;
+        medium->sigma_t[c] = sigma_t[source];
+        medium->albedo[c] = albedo[source];
+        if (c < channels && albedo[c] > albedo[medium->guide_channel]) medium->guide_channel = c;
+    }
+    medium->g = g;
+    medium->dwivedi = dwvk_dwivedi_from_kappa(dwvk_kappa_exact(albedo[medium->guide_channel]));
+    medium->dwivedi_f = dwvk_dwivedi_to_float(medium->dwivedi);
+}
+
+/* The auto heuristic. Guiding pays where walks are long (high albedo) and the Dwivedi
+ * eigenfunction describes the medium (isotropic scattering). Below albedo 0.2 the guided
+ * distribution is clamped to a near-delta and classical sampling is left alone. Otherwise 2% go to
+ * classical sampling, a defensive component that bounds every step's weight by 50 times the
+ * analog one, raised to |g| for anisotropic media, where the ratio of the phase function to the
+ * Dwivedi pdf of guided steps grows with |g| (Cycles' rule, max(0.5, |g|^(1/8)), gives up half the
+ * guiding even at g = 0). The guided rest goes 9/10 to the lit patches (incident), 1/10 to the
+ * closest surface point, all to closest when no light is known. Measured (docs/walk.md, "auto"):
+ * with classical shares 0.1 / 0.05 / 0.02 and incident shares 2/3 / 0.9, 0.02 and 0.9 were best on
+ * every case, at 0.80 to 0.99 of the best single technique's efficiency. */
+void dwvw_auto_weights(const dwvw_medium *medium, int patch_count, double *q_classical, double *q_closest,
+                       double *q_incident)
+{
+    double alpha = medium->albedo[medium->guide_channel];
+    double classical = alpha < 0.2 ? 1.0 : fmax(0.02, fabs(medium->g));
+    double guided = 1.0 - classical;
+    *q_classical = classical;
+    *q_incident = patch_count > 0 ? guided * 0.9 : 0.0;
+    *q_closest = guided - *q_incident;
+}
+
+void dwvw_guide_init(dwvw_guide *guide, dwvw_technique technique, const dwvw_medium *medium,
+                     const dwvw_light_patch *patches, int patch_count)
+{
+    guide->q_classical = guide->q_poe = guide->q_closest = guide->q_incident = guide->q_backward = 0.0;
+    guide->patch_count = patch_count < DWVW_MAX_PATCHES ? patch_count : DWVW_MAX_PATCHES;
+    for (int i = 0; i < guide->patch_count; ++i) {
+        guide->patches[i] = patches[i];
+        guide->patches[i].log_power = log(patches[i].power);
+    }
+    switch (technique) {
+    case DWVW_CLASSICAL: guide->q_classical = 1.0; break;
+    case DWVW_POE: guide->q_poe = 1.0; break;
+    case DWVW_CLOSEST: guide->q_closest = 1.0; break;
+    case DWVW_INCIDENT: guide->q_incident = 1.0; break;
+    case DWVW_BACKWARD: guide->q_backward = 1.0; break;
+    case DWVW_CYCLES: {
+        /* Cycles: guided_fraction = 1 - max(0.5, |g|^(1/8)). */
+        double guided = 1.0 - fmax(0.5, pow(fabs(medium->g), 0.125));
+        guide->q_classical = 1.0 - guided;
+        guide->q_backward = guided;
+        break;
+    }
+    case DWVW_AUTO:
+        dwvw_auto_weights(medium, guide->patch_count, &guide->q_classical, &guide->q_closest, &guide->q_incident);
+        break;
+    }
+}
+
+int dwvw_guide_needs_closest(const dwvw_guide *guide)
+{
+    return guide->q_closest > 0.0;
+}
+
+void dwvw_walk_begin(dwvw_walk *walk, const dwvw_medium *medium, const dwvw_guide *guide, uint64_t key,
+                     uint32_t max_events, dwvw_vec3 point, dwvw_vec3 direction, dwvw_vec3 normal)
+{
+    walk->medium = medium;
+    walk->guide = guide;
+    walk->key = key;
+    walk->max_events = max_events;
+    walk->events = 0;
+    walk->status = DWVW_RUNNING;
+    walk->position = walk->entry_point = point;
+    walk->direction = direction;
+    walk->entry_normal = normal;
+    walk->exit_normal = normal;
+    for (int c = 0; c < DWVW_MAX_CHANNELS; ++c) walk->weight[c] = c < medium->channels ? 1.0 : 0.0;
+    walk->have_opposite = 0;
+    walk->opposite_depth = 0.0;
+    walk->closest_known = 0;
+    walk->closest_normal = normal;
+    walk->step_distance = 0.0;
+    walk->component_count = 0;
+}
+
+void dwvw_walk_set_closest(dwvw_walk *walk, dwvw_vec3 normal)
+{
+    walk->closest_normal = normal;
+    walk->closest_known = 1;
+}
+
+/* Adds a guided component, or its weight to one with the same axis: the mixture is the same, and
+ * every component costs a pdf and an exponential per channel at every event. */
+static void add_component(dwvw_walk *walk, double q, dwvw_vec3 axis)
+{
+    if (!(q > 0.0)) return;
+    for (int k = 1; k < walk->component_count; ++k) {
+        if (dwvw_dot(walk->component_axis[k], axis) >= 1.0 - 1e-12) {
+            walk->component_q[k] += q;
+            return;
+        }
+    }
+    if (walk->component_count >= DWVW_MAX_COMPONENTS) return;
+    walk->component_q[walk->component_count] = q;
+    walk->component_axis[walk->component_count] = axis;
+    ++walk->component_count;
+}
+
+/* The incident technique's patch weights: power_j exp(-sigma_t d_j / v), normalised in the log
+ * domain so that distant patches do not underflow all at once. */
+static void add_incident_components(dwvw_walk *walk, double q)
+{
+    const dwvw_guide *guide = walk->guide;
+    const dwvw_medium *m = walk->medium;
+    double decay = m->sigma_t[m->guide_channel] * m->dwivedi.kappa; /* sigma_t / v */
+    double log_w[DWVW_MAX_PATCHES], largest = -INFINITY;
+    for (int j = 0; j < guide->patch_count; ++j) {
+        const dwvw_light_patch *patch = &guide->patches[j];
+        dwvw_vec3 offset = dwvw_sub(walk->position, patch->point);
+        double distance = patch->is_plane ? fabs(dwvw_dot(offset, patch->normal)) : dwvw_length(offset);
+        log_w[j] = patch->log_power - decay * distance;
+        largest = fmax(largest, log_w[j]);
+    }
+    double sum = 0.0, w[DWVW_MAX_PATCHES];
+    for (int j = 0; j < guide->patch_count; ++j) sum += (w[j] = exp(log_w[j] - largest));
+    for (int j = 0; j < guide->patch_count; ++j) add_component(walk, q * w[j] / sum, guide->patches[j].normal);
+}
+
+static void build_components(dwvw_walk *walk)
+{
+    const dwvw_guide *guide = walk->guide;
+    const dwvw_medium *m = walk->medium;
+    /* Component 0 is always the classical one (possibly with weight 0), so its index is fixed. */
+    walk->component_q[0] = guide->q_classical;
+    walk->component_count = 1;
+    double backward_fraction = 0.0;
+    if (guide->q_backward > 0.0 && walk->have_opposite) {
+        double depth = fmin(fmax(dwvw_dot(dwvw_sub(walk->position, walk->entry_point), walk->entry_normal) * -1.0, 0.0),
+                            walk->opposite_depth);
+        double x = m->sigma_t[m->guide_channel] * (walk->opposite_depth - 2.0 * depth) * m->dwivedi.kappa;
+        backward_fraction = 1.0 / (1.0 + exp(x));
+    }
+    add_component(walk, guide->q_poe + guide->q_backward * (1.0 - backward_fraction), walk->entry_normal);
+    add_component(walk, guide->q_backward * backward_fraction, dwvw_scale(walk->entry_normal, -1.0));
+    if (guide->q_closest > 0.0) add_component(walk, guide->q_closest, walk->closest_normal);
+    if (guide->q_incident > 0.0) add_incident_components(walk, guide->q_incident);
+}
+
+static inline float clamp_cosine(double mu)
+{
+    return mu < -1.0 ? -1.0f : mu > 1.0 ? 1.0f : (float)mu;
+}
+
+static int pick(const double *p, int n, double u)
+{
+    double total = 0.0;
+    for (int i = 0; i < n; ++i) total += p[i];
+    double target = u * total, cumulative = 0.0;
+    int last = 0;
+    for (int i = 0; i < n; ++i) {
+        if (!(p[i] > 0.0)) continue;
+        cumulative += p[i];
+        last = i;
+        if (target < cumulative) return i;
+    }
+    return last;
+}
+
+double dwvw_walk_sample(dwvw_walk *walk)
+{
+    const dwvw_medium *m = walk->medium;
+    uint32_t dim = 2u + DWVW_DIMS_PER_EVENT * walk->events;
+    double u_channel = dwvk_rng_uniform_d(walk->key, dim);
+    double u_component = dwvk_rng_uniform_d(walk->key, dim + 1);
+    double u_cos = dwvk_rng_uniform_d(walk->key, dim + 2);
+    double u_phi = dwvk_rng_uniform_d(walk->key, dim + 3);
+    double u_distance = dwvk_rng_uniform_d(walk->key, dim + 4);
+
+    /* Channel: proportional to throughput x albedo (Cycles), to throughput where all albedos are 0. */
+    double total = 0.0;
+    for (int c = 0; c < m->channels; ++c) total += (walk->channel_p[c] = walk->weight[c] * m->albedo[c]);
+    if (!(total > 0.0))
+        for (int c = 0; c < m->channels; ++c) total += (walk->channel_p[c] = walk->weight[c]);
+    for (int c = 0; c < m->channels; ++c) walk->channel_p[c] /= total;
+    int channel = m->channels > 1 ? pick(walk->channel_p, m->channels, u_channel) : 0;
+
+    build_components(walk);
+    int chosen = pick(walk->component_q, walk->component_count, u_component);
+    /* Per-event sampling and pdfs run in single precision (src/kernel's float path); positions,
+     * weights and their exponentials stay in double. */
+    dwvw_vec3 previous = walk->direction;
+    float g = (float)m->g;
+    if (walk->events > 0) {
+        /* The first step keeps the entry direction: only its distance is sampled. */
+        if (chosen == 0) {
+            float mu = dwvk_hg_sample_f(g, (float)u_cos);
+            walk->direction = dwvw_direction_about(previous, mu, 1.0f - mu, 1.0f + mu, u_phi);
+        } else {
+            dwvk_dwivedi_sample_f s = dwvk_dwivedi_sample_pdf_f(&m->dwivedi_f, (float)u_cos);
+            walk->direction = dwvw_direction_about(walk->component_axis[chosen], s.cos_theta, s.one_minus_cos,
+                                                   s.one_plus_cos, u_phi);
+        }
+        walk->phase = dwvk_hg_pdf_f(g, clamp_cosine(dwvw_dot(previous, walk->direction)));
+    } else {
+        walk->phase = 1.0;
+    }
+    /* Every component's direction pdf and stretch at the sampled direction (the pdf is 1 for all
+     * on the first step, whose direction was not sampled). */
+    walk->component_pdf[0] = walk->phase;
+    walk->component_stretch[0] = 1.0;
+    for (int k = 1; k < walk->component_count; ++k) {
+        float mu = clamp_cosine(dwvw_dot(walk->direction, walk->component_axis[k]));
+        walk->component_pdf[k] = walk->events > 0 ? dwvk_dwivedi_pdf_f(&m->dwivedi_f, mu) * (float)INV_TWO_PI : 1.0;
+        walk->component_stretch[k] = dwvk_dwivedi_stretch_f(&m->dwivedi_f, mu);
+    }
+    float sigma = (float)(m->sigma_t[channel] * walk->component_stretch[chosen]);
+    walk->step_distance = dwvk_exponential_sample_f(sigma, (float)u_distance);
+    return walk->step_distance;
+}
+
+dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 hit_normal)
+{
+    const dwvw_medium *m = walk->medium;
+    if (walk->events == 0 && walk->guide->q_backward > 0.0 && hit_distance < INFINITY) {
+        /* The first step's probe: an opposite interface within 10 mean free paths (Cycles' reach). */
+        double sigma_min = m->sigma_t[0];
+        for (int c = 1; c < m->channels; ++c) sigma_min = fmin(sigma_min, m->sigma_t[c]);
+        if (hit_distance <= fmax(walk->step_distance, 10.0 / sigma_min)) {
+            walk->have_opposite = 1;
+            walk->opposite_depth = -hit_distance * dwvw_dot(walk->direction, walk->entry_normal);
+        }
+    }
+    int exited = hit_distance <= walk->step_distance;
+    double t = exited ? hit_distance : walk->step_distance;
+
+    /* weight_c' *= f_c' / p with p = sum_k Q_k p_k sum_c P_c pdist_{k,c}(t); f_c' and each pdist
+     * share the factor exp(-sigma t), so the ratio is formed from exp(sigma_c' t - sigma_c s_k t)
+     * and neither underflows alone. pdist is sigma s exp(-sigma s t) for a scattering event and
+     * exp(-sigma s t) for leaving at t. */
+    for (int cw = 0; cw < m->channels; ++cw) {
+        if (walk->weight[cw] == 0.0) continue;
+        double denominator = 0.0;
+        for (int k = 0; k < walk->component_count; ++k) {
+            double qk = walk->component_q[k] * walk->component_pdf[k];
+            if (!(qk > 0.0)) continue;
+            for (int c = 0; c < m->channels; ++c) {
+                if (!(walk->channel_p[c] > 0.0)) continue;
+                double sigma = m->sigma_t[c] * walk->component_stretch[k];
+                double density = exited ? 1.0 : sigma;
+                denominator += qk * walk->channel_p[c] * density * exp((m->sigma_t[cw] - sigma) * t);
+            }
+        }
+        double f = walk->phase * (exited ? 1.0 : m->sigma_t[cw] * m->albedo[cw]);
+        double ratio = f / denominator;
+        walk->weight[cw] *= isfinite(ratio) ? ratio : 0.0;
+    }
+    walk->position = dwvw_madd(walk->position, walk->direction, t);
+    if (exited) {
+        walk->exit_normal = hit_normal;
+        return walk->status = DWVW_EXITED;
+    }
+    ++walk->events;
+    walk->closest_known = 0;
+
+    double largest = 0.0;
+    for (int c = 0; c < m->channels; ++c) largest = fmax(largest, walk->weight[c]);
+    if (!(largest > 0.0)) return walk->status = DWVW_ABSORBED;
+    if (largest < DWVW_ROULETTE_THRESHOLD) {
+        /* Russian roulette on small throughput only: survive with probability largest/threshold.
+         * Guided walks carry weights near alpha exp(sigma kappa z)/(1 + kappa), just below 1 near
+         * the surface; a threshold of 1 would kill them there for nothing but variance. */
+        double survive = largest / DWVW_ROULETTE_THRESHOLD;
+        double u = dwvk_rng_uniform_d(walk->key, 2u + DWVW_DIMS_PER_EVENT * walk->events - 1u);
+        if (u >= survive) {
+            for (int c = 0; c < m->channels; ++c) walk->weight[c] = 0.0;
+            return walk->status = DWVW_ABSORBED;
+        }
+        for (int c = 0; c < m->channels; ++c) walk->weight[c] /= survive;
+    }
+    if (walk->events >= walk->max_events) return walk->status = DWVW_TRUNCATED;
+    return walk->status = DWVW_RUNNING;
+}

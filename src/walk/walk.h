@@ -1,0 +1,130 @@
+/* Random walks in a homogeneous medium bounded by a surface, one step at a time.
+ *
+ * Every step is one sample of a mixture (one-sample MIS, balance heuristic, Veach 1997 Sec. 9.2)
+ * over components x colour channels. A component is either the classical (analog) technique or
+ * a guided one: Dwivedi sampling about an axis (Krivanek and d'Eon 2014; Meng et al. 2016), its
+ * free flight stretched by 1 - mu/v. The techniques differ only in which components a step has:
+ *   classical  classical only
+ *   poe        the entry point's outward normal
+ *   closest    the outward normal of the closest surface point, found again at every event
+ *   incident   the outward normals of lit surface patches, weighted by the light they receive
+ *              and by exp(-sigma_t distance / v) to the walk (Meng et al. 2016, Sec. 4.3)
+ *   backward   the entry normal or its opposite, the latter with probability
+ *              1 / (1 + exp(sigma_t (D - 2x) / v)) at depth x below the entry plane when a probe
+ *              along the entry direction found an opposite interface at depth D (as Cycles does,
+ *              after d'Eon and Krivanek 2020; Cycles mixes world units and mean free paths there)
+ *   cycles     Cycles' own mixture: classical 1/2 + backward 1/2 (isotropic media)
+ *   auto       classical 2% + incident and closest 9:1 (see dwvw_auto_weights)
+ * The colour channel that drives the distance is chosen with probability proportional to
+ * throughput x albedo, as Cycles does; the direction pdfs do not depend on it (v comes from the
+ * largest albedo), so a step's pdf is sum_k Q_k p_k(w) sum_c P_c pdist_{k,c}(t). */
+#ifndef DWV_WALK_WALK_H
+#define DWV_WALK_WALK_H
+
+#include <stdint.h>
+
+#include "kernel/dwivedi.h"
+#include "vec3.h"
+
+#define DWVW_MAX_CHANNELS 3
+#define DWVW_MAX_PATCHES 16
+#define DWVW_MAX_COMPONENTS (4 + DWVW_MAX_PATCHES)
+#define DWVW_DIMS_PER_EVENT 6
+
+typedef enum dwvw_technique {
+    DWVW_AUTO = 0,
+    DWVW_CLASSICAL = 1,
+    DWVW_POE = 2,
+    DWVW_CLOSEST = 3,
+    DWVW_INCIDENT = 4,
+    DWVW_BACKWARD = 5,
+    DWVW_CYCLES = 6
+} dwvw_technique;
+#define DWVW_TECHNIQUE_COUNT 7
+
+typedef struct dwvw_medium {
+    int channels;                        /* 1 (grey) or 3 */
+    double sigma_t[DWVW_MAX_CHANNELS];   /* extinction, > 0 */
+    double albedo[DWVW_MAX_CHANNELS];    /* single-scattering albedo in [0, 1] */
+    double g;                            /* Henyey-Greenstein anisotropy in (-1, 1) */
+    int guide_channel;                   /* the channel with the largest albedo */
+    dwvk_dwivedi_d dwivedi;              /* the direction distribution, from that albedo */
+    dwvk_dwivedi_f dwivedi_f;            /* the same in single precision, for the per-event path */
+} dwvw_medium;
+
+/* A lit part of the surface: an infinite plane (distance measured to the plane) or a patch
+ * around a point; `power` is the light it receives (irradiance x area), > 0. */
+typedef struct dwvw_light_patch {
+    dwvw_vec3 point, normal;
+    double power;
+    double log_power; /* log(power), kept by dwvw_guide_init */
+    int is_plane;
+} dwvw_light_patch;
+
+/* What a technique mixes, fixed for a walk. */
+typedef struct dwvw_guide {
+    double q_classical, q_poe, q_closest, q_incident, q_backward; /* sum to 1 */
+    int patch_count;
+    dwvw_light_patch patches[DWVW_MAX_PATCHES];
+} dwvw_guide;
+
+typedef enum dwvw_status {
+    DWVW_RUNNING = 0,    /* scattered inside; take another step */
+    DWVW_EXITED = 1,     /* left through the surface: exit_point, exit_normal, weight */
+    DWVW_ABSORBED = 2,   /* ended by Russian roulette or zero throughput */
+    DWVW_TRUNCATED = 3   /* ended by the event cap: its weight is reported, not dropped */
+} dwvw_status;
+
+typedef struct dwvw_walk {
+    const dwvw_medium *medium;
+    const dwvw_guide *guide;
+    uint64_t key;          /* counter-based RNG key of this walk */
+    uint32_t max_events;
+    uint32_t events;       /* scattering events so far */
+    dwvw_status status;
+    dwvw_vec3 position, direction;
+    dwvw_vec3 entry_point, entry_normal; /* entry_normal points out of the medium */
+    double weight[DWVW_MAX_CHANNELS];    /* throughput; on exit, the walk's estimate */
+    dwvw_vec3 exit_normal;
+    int have_opposite;
+    double opposite_depth;
+    /* the pending step, between dwvw_walk_sample and dwvw_walk_complete */
+    dwvw_vec3 closest_normal;
+    int closest_known;
+    double step_distance;
+    int component_count;
+    double component_q[DWVW_MAX_COMPONENTS];
+    dwvw_vec3 component_axis[DWVW_MAX_COMPONENTS]; /* unused for component 0 (classical) */
+    double component_pdf[DWVW_MAX_COMPONENTS];     /* direction pdf per steradian */
+    double component_stretch[DWVW_MAX_COMPONENTS];
+    double channel_p[DWVW_MAX_CHANNELS];
+    double phase;                                   /* phase function value of the step */
+} dwvw_walk;
+
+/* Fills a medium; the caller validated the values. */
+void dwvw_medium_init(dwvw_medium *medium, int channels, const double *sigma_t, const double *albedo, double g);
+/* The component weights of a technique for a medium and its lit patches (copied in). */
+void dwvw_guide_init(dwvw_guide *guide, dwvw_technique technique, const dwvw_medium *medium,
+                     const dwvw_light_patch *patches, int patch_count);
+/* Which techniques need the closest surface point at every event, and which a first-step probe. */
+int dwvw_guide_needs_closest(const dwvw_guide *guide);
+
+/* Starts a walk at `point` heading along unit `direction` into the medium, whose outward normal
+ * there is `normal`; weight 1 in every channel. */
+void dwvw_walk_begin(dwvw_walk *walk, const dwvw_medium *medium, const dwvw_guide *guide, uint64_t key,
+                     uint32_t max_events, dwvw_vec3 point, dwvw_vec3 direction, dwvw_vec3 normal);
+/* Before dwvw_walk_sample, where the guide needs it: the closest surface point's outward normal. */
+void dwvw_walk_set_closest(dwvw_walk *walk, dwvw_vec3 normal);
+/* Samples the next step's direction (walk->direction) and tentative distance (return value). */
+double dwvw_walk_sample(dwvw_walk *walk);
+/* Reports what the ray along walk->direction met: the surface at `hit_distance` (+INFINITY for
+ * none) with outward normal `hit_normal`. On the first step hit_distance is the probe's full
+ * answer (not cut at the sampled distance), which locates the opposite interface. Returns the
+ * new status. */
+dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 hit_normal);
+
+/* The mixture weights `auto` uses for a medium: see the definition for the heuristic. */
+void dwvw_auto_weights(const dwvw_medium *medium, int patch_count, double *q_classical, double *q_closest,
+                       double *q_incident);
+
+#endif
