@@ -188,9 +188,9 @@ double dwvw_walk_sample(dwvw_walk *walk)
     uint32_t dim = 2u + DWVW_DIMS_PER_EVENT * walk->events;
     double u_channel = dwvk_rng_uniform_d(walk->key, dim);
     double u_component = dwvk_rng_uniform_d(walk->key, dim + 1);
-    double u_cos = dwvk_rng_uniform_d(walk->key, dim + 2);
-    double u_phi = dwvk_rng_uniform_d(walk->key, dim + 3);
-    double u_distance = dwvk_rng_uniform_d(walk->key, dim + 4);
+    float u_cos = dwvk_rng_uniform_f(walk->key, dim + 2);
+    float u_phi = dwvk_rng_uniform_f(walk->key, dim + 3);
+    float u_distance = dwvk_rng_uniform_f(walk->key, dim + 4);
 
     /* Channel: proportional to throughput x albedo (Cycles), to throughput where all albedos are 0. */
     double total = 0.0;
@@ -209,14 +209,16 @@ double dwvw_walk_sample(dwvw_walk *walk)
     if (walk->events > 0) {
         /* The first step keeps the entry direction: only its distance is sampled. */
         if (chosen == 0) {
-            float mu = dwvk_hg_sample_f(g, (float)u_cos);
+            float mu = g == 0.0f ? dwvk_isotropic_sample_f(u_cos) : dwvk_hg_sample_f(g, u_cos);
             walk->direction = dwvw_direction_about(previous, mu, 1.0f - mu, 1.0f + mu, u_phi);
         } else {
-            dwvk_dwivedi_sample_f s = dwvk_dwivedi_sample_pdf_f(&m->dwivedi_f, (float)u_cos);
+            dwvk_dwivedi_sample_f s = dwvk_dwivedi_sample_pdf_f(&m->dwivedi_f, u_cos);
             walk->direction = dwvw_direction_about(walk->component_axis[chosen], s.cos_theta, s.one_minus_cos,
                                                    s.one_plus_cos, u_phi);
         }
-        walk->phase = dwvk_hg_pdf_f(g, clamp_cosine(dwvw_dot(previous, walk->direction)));
+        /* HG at g = 0 is the isotropic 1/(4 pi): skip its square root and division. */
+        walk->phase = g == 0.0f ? (float)DWVK_INV_FOUR_PI
+                                : dwvk_hg_pdf_f(g, clamp_cosine(dwvw_dot(previous, walk->direction)));
     } else {
         walk->phase = 1.0;
     }
@@ -230,7 +232,7 @@ double dwvw_walk_sample(dwvw_walk *walk)
         walk->component_stretch[k] = dwvk_dwivedi_stretch_f(&m->dwivedi_f, mu);
     }
     float sigma = (float)(m->sigma_t[channel] * walk->component_stretch[chosen]);
-    walk->step_distance = dwvk_exponential_sample_f(sigma, (float)u_distance);
+    walk->step_distance = dwvk_exponential_sample_f(sigma, u_distance);
     return walk->step_distance;
 }
 
@@ -253,22 +255,36 @@ dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 h
      * share the factor exp(-sigma t), so the ratio is formed from exp(sigma_c' t - sigma_c s_k t)
      * and neither underflows alone. pdist is sigma s exp(-sigma s t) for a scattering event and
      * exp(-sigma s t) for leaving at t. */
-    for (int cw = 0; cw < m->channels; ++cw) {
-        if (walk->weight[cw] == 0.0) continue;
-        double denominator = 0.0;
-        for (int k = 0; k < walk->component_count; ++k) {
-            double qk = walk->component_q[k] * walk->component_pdf[k];
-            if (!(qk > 0.0)) continue;
-            for (int c = 0; c < m->channels; ++c) {
-                if (!(walk->channel_p[c] > 0.0)) continue;
-                double sigma = m->sigma_t[c] * walk->component_stretch[k];
-                double density = exited ? 1.0 : sigma;
-                denominator += qk * walk->channel_p[c] * density * exp((m->sigma_t[cw] - sigma) * t);
-            }
+    const int components = walk->component_count, channels = m->channels;
+    double qp[DWVW_MAX_COMPONENTS];
+    for (int k = 0; k < components; ++k) qp[k] = walk->component_q[k] * walk->component_pdf[k];
+    if (channels == 1) {
+        /* Grey medium: one channel, P = 1. */
+        double sigma_t = m->sigma_t[0], denominator = 0.0;
+        for (int k = 0; k < components; ++k) {
+            if (!(qp[k] > 0.0)) continue;
+            double stretch = walk->component_stretch[k];
+            denominator += qp[k] * (exited ? 1.0 : stretch) * exp(sigma_t * (1.0 - stretch) * t);
         }
-        double f = walk->phase * (exited ? 1.0 : m->sigma_t[cw] * m->albedo[cw]);
-        double ratio = f / denominator;
-        walk->weight[cw] *= isfinite(ratio) ? ratio : 0.0;
+        double ratio = walk->phase * (exited ? 1.0 : m->albedo[0]) / denominator;
+        walk->weight[0] *= isfinite(ratio) ? ratio : 0.0;
+    } else {
+        for (int cw = 0; cw < channels; ++cw) {
+            if (walk->weight[cw] == 0.0) continue;
+            double denominator = 0.0;
+            for (int k = 0; k < components; ++k) {
+                if (!(qp[k] > 0.0)) continue;
+                for (int c = 0; c < channels; ++c) {
+                    if (!(walk->channel_p[c] > 0.0)) continue;
+                    double sigma = m->sigma_t[c] * walk->component_stretch[k];
+                    double density = exited ? 1.0 : sigma;
+                    denominator += qp[k] * walk->channel_p[c] * density * exp((m->sigma_t[cw] - sigma) * t);
+                }
+            }
+            double f = walk->phase * (exited ? 1.0 : m->sigma_t[cw] * m->albedo[cw]);
+            double ratio = f / denominator;
+            walk->weight[cw] *= isfinite(ratio) ? ratio : 0.0;
+        }
     }
     walk->position = dwvw_madd(walk->position, walk->direction, t);
     if (exited) {
