@@ -12,8 +12,8 @@
  * Case's bracket; log(1 - kappa0) = log 2 - 2/alpha + d, d = log D. D and d are flat at alpha = 0
  * (D - 1 is about (4/alpha - 1) E), which no one polynomial follows, so both are polynomials on
  * every interval [k/32, (k+1)/32) (D = 1, d = 0 below 1/16, where d < 1e-12). E is computed inline
- * and in parallel with D and d, rather than as exp(d - 2/alpha), to keep the chain of dependent
- * operations short (that chain, not the operation count, bounds the time of a call).
+ * and in parallel with D and d, rather than as exp(d - 2/alpha): a long chain of dependent
+ * operations limits how many calls the processor overlaps, as much as their number does.
  * Tiny albedo, alpha < 1/256: 1 - kappa0 = 2 exp(-2/alpha) (d < 1e-200), rounding gradually into
  * the subnormals and to 0, and log(1 - kappa0) = log 2 - 2/alpha, -infinity at alpha = 0 and where
  * 2/alpha overflows (alpha < 2/DBL_MAX, where the true value is below -DBL_MAX).
@@ -145,11 +145,11 @@ static dwvk_kappa_t kappa_high(double alpha)
     return out;
 }
 
-/* 2 E = 2 exp(-2/alpha) is 2^(-n/16) 2^(f/16) with n = round(Y), f = n - Y in [-1/2, 1/2]
+/* E = exp(-2/alpha) is 2^(-n/16) 2^(f/16) with n = round(Y), f = n - Y in [-1/2, 1/2]
  * (Y = 2/alpha 16/log 2 <= 11819 here): 2^(-n/16) = 2^m 2^(i/16), -n = 16 m + i, from the table
- * and the exponent bits, 2^(f/16) = exp(f log(2)/16) by its Taylor polynomial of degree 5, whose
- * error, below 1.5e-13, has the same sign at f = -1/2 and f = 1/2 so that E keeps increasing with
- * alpha where n steps. */
+ * and the exponent bits, 2^(f/16) = exp(f log(2)/16) by its Taylor polynomial of degree 5. That
+ * polynomial falls short of exp by r^6/720 (r = f log(2)/16, below 1.5e-13) at both ends, a little
+ * less at f = -1/2, where f lands when n steps down as alpha grows: E never steps down there. */
 static dwvk_kappa_t kappa_low(double alpha)
 {
     double two_over_alpha = 2.0 / alpha;
