@@ -271,8 +271,7 @@ enum { DWV_LIGHT_FRONT = 1, DWV_LIGHT_BACK = 2, DWV_LIGHT_BOTH = 3 };
  * and/or +z (back). So a front-lit half-space with normal incidence estimates its total diffuse
  * reflectance, a back-lit slab its total transmittance. The incident technique (and auto) aims
  * at the lit faces: the planes z = 0 (normal -z) and z = thickness (normal +z), each with power 1;
- * on the sphere, per lit side, seven patches: the lit pole (power 1/4), then six at 60 degrees
- * from it at azimuths k 60 degrees, k = 1..6 (power 1/16 each), in that order. */
+ * on the sphere, one patch per lit side at its pole (normal -z or +z, power 1); front first. */
 typedef struct dwv_estimate_options_t {
     uint32_t struct_size; /* sizeof(dwv_estimate_options_t): set by DWV_ESTIMATE_OPTIONS_INIT */
     dwv_shape_t shape;

@@ -5,23 +5,9 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "api_checks.h"
 #include "check.h"
 #include "dwivedi.h"
-
-static const char PRIMER_NAME[] = "no-such-technique-primer";
-
-/* Leaves a known message behind, so that a check can tell a new message from a stale one. */
-static void prime_message(void)
-{
-    dwv_technique_t ignored;
-    (void)dwv_technique_from_name(PRIMER_NAME, &ignored);
-}
-
-static int fresh_message_with(const char *keyword)
-{
-    const char *message = dwv_last_error_message();
-    return message[0] != '\0' && strstr(message, PRIMER_NAME) == NULL && strstr(message, keyword) != NULL;
-}
 
 /* Small valid options: every refusal below changes exactly one thing. */
 static dwv_estimate_options_t valid_options(void)
