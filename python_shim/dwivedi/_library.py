@@ -49,7 +49,15 @@ class Error(ValueError):
 Error.__module__ = "dwivedi"
 
 
-class DiffusionLength(ctypes.Structure):
+class _SizedStructure(ctypes.Structure):
+    """A capi struct that begins with struct_size, constructed with struct_size set to the size of
+    the struct as its DWV_..._INIT macro sets it (the other fields start at 0)."""
+
+    def __init__(self) -> None:
+        super().__init__(ctypes.sizeof(type(self)))
+
+
+class DiffusionLength(_SizedStructure):
     """dwv_diffusion_length_t, with struct_size set as DWV_DIFFUSION_LENGTH_INIT does."""
 
     _fields_ = [
@@ -63,11 +71,8 @@ class DiffusionLength(ctypes.Structure):
         ("log_ratio", ctypes.c_double),
     ]
 
-    def __init__(self) -> None:
-        super().__init__(ctypes.sizeof(DiffusionLength))
 
-
-class Dwivedi(ctypes.Structure):
+class Dwivedi(_SizedStructure):
     """dwv_dwivedi_t, with struct_size set as DWV_DWIVEDI_INIT does."""
 
     _fields_ = [
@@ -84,11 +89,8 @@ class Dwivedi(ctypes.Structure):
         ("albedo_eff_f", ctypes.c_float),
     ]
 
-    def __init__(self) -> None:
-        super().__init__(ctypes.sizeof(Dwivedi))
 
-
-class DwivediSample(ctypes.Structure):
+class DwivediSample(_SizedStructure):
     """dwv_dwivedi_sample_t, with struct_size set as DWV_DWIVEDI_SAMPLE_INIT does."""
 
     _fields_ = [
@@ -100,9 +102,6 @@ class DwivediSample(ctypes.Structure):
         ("pdf", ctypes.c_double),
         ("stretch", ctypes.c_double),
     ]
-
-    def __init__(self) -> None:
-        super().__init__(ctypes.sizeof(DwivediSample))
 
 
 _result_t = ctypes.c_int32

@@ -5,27 +5,16 @@ starting with "dwivedi").
 Run by ctest (see tests/CMakeLists.txt), which sets DWIVEDI_CLI, DWIVEDI_LIBRARY,
 DWIVEDI_SOURCE_DIR and PYTHONPATH. Standard library only.
 """
-import json
 import math
-import os
-import subprocess
 import unittest
 from typing import Dict, List, Optional
 
+from cli_helpers import assert_bad_usage, listed_verbs, run_cli, run_json
 from test_shim import header_version, read_v0_reference, relative_error
 
 import dwivedi
 
 JSON_KEYS = {"albedo", "method", "v0", "kappa", "one_minus_kappa", "log_one_minus_kappa"}
-USAGE = 2  # exit code of bad usage (src/cli/cli.h)
-
-
-def run_cli(*args: str) -> subprocess.CompletedProcess:
-    cli = os.environ.get("DWIVEDI_CLI")
-    if not cli:
-        raise AssertionError("DWIVEDI_CLI is not set; run these tests through ctest")
-    return subprocess.run([cli, *args], capture_output=True, text=True, timeout=30)
-
 
 def json_number(value: float) -> Optional[float]:
     """How the CLI writes a double in JSON: itself, or null where it is not finite."""
@@ -40,9 +29,7 @@ class HelpTest(unittest.TestCase):
                 self.assertEqual(done.returncode, 0)
                 self.assertEqual(done.stderr, "")
                 self.assertIn("usage: dwivedi", done.stdout)
-                lines = done.stdout.splitlines()
-                verb_lines = lines[lines.index("verbs:") + 1:]
-                verbs = [line.split()[0] for line in verb_lines[:verb_lines.index("")]]
+                verbs = listed_verbs(done.stdout)
                 self.assertIn("v0", verbs)
                 self.assertIn("bench", verbs)
 
@@ -64,14 +51,7 @@ class HelpTest(unittest.TestCase):
 
 class V0Test(unittest.TestCase):
     def v0_json(self, *args: str) -> Dict[str, object]:
-        done = run_cli("v0", *args, "--json")
-        self.assertEqual(done.returncode, 0, done.stderr)
-        self.assertEqual(done.stderr, "")
-        self.assertEqual(len(done.stdout.splitlines()), 1, done.stdout)
-        result = json.loads(done.stdout)
-        self.assertIsInstance(result, dict)
-        self.assertEqual(set(result), JSON_KEYS)
-        return result
+        return run_json(self, JSON_KEYS, "v0", *args)
 
     def assert_matches_shim(self, result: Dict[str, object], albedo: float, method: str) -> None:
         # %.17g round-trips a double, so the CLI's numbers equal the library's exactly.
@@ -155,16 +135,8 @@ class UsageErrorTest(unittest.TestCase):
     def test_bad_usage(self) -> None:
         for args, words in self.CASES:
             with self.subTest(args=args):
-                done = run_cli(*args)
-                self.assertEqual(done.returncode, USAGE)
-                self.assertEqual(done.stdout, "")
-                self.assertTrue(done.stderr.endswith("\n"), repr(done.stderr))
-                lines = done.stderr.splitlines()
-                self.assertEqual(len(lines), 1, done.stderr)
                 expected_start = "dwivedi v0: " if args[0] == "v0" else "dwivedi: "
-                self.assertTrue(lines[0].startswith(expected_start), lines[0])
-                for word in words:
-                    self.assertIn(word, lines[0])
+                assert_bad_usage(self, args, expected_start, words)
 
 
 if __name__ == "__main__":

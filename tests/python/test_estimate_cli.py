@@ -4,27 +4,18 @@ stdout, one line on stderr starting with "dwivedi").
 
 Run by ctest (see tests/CMakeLists.txt), which sets DWIVEDI_CLI. Standard library only.
 """
-import json
 import math
-import os
-import subprocess
 import unittest
 from typing import Dict, List
 
-USAGE = 2  # exit code of bad usage (src/cli/cli.h)
+from cli_helpers import assert_bad_usage, listed_verbs, run_cli, run_json
+
 JSON_KEYS = {"technique", "channels", "mean", "stderr", "variance", "walks", "events", "seconds", "efficiency",
              "truncated_weight", "truncated_walks"}
 PER_CHANNEL_KEYS = ("mean", "stderr", "variance", "truncated_weight")
 # A small valid run; the bad-argument cases below change or drop one thing of it.
 SMALL_RUN = ["--scene", "halfspace", "--albedo", "0.5", "--technique", "auto", "--walks", "20000", "--seed", "7",
              "--threads", "1"]
-
-
-def run_cli(*args: str) -> subprocess.CompletedProcess:
-    cli = os.environ.get("DWIVEDI_CLI")
-    if not cli:
-        raise AssertionError("DWIVEDI_CLI is not set; run these tests through ctest")
-    return subprocess.run([cli, *args], capture_output=True, text=True, timeout=60)
 
 
 def without(args: List[str], flag: str) -> List[str]:
@@ -56,21 +47,12 @@ class EstimateHelpTest(unittest.TestCase):
     def test_listed_by_dwivedi_help(self) -> None:
         done = run_cli("--help")
         self.assertEqual(done.returncode, 0, done.stderr)
-        lines = done.stdout.splitlines()
-        verb_lines = lines[lines.index("verbs:") + 1:]
-        self.assertIn("estimate", [line.split()[0] for line in verb_lines[:verb_lines.index("")]])
+        self.assertIn("estimate", listed_verbs(done.stdout))
 
 
 class EstimateJsonTest(unittest.TestCase):
     def estimate_json(self, *args: str) -> Dict[str, object]:
-        done = run_cli("estimate", *args, "--json")
-        self.assertEqual(done.returncode, 0, done.stderr)
-        self.assertEqual(done.stderr, "")
-        self.assertEqual(len(done.stdout.splitlines()), 1, done.stdout)
-        result = json.loads(done.stdout)
-        self.assertIsInstance(result, dict)
-        self.assertEqual(set(result), JSON_KEYS)
-        return result
+        return run_json(self, JSON_KEYS, "estimate", *args)
 
     def assert_channel_sane(self, mean: float, stderr: float, variance: float, truncated: float,
                             walks: int) -> None:
@@ -158,14 +140,7 @@ class EstimateUsageErrorTest(unittest.TestCase):
     def assert_usage_error(self, args: List[str], names: str) -> None:
         """Exit 2, nothing on stdout, one line on stderr that starts with "dwivedi" and names the
         offending flag or value (`names`)."""
-        done = run_cli("estimate", *args)
-        self.assertEqual(done.returncode, USAGE, (args, done.stdout, done.stderr))
-        self.assertEqual(done.stdout, "")
-        lines = done.stderr.splitlines()
-        self.assertEqual(len(lines), 1, done.stderr)
-        self.assertTrue(lines[0].startswith("dwivedi"), lines[0])
-        self.assertTrue(done.stderr.endswith("\n"), done.stderr)
-        self.assertIn(names, lines[0])
+        assert_bad_usage(self, ["estimate", *args], "dwivedi", [names])
 
     def test_the_small_run_itself_is_valid(self) -> None:
         # Each case below differs from SMALL_RUN in one thing, so its failure is that thing's doing.

@@ -11,46 +11,18 @@
 #include <stdint.h>
 #include <stdio.h>
 
-#include "check.h"
-#include "dwivedi.h"
-
-/* Every run has a seed of its own, so that the estimates compared are independent. */
-static uint64_t next_seed = 0xa9ee0001u;
-
-static dwv_estimate_result_t estimate(dwv_estimate_options_t options, uint64_t walks)
-{
-    options.walks = walks;
-    options.seed = next_seed++;
-    options.threads = 2;
-    dwv_estimate_result_t result = DWV_ESTIMATE_RESULT_INIT;
-    dwv_result_t rc = dwv_estimate(&options, &result);
-    CHECK(rc == DWV_SUCCESS, "dwv_estimate: %s", dwv_last_error_message());
-    return result;
-}
+#define WALK_SEED_BASE 0xa9ee0001u
+#include "walk_harness.h"
 
 /* Walk counts from a pilot run, for a standard error of about 0.35 percent of the mean, within
- * [MIN_WALKS, MAX_WALKS]: techniques that do not suit a scene (a guide toward the front of a
- * back-lit slab) have heavy-tailed weights and stop at MAX_WALKS with a larger error. */
-enum { PILOT_WALKS = 5000, MIN_WALKS = 20000, MAX_WALKS = 250000 };
-#define TARGET_RELATIVE_ERROR 0.0035
-
-static dwv_estimate_result_t estimate_to_precision(dwv_estimate_options_t options)
-{
-    dwv_estimate_result_t pilot = estimate(options, PILOT_WALKS);
-    double target = TARGET_RELATIVE_ERROR * pilot.mean[0];
-    double walks = target > 0.0 ? ceil(pilot.variance[0] / (target * target)) : MAX_WALKS;
-    walks = fmin(fmax(walks, MIN_WALKS), MAX_WALKS);
-    return estimate(options, (uint64_t)walks);
-}
+ * [min_walks, max_walks]: techniques that do not suit a scene (a guide toward the front of a
+ * back-lit slab) have heavy-tailed weights and stop at max_walks with a larger error. */
+static const walk_budget_t BUDGET = {
+    .pilot_walks = 5000, .min_walks = 20000, .max_walks = 250000, .zero_mean_walks = 250000,
+    .target_relative_error = 0.0035,
+};
 
 #define SIGMAS 5.0
-
-typedef struct scene_t {
-    const char *name;
-    dwv_shape_t shape;
-    double size; /* slab thickness or sphere radius */
-    dwv_light_t light;
-} scene_t;
 
 static const scene_t SCENES[] = {
     {"half-space, front", DWV_SHAPE_HALFSPACE, 0.0, DWV_LIGHT_FRONT},
@@ -71,14 +43,9 @@ int main(void)
             dwv_estimate_result_t r[TECHNIQUES];
             printf("  %s, albedo %g\n", scene->name, ALBEDOS[a]);
             for (dwv_technique_t t = 0; t < TECHNIQUES; ++t) {
-                dwv_estimate_options_t options = DWV_ESTIMATE_OPTIONS_INIT;
-                options.shape = scene->shape;
-                options.thickness = scene->shape == DWV_SHAPE_SLAB ? scene->size : options.thickness;
-                options.radius = scene->shape == DWV_SHAPE_SPHERE ? scene->size : options.radius;
+                dwv_estimate_options_t options = scene_options(scene, t);
                 options.medium.albedo[0] = ALBEDOS[a];
-                options.light = scene->light;
-                options.technique = t;
-                r[t] = estimate_to_precision(options);
+                r[t] = estimate_to_precision(options, &BUDGET);
                 CHECK(r[t].truncated_walks == 0, "%s albedo %g %s: %llu walks truncated", scene->name, ALBEDOS[a],
                       dwv_technique_name(t), (unsigned long long)r[t].truncated_walks);
             }
@@ -87,8 +54,7 @@ int main(void)
                 dwv_technique_t worst_other = t;
                 for (dwv_technique_t u = 0; u < TECHNIQUES; ++u) {
                     if (u == t) continue;
-                    double sigma = sqrt(r[t].std_error[0] * r[t].std_error[0] + r[u].std_error[0] * r[u].std_error[0]);
-                    double z = (r[t].mean[0] - r[u].mean[0]) / sigma;
+                    double z = difference_z(r[t].mean[0], r[t].std_error[0], r[u].mean[0], r[u].std_error[0]);
                     if (fabs(z) > fabs(worst)) worst = z, worst_other = u;
                     if (u > t)
                         CHECK(fabs(z) <= SIGMAS, "%s albedo %g: %s %.8f +- %.3e vs %s %.8f +- %.3e: z = %.2f",

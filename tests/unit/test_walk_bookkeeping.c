@@ -14,16 +14,8 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "check.h"
-#include "dwivedi.h"
-
-static dwv_estimate_result_t estimate(const dwv_estimate_options_t *options)
-{
-    dwv_estimate_result_t result = DWV_ESTIMATE_RESULT_INIT;
-    dwv_result_t rc = dwv_estimate(options, &result);
-    CHECK(rc == DWV_SUCCESS, "dwv_estimate: %s", dwv_last_error_message());
-    return result;
-}
+/* Every run here sets its own seed and thread count: no WALK_SEED_BASE. */
+#include "walk_harness.h"
 
 /* ---- determinism --------------------------------------------------------------------------- */
 
@@ -71,11 +63,11 @@ static void test_determinism(void)
         options.seed = 77;
         options.max_events = 40;
         options.threads = 1;
-        dwv_estimate_result_t one = estimate(&options);
+        dwv_estimate_result_t one = run_estimate(&options);
         CHECK(one.truncated_walks > 0, "%s: no walk met the cap of %u events", dwv_technique_name(t), options.max_events);
         for (uint32_t threads = 2; threads <= 3; ++threads) {
             options.threads = threads;
-            dwv_estimate_result_t many = estimate(&options);
+            dwv_estimate_result_t many = run_estimate(&options);
             check_identical(dwv_technique_name(t), &one, &many, threads);
         }
         printf("  %-9s mean %.17g %.17g %.17g  events %llu  truncated %llu\n", dwv_technique_name(t), one.mean[0],
@@ -100,10 +92,10 @@ static void test_truncation(void)
         options.threads = 2;
         options.seed = 1000u + (uint64_t)t;
         options.max_events = CAP;
-        dwv_estimate_result_t capped = estimate(&options);
+        dwv_estimate_result_t capped = run_estimate(&options);
         options.seed = 2000u + (uint64_t)t; /* independent of the capped run */
         options.max_events = 0;
-        dwv_estimate_result_t full = estimate(&options);
+        dwv_estimate_result_t full = run_estimate(&options);
         double sigma = sqrt(capped.std_error[0] * capped.std_error[0] + full.std_error[0] * full.std_error[0]);
         printf("  %-9s %12.8f %12.8f %12.8f %10.3e %10llu\n", dwv_technique_name(t), capped.mean[0],
                capped.truncated_weight[0], full.mean[0], sigma, (unsigned long long)capped.truncated_walks);

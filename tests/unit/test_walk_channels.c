@@ -9,22 +9,8 @@
 #include <stdint.h>
 #include <stdio.h>
 
-#include "check.h"
-#include "dwivedi.h"
-
-/* Every run has a seed of its own, so that estimates compared with each other are independent. */
-static uint64_t next_seed = 0xc4a10001u;
-
-static dwv_estimate_result_t estimate(dwv_estimate_options_t options, uint64_t walks)
-{
-    options.walks = walks;
-    options.seed = next_seed++;
-    options.threads = 2;
-    dwv_estimate_result_t result = DWV_ESTIMATE_RESULT_INIT;
-    dwv_result_t rc = dwv_estimate(&options, &result);
-    CHECK(rc == DWV_SUCCESS, "dwv_estimate: %s", dwv_last_error_message());
-    return result;
-}
+#define WALK_SEED_BASE 0xc4a10001u
+#include "walk_harness.h"
 
 #define SIGMAS 5.0
 enum { WALKS = 60000, TECHNIQUES = DWV_TECHNIQUE_CYCLES + 1 };
@@ -34,29 +20,11 @@ enum { WALKS = 60000, TECHNIQUES = DWV_TECHNIQUE_CYCLES + 1 };
 static const double SIGMA_T[3] = {1.0, 2.0, 0.5};
 static const double ALBEDO[3] = {0.99, 0.9, 0.6};
 
-typedef struct scene_t {
-    const char *name;
-    dwv_shape_t shape;
-    double size; /* slab thickness or sphere radius, in the units of 1/sigma_t */
-    dwv_light_t light;
-} scene_t;
-
 static const scene_t SCENES[] = {
     {"half-space, front", DWV_SHAPE_HALFSPACE, 0.0, DWV_LIGHT_FRONT},
     {"slab 2, back", DWV_SHAPE_SLAB, 2.0, DWV_LIGHT_BACK},
     {"sphere 2, front", DWV_SHAPE_SPHERE, 2.0, DWV_LIGHT_FRONT},
 };
-
-static dwv_estimate_options_t scene_options(const scene_t *scene, dwv_technique_t technique)
-{
-    dwv_estimate_options_t options = DWV_ESTIMATE_OPTIONS_INIT;
-    options.shape = scene->shape;
-    options.thickness = scene->shape == DWV_SHAPE_SLAB ? scene->size : options.thickness;
-    options.radius = scene->shape == DWV_SHAPE_SPHERE ? scene->size : options.radius;
-    options.light = scene->light;
-    options.technique = technique;
-    return options;
-}
 
 int main(void)
 {
@@ -76,8 +44,7 @@ int main(void)
                 grey.medium.sigma_t[0] = SIGMA_T[c];
                 grey.medium.albedo[0] = ALBEDO[c];
                 dwv_estimate_result_t g = estimate(grey, WALKS);
-                double sigma = sqrt(r.std_error[c] * r.std_error[c] + g.std_error[0] * g.std_error[0]);
-                double z = (r.mean[c] - g.mean[0]) / sigma;
+                double z = difference_z(r.mean[c], r.std_error[c], g.mean[0], g.std_error[0]);
                 printf("  %-18s %-9s %-2d %12.8f %10.3e %12.8f %10.3e %8.2f\n", SCENES[s].name, dwv_technique_name(t), c,
                        r.mean[c], r.std_error[c], g.mean[0], g.std_error[0], z);
                 CHECK(fabs(z) <= SIGMAS, "%s %s channel %d: rgb %.8f +- %.3e, grey %.8f +- %.3e: z = %.2f",

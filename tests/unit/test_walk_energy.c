@@ -20,22 +20,8 @@
 #include <stdint.h>
 #include <stdio.h>
 
-#include "check.h"
-#include "dwivedi.h"
-
-/* Every run has a seed of its own, so that estimates compared with each other are independent. */
-static uint64_t next_seed = 0xe4e60001u;
-
-static dwv_estimate_result_t estimate(dwv_estimate_options_t options, uint64_t walks)
-{
-    options.walks = walks;
-    options.seed = next_seed++;
-    options.threads = 2;
-    dwv_estimate_result_t result = DWV_ESTIMATE_RESULT_INIT;
-    dwv_result_t rc = dwv_estimate(&options, &result);
-    CHECK(rc == DWV_SUCCESS, "dwv_estimate: %s", dwv_last_error_message());
-    return result;
-}
+#define WALK_SEED_BASE 0xe4e60001u
+#include "walk_harness.h"
 
 #define SIGMAS 5.0
 /* Weights are products of per-event ratios, each rounded; where they are all 1 in exact arithmetic
@@ -108,13 +94,13 @@ static void test_conservative_halfspace(void)
 
 enum { SUM_WALKS = 40000 };
 
-typedef struct scene_t {
+typedef struct sum_scene_t {
     const char *name;
     dwv_shape_t shape;
     double size;
-} scene_t;
+} sum_scene_t;
 
-static const scene_t SUM_SCENES[] = {
+static const sum_scene_t SUM_SCENES[] = {
     {"slab 1", DWV_SHAPE_SLAB, 1.0},
     {"slab 4", DWV_SHAPE_SLAB, 4.0},
     {"sphere 2", DWV_SHAPE_SPHERE, 2.0},
