@@ -233,7 +233,7 @@ DWV_API dwv_result_t dwv_random_uniform_f(uint64_t seed, uint64_t stream, uint64
  * ------------------------------------------------------------------------------------------- */
 typedef int32_t dwv_technique_t;
 enum {
-    DWV_TECHNIQUE_AUTO = 0,      /* classical 2% + incident and closest 9:1 (dwivedi heuristic) */
+    DWV_TECHNIQUE_AUTO = 0,      /* small classical share + incident (closest without light) */
     DWV_TECHNIQUE_CLASSICAL = 1, /* analog phase-function and free-flight sampling */
     DWV_TECHNIQUE_POE = 2,       /* Dwivedi about the entry point's normal (Krivanek, d'Eon 2014) */
     DWV_TECHNIQUE_CLOSEST = 3,   /* Dwivedi about the closest surface point's normal (Meng 2016) */

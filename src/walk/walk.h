@@ -14,7 +14,7 @@
  *              along the entry direction found an opposite interface at depth D (as Cycles does,
  *              after d'Eon and Krivanek 2020; Cycles mixes world units and mean free paths there)
  *   cycles     Cycles' own mixture: classical 1/2 + backward 1/2 (isotropic media)
- *   auto       classical 2% + incident and closest 9:1 (see dwvw_auto_weights)
+ *   auto       a small classical share + incident (closest where no light is known)
  * The colour channel that drives the distance is chosen with probability proportional to
  * throughput x albedo, as Cycles does; the direction pdfs do not depend on it (v comes from the
  * largest albedo), so a step's pdf is sum_k Q_k p_k(w) sum_c P_c pdist_{k,c}(t). */
