@@ -248,7 +248,7 @@ DWV_API dwv_result_t dwv_technique_from_name(const char *name, dwv_technique_t *
 typedef struct dwv_medium_t {
     uint32_t struct_size; /* sizeof(dwv_medium_t): set by DWV_MEDIUM_INIT */
     uint32_t channels;    /* 1 or 3 */
-    double sigma_t[3];    /* extinction per unit length, finite and > 0 */
+    double sigma_t[3];    /* extinction per unit length, in [1e-30, 1e30] */
     double albedo[3];     /* single-scattering albedo in [0, 1] */
     double anisotropy;    /* Henyey-Greenstein g in (-1, 1) */
 } dwv_medium_t;

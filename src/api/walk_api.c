@@ -68,6 +68,11 @@ static dwv_result_t medium_from_api(const char *fn, const dwv_medium_t *in, dwvw
     static const char *const albedo_names[] = {"medium albedo[0]", "medium albedo[1]", "medium albedo[2]"};
     for (uint32_t c = 0; c < in->channels; ++c) {
         DWV_TRY(check_positive(fn, sigma_names[c], in->sigma_t[c]));
+        /* Free flights are sampled in single precision (stretched by as little as 2^-20): outside
+         * this range sigma_t would round to 0 or infinity there. */
+        if (in->sigma_t[c] < 1e-30 || in->sigma_t[c] > 1e30)
+            return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: %s = %.17g is outside [1e-30, 1e30]", fn, sigma_names[c],
+                            in->sigma_t[c]);
         DWV_TRY(dwv_check_range(fn, albedo_names[c], in->albedo[c], 0.0, 1.0));
     }
     DWV_TRY(dwv_check_finite(fn, "medium anisotropy", in->anisotropy));

@@ -111,6 +111,11 @@ static void test_refusals(void)
     expect_refused("sigma_t NaN", &o, DWV_ERROR_INVALID_ARGUMENT, "sigma_t");
     o = valid_options(), o.medium.sigma_t[0] = INFINITY;
     expect_refused("sigma_t inf", &o, DWV_ERROR_INVALID_ARGUMENT, "sigma_t");
+    /* Beyond single precision, where free flights are sampled. */
+    o = valid_options(), o.medium.sigma_t[0] = 1e31;
+    expect_refused("sigma_t 1e31", &o, DWV_ERROR_OUT_OF_RANGE, "sigma_t");
+    o = valid_options(), o.medium.sigma_t[0] = 1e-31;
+    expect_refused("sigma_t 1e-31", &o, DWV_ERROR_OUT_OF_RANGE, "sigma_t");
     o = valid_options(), o.medium.channels = 3u, o.medium.sigma_t[1] = 0.0;
     expect_refused("rgb sigma_t[1] 0", &o, DWV_ERROR_OUT_OF_RANGE, "sigma_t[1]");
     o = valid_options(), o.medium.albedo[0] = 1.5;
