@@ -6,7 +6,9 @@
 
 int main(void)
 {
-    if (dwv_version() != DWV_VERSION || strcmp(dwv_version_string(), "0.1.0") != 0) {
+    char expected[32];
+    snprintf(expected, sizeof expected, "%d.%d.%d", DWV_VERSION_MAJOR, DWV_VERSION_MINOR, DWV_VERSION_PATCH);
+    if (dwv_version() != DWV_VERSION || strcmp(dwv_version_string(), expected) != 0) {
         fprintf(stderr, "version mismatch: header %d, library %u (%s)\n", DWV_VERSION, dwv_version(),
                 dwv_version_string());
         return 1;
