@@ -56,7 +56,10 @@ enum {
     DWV_ERROR_UNKNOWN_NAME = 5,     /* a name (method, technique...) is not known */
     DWV_ERROR_OUT_OF_MEMORY = 6,
     DWV_ERROR_INTERNAL = 7,         /* a bug in dwivedi: please report it with the message */
-    DWV_ERROR_INVALID_STATE = 8     /* a call out of order (e.g. a walk step before dwv_walk_begin) */
+    DWV_ERROR_INVALID_STATE = 8,    /* a call out of order (e.g. a walk step before dwv_walk_begin) */
+    DWV_ERROR_CANCELLED = 9,        /* the caller cancelled a bake */
+    DWV_ERROR_IO = 10,              /* a file could not be read or written (the message says why) */
+    DWV_ERROR_FORMAT = 11           /* a scene file or mesh file is malformed (the message says where) */
 };
 
 /* A static, constant description of a result code ("invalid argument"); never NULL. */
@@ -368,6 +371,312 @@ DWV_API dwv_result_t dwv_walk_set_closest(dwv_walk_t *walk, const double normal[
 DWV_API dwv_result_t dwv_walk_sample(dwv_walk_t *walk, double direction[3], double *distance);
 DWV_API dwv_result_t dwv_walk_report(dwv_walk_t *walk, double hit_distance, const double hit_normal[3],
                                      dwv_walk_state_t *state);
+
+/* ---------------------------------------------------------------------------------------------
+ * Scenes: triangle meshes with Cycles' subsurface materials, lights, a world and a camera.
+ *
+ * Build a scene with the dwv_scene_add_* calls, then dwv_scene_commit freezes it (geometry
+ * structures are built then, and the scene is analysed to leave out work it cannot use); a
+ * committed scene can be baked any number of times, from any number of threads at once, and can
+ * no longer be changed (DWV_ERROR_INVALID_STATE). Lengths are in scene units (Blender's metres);
+ * transforms are row-major 3 x 4 object-to-world matrices (the last row 0 0 0 1 implied).
+ * Every array passed in is copied; the caller may free it when the call returns.
+ * ------------------------------------------------------------------------------------------- */
+typedef struct dwv_scene_s dwv_scene_t;
+
+/* Creates an empty scene (reference count 1): black world, no camera. */
+DWV_API dwv_result_t dwv_scene_create(dwv_scene_t **scene);
+DWV_API dwv_result_t dwv_scene_retain(dwv_scene_t *scene);
+/* Drops one reference; the last frees the scene. NULL is ignored. */
+DWV_API void dwv_scene_release(dwv_scene_t *scene);
+
+typedef int32_t dwv_material_kind_t;
+enum {
+    DWV_MATERIAL_SUBSURFACE = 0, /* (1 - weight) diffuse base + weight subsurface random walk */
+    DWV_MATERIAL_DIFFUSE = 1     /* Lambertian reflection of base_color only */
+};
+
+/* A material in the terms of Cycles' Principled BSDF with subsurface method "Random Walk (Fixed
+ * Radius)", Blender 4.x naming: the surface is (1 - subsurface_weight) Lambertian diffuse of
+ * base_color plus subsurface_weight random-walk subsurface scattering whose multiple-scattering
+ * albedo is subsurface_color (turned into single-scattering albedo by Cycles' inversion fit) and
+ * whose per-channel radius is subsurface_radius x subsurface_scale (scene units). Blender 3.x's
+ * inputs map as: subsurface_weight = 1 where "Subsurface" > 0 (else 0), subsurface_color =
+ * mix(Base Color, Subsurface Color, Subsurface), subsurface_scale = "Subsurface". Entry is
+ * cosine-weighted diffuse transmission, exit Lambertian, as in Cycles. */
+typedef struct dwv_material_t {
+    uint32_t struct_size;         /* sizeof(dwv_material_t): set by DWV_MATERIAL_INIT */
+    dwv_material_kind_t kind;
+    double base_color[3];         /* in [0, 1] */
+    double subsurface_weight;     /* in [0, 1] */
+    double subsurface_color[3];   /* in [0, 1] */
+    double subsurface_radius[3];  /* >= 0, finite; a channel of radius 0 does not scatter */
+    double subsurface_scale;      /* >= 0, finite */
+    double subsurface_anisotropy; /* Henyey-Greenstein g in (-1, 1); Cycles clamps to [-0.9, 0.9] */
+    double subsurface_ior;        /* in [1, 4]; kept for compatibility (Cycles' walk ignores it) */
+} dwv_material_t;
+#define DWV_MATERIAL_INIT                                                                           \
+    {sizeof(dwv_material_t), DWV_MATERIAL_SUBSURFACE, {0.8, 0.8, 0.8}, 1.0, {0.8, 0.8, 0.8},         \
+     {1.0, 0.2, 0.1}, 0.05, 0.0, 1.4}
+
+/* Adds a material; *material_id numbers them from 0 in order. */
+DWV_API dwv_result_t dwv_scene_add_material(dwv_scene_t *scene, const dwv_material_t *material,
+                                            uint32_t *material_id);
+
+/* A triangle mesh. Positions (and normals) are in object space; `transform` takes them to the
+ * world. UVs are per triangle corner (Blender's loops), so seams need no split vertices. */
+typedef struct dwv_mesh_t {
+    uint32_t struct_size;     /* sizeof(dwv_mesh_t): set by DWV_MESH_INIT */
+    uint32_t vertex_count;    /* >= 3 */
+    uint32_t triangle_count;  /* >= 1 */
+    uint32_t material_id;     /* from dwv_scene_add_material */
+    const float *positions;   /* 3 x vertex_count, finite */
+    const uint32_t *indices;  /* 3 x triangle_count, each < vertex_count */
+    const float *normals;     /* optional (NULL: flat shading): 3 x vertex_count, per vertex */
+    const float *uvs;         /* optional (NULL: no UV bake): 2 x 3 x triangle_count, per corner */
+    double transform[12];     /* row-major 3 x 4 object-to-world, invertible */
+} dwv_mesh_t;
+#define DWV_MESH_INIT                                                                               \
+    {sizeof(dwv_mesh_t), 0u, 0u, 0u, NULL, NULL, NULL, NULL,                                        \
+     {1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0}}
+
+/* Adds a mesh; *mesh_id numbers meshes from 0 in order (the id a UV bake names). Open meshes,
+ * zero-area or duplicate triangles are accepted and counted in the bake's warnings. */
+DWV_API dwv_result_t dwv_scene_add_mesh(dwv_scene_t *scene, const dwv_mesh_t *mesh, uint32_t *mesh_id);
+
+typedef int32_t dwv_light_kind_t;
+enum {
+    DWV_LIGHT_SUN = 0,   /* direction, strength (irradiance, W/m^2), angle (angular diameter) */
+    DWV_LIGHT_POINT = 1, /* position, power (W, Blender's convention), radius (a sphere light) */
+    DWV_LIGHT_AREA_RECTANGLE = 2, /* transform, size_x x size_y in its local xy plane, power */
+    DWV_LIGHT_AREA_DISK = 3       /* transform, diameter size_x (size_y for an ellipse), power */
+};
+/* Lights in Blender's units and conventions; an area light emits along its local -z. */
+typedef struct dwv_light_desc_t {
+    uint32_t struct_size; /* sizeof(dwv_light_desc_t): set by DWV_LIGHT_DESC_INIT */
+    dwv_light_kind_t kind;
+    double color[3];      /* in [0, infinity) */
+    double strength;      /* sun: irradiance W/m^2; point and area: power in W; >= 0 */
+    double direction[3];  /* sun: the direction the light travels (need not be unit) */
+    double angle;         /* sun: angular diameter in radians, [0, pi] */
+    double position[3];   /* point */
+    double radius;        /* point: >= 0 */
+    double transform[12]; /* area: row-major 3 x 4 light-to-world (no shear) */
+    double size_x, size_y;/* area: > 0 */
+} dwv_light_desc_t;
+#define DWV_LIGHT_DESC_INIT                                                                         \
+    {sizeof(dwv_light_desc_t), DWV_LIGHT_SUN, {1.0, 1.0, 1.0}, 1.0, {0.0, 0.0, -1.0}, 0.0,          \
+     {0.0, 0.0, 0.0}, 0.0, {1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0}, 1.0, 1.0}
+
+DWV_API dwv_result_t dwv_scene_add_light(dwv_scene_t *scene, const dwv_light_desc_t *light);
+
+/* A constant world: radiance color x strength from every direction (default black). */
+DWV_API dwv_result_t dwv_scene_set_world(dwv_scene_t *scene, const double color[3], double strength);
+
+typedef int32_t dwv_camera_kind_t;
+enum { DWV_CAMERA_PERSPECTIVE = 0, DWV_CAMERA_ORTHOGRAPHIC = 1 };
+/* A camera as Blender's: it looks along its local -z with +y up; the sensor fits the larger image
+ * side (Blender's "Auto" sensor fit). */
+typedef struct dwv_camera_t {
+    uint32_t struct_size; /* sizeof(dwv_camera_t): set by DWV_CAMERA_INIT */
+    dwv_camera_kind_t kind;
+    double transform[12]; /* row-major 3 x 4 camera-to-world, rotation and translation only */
+    double focal_length;  /* perspective: mm, > 0 */
+    double sensor_width;  /* perspective: mm, > 0 */
+    double ortho_scale;   /* orthographic: the larger image side in scene units, > 0 */
+} dwv_camera_t;
+#define DWV_CAMERA_INIT                                                                             \
+    {sizeof(dwv_camera_t), DWV_CAMERA_PERSPECTIVE,                                                  \
+     {1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0}, 50.0, 36.0, 1.0}
+
+DWV_API dwv_result_t dwv_scene_set_camera(dwv_scene_t *scene, const dwv_camera_t *camera);
+
+/* Freezes the scene: builds its ray-tracing structures and analyses which work it needs. */
+DWV_API dwv_result_t dwv_scene_commit(dwv_scene_t *scene);
+
+/* Scene-level work that a committed scene leaves out or keeps (the "features" of its bakes). */
+enum {
+    DWV_FEATURE_EMBREE = 1u << 0,            /* triangle meshes traced with Embree */
+    DWV_FEATURE_SUBSURFACE = 1u << 1,        /* random walks (some material scatters) */
+    DWV_FEATURE_CLOSEST_POINT = 1u << 2,     /* closest-point queries during walks */
+    DWV_FEATURE_INCIDENT_PATCHES = 1u << 3,  /* lit patches for incident-illumination guiding */
+    DWV_FEATURE_RGB_WALKS = 1u << 4,         /* three-channel walks (else grey, one channel) */
+    DWV_FEATURE_GUIDED = 1u << 5,            /* Dwivedi guiding (else classical: albedo too low) */
+    DWV_FEATURE_WORLD_LIGHT = 1u << 6,       /* the world is sampled (not black) */
+    DWV_FEATURE_DIRECT_LIGHTS = 1u << 7,     /* next-event estimation to lights */
+    DWV_FEATURE_DIFFUSE_SURFACES = 1u << 8   /* plain diffuse surfaces shaded */
+};
+/* The lower-case name of one feature bit ("embree", "closest_point"...), or NULL. */
+DWV_API const char *dwv_feature_name(uint32_t feature);
+
+/* ---------------------------------------------------------------------------------------------
+ * Bakes: images of a committed scene, progressive, deterministic, cancellable.
+ *
+ * dwv_bake_start runs a bake on a pool of threads and returns at once; dwv_bake_wait,
+ * dwv_bake_progress and dwv_bake_cancel may be called from any thread while it runs (cancel
+ * returns within 100 ms); dwv_bake_finish waits and hands over the image. dwv_bake does all of
+ * it in one call. With the same scene, options and seed, the image is bit-identical for any
+ * thread count and tile order (time budgets aside, which cut a bake where the clock says).
+ * Budgets: samples per pixel, wall time, target relative error; whichever is reached first.
+ * ------------------------------------------------------------------------------------------- */
+typedef int32_t dwv_bake_target_t;
+enum {
+    DWV_BAKE_CAMERA = 0, /* the camera's view: subsurface and diffuse surfaces, world behind */
+    DWV_BAKE_UV = 1      /* one mesh's outgoing subsurface radiance laid out in its UVs */
+};
+
+typedef struct dwv_bake_progress_t {
+    uint32_t struct_size;     /* sizeof(dwv_bake_progress_t): set by DWV_BAKE_PROGRESS_INIT */
+    uint32_t done;            /* 1 once the bake has ended (finished, cancelled or failed) */
+    double fraction;          /* of the larger of the budgets, in [0, 1] */
+    double seconds;           /* since the start */
+    double estimated_relative_error; /* of the image so far (see dwv_bake_stats_t); inf before */
+    uint64_t samples_per_pixel;      /* completed passes' samples per pixel */
+    uint64_t events;                 /* scattering events so far */
+} dwv_bake_progress_t;
+#define DWV_BAKE_PROGRESS_INIT {sizeof(dwv_bake_progress_t), 0u, 0.0, 0.0, 0.0, 0u, 0u}
+
+/* Called from a bake thread (one at a time) about 10 times a second and once at the end; a
+ * non-zero return cancels the bake. It must not call into the same bake but dwv_bake_cancel. */
+typedef int32_t (*dwv_progress_callback_t)(void *user, const dwv_bake_progress_t *progress);
+
+typedef struct dwv_bake_options_t {
+    uint32_t struct_size;     /* sizeof(dwv_bake_options_t): set by DWV_BAKE_OPTIONS_INIT */
+    dwv_bake_target_t target;
+    uint32_t width, height;   /* 1 to 16384 each, at most 2^26 pixels */
+    uint32_t uv_mesh;         /* UV bakes: the mesh id (it must have UVs) */
+    uint32_t uv_margin;       /* UV bakes: pixels of dilation around islands, <= 64 */
+    dwv_technique_t technique;
+    uint64_t samples;         /* samples per pixel, 1 to 2^24; the bake stops there */
+    double time_limit;        /* seconds, >= 0; 0: none */
+    double target_error;      /* relative error of the image, >= 0; 0: none */
+    uint32_t threads;         /* 0: all cores; at most 1024 */
+    uint32_t max_events;      /* cap on scattering events per walk; 0: 10^6 */
+    uint64_t seed;
+    uint32_t tile_size;       /* pixels per tile side, 0: 32 */
+    uint32_t reserved;
+    dwv_progress_callback_t progress;  /* optional */
+    void *progress_user;
+} dwv_bake_options_t;
+#define DWV_BAKE_OPTIONS_INIT                                                                       \
+    {sizeof(dwv_bake_options_t), DWV_BAKE_CAMERA, 256u, 256u, 0u, 16u, DWV_TECHNIQUE_AUTO, 64u, 0.0,  \
+     0.0, 0u, 0u, 0u, 0u, 0u, NULL, NULL}
+
+typedef struct dwv_bake_s dwv_bake_t;
+typedef struct dwv_image_s dwv_image_t;
+
+/* Validates the options against the committed scene and starts the bake; *bake is the handle
+ * (release it with dwv_bake_release, which cancels a running bake and waits for it). */
+DWV_API dwv_result_t dwv_bake_start(dwv_scene_t *scene, const dwv_bake_options_t *options, dwv_bake_t **bake);
+/* Waits up to timeout_seconds (0: just looks; negative: forever); *done is 1 once it ended. */
+DWV_API dwv_result_t dwv_bake_wait(dwv_bake_t *bake, double timeout_seconds, int32_t *done);
+DWV_API dwv_result_t dwv_bake_progress(dwv_bake_t *bake, dwv_bake_progress_t *progress);
+/* Asks a running bake to stop; it ends within 100 ms. Any thread; harmless once it ended. */
+DWV_API dwv_result_t dwv_bake_cancel(dwv_bake_t *bake);
+/* Waits for the end and hands over the image (*image, reference count 1): DWV_ERROR_CANCELLED
+ * and no image if it was cancelled; the bake's own error if it failed. */
+DWV_API dwv_result_t dwv_bake_finish(dwv_bake_t *bake, dwv_image_t **image);
+DWV_API void dwv_bake_release(dwv_bake_t *bake);
+/* dwv_bake_start + dwv_bake_finish + dwv_bake_release. */
+DWV_API dwv_result_t dwv_bake(dwv_scene_t *scene, const dwv_bake_options_t *options, dwv_image_t **image);
+
+/* The pixels of an image: RGBA scene-linear Rec.709, row 0 at the top; the estimate's variance
+ * (of the pixel mean, per channel RGB) and each pixel's sample count. Pointers stay valid while
+ * the image lives. UV bakes leave alpha 0 on texels outside every island and its margin. */
+typedef struct dwv_image_info_t {
+    uint32_t struct_size;   /* sizeof(dwv_image_info_t): set by DWV_IMAGE_INFO_INIT */
+    uint32_t width, height;
+    uint32_t reserved;
+    const float *rgba;      /* 4 x width x height */
+    const float *variance;  /* 3 x width x height */
+    const uint32_t *samples;/* width x height */
+} dwv_image_info_t;
+#define DWV_IMAGE_INFO_INIT {sizeof(dwv_image_info_t), 0u, 0u, 0u, NULL, NULL, NULL}
+DWV_API dwv_result_t dwv_image_info(const dwv_image_t *image, dwv_image_info_t *info);
+
+/* What a bake did. The estimated relative error is sqrt(sum of pixel-mean variances) / sum of
+ * pixel luminances over the covered pixels (the relative standard error of the image's mean). */
+typedef struct dwv_bake_stats_t {
+    uint32_t struct_size;    /* sizeof(dwv_bake_stats_t): set by DWV_BAKE_STATS_INIT */
+    dwv_technique_t technique;
+    uint64_t samples_per_pixel;  /* the largest per-pixel count */
+    uint64_t samples;            /* all camera or texel samples together */
+    uint64_t events;             /* scattering events */
+    uint64_t walks;
+    double seconds;
+    double estimated_relative_error;
+    double mean_rgb[3];          /* the mean of the covered pixels */
+    double truncated_weight[3];  /* weight of walks ended by the event cap, per covered pixel */
+    uint32_t features;           /* DWV_FEATURE_* bits the bake used */
+    uint32_t threads;
+    uint64_t warnings;           /* degenerate geometry met (zero-area triangles, NaN hits...) */
+    uint32_t error_vs_time_count;/* points in dwv_image_error_vs_time */
+    uint32_t reserved;
+} dwv_bake_stats_t;
+#define DWV_BAKE_STATS_INIT                                                                         \
+    {sizeof(dwv_bake_stats_t), 0, 0u, 0u, 0u, 0u, 0.0, 0.0, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, 0u,    \
+     0u, 0u, 0u, 0u}
+DWV_API dwv_result_t dwv_image_stats(const dwv_image_t *image, dwv_bake_stats_t *stats);
+/* One point of the error-against-time series (one per completed pass). */
+typedef struct dwv_error_point_t {
+    double seconds;
+    double estimated_relative_error;
+    uint64_t samples_per_pixel;
+} dwv_error_point_t;
+/* Copies up to `capacity` points into `points`; *count gets how many there are in all. */
+DWV_API dwv_result_t dwv_image_error_vs_time(const dwv_image_t *image, dwv_error_point_t *points,
+                                             uint32_t capacity, uint32_t *count);
+DWV_API dwv_result_t dwv_image_retain(dwv_image_t *image);
+DWV_API void dwv_image_release(dwv_image_t *image);
+/* An image made from caller pixels (RGBA, 4 x width x height), e.g. to colour-manage them. */
+DWV_API dwv_result_t dwv_image_create(uint32_t width, uint32_t height, const float *rgba, dwv_image_t **image);
+
+/* ---------------------------------------------------------------------------------------------
+ * Output: OpenEXR and colour-managed display images. Files are written under a temporary name in
+ * the same folder and renamed over the target only when complete: a failure never leaves a
+ * partial file and never replaces a good one.
+ * ------------------------------------------------------------------------------------------- */
+/* Float RGBA, scene-linear Rec.709 with the chromaticities attribute, plus the variance layer
+ * (variance.R/G/B) and the sample counts (samples.Y), and metadata: technique, samples, seconds,
+ * estimated error, features, library version, the error-against-time series. */
+DWV_API dwv_result_t dwv_image_write_exr(const dwv_image_t *image, const char *path);
+
+/* Blender's colour-management settings, applied through OpenColorIO: exposure (stops) in scene
+ * linear, then the display/view/look transform, then gamma (display = display^(1/gamma)).
+ * NULL strings mean the config's defaults ("" for look means none). The config comes from
+ * `config_path`, else $OCIO, else the small default config dwivedi ships (sRGB display with
+ * "Standard" and a filmic view). */
+typedef struct dwv_display_options_t {
+    uint32_t struct_size; /* sizeof(dwv_display_options_t): set by DWV_DISPLAY_OPTIONS_INIT */
+    uint32_t reserved;
+    const char *config_path;
+    const char *display;
+    const char *view;
+    const char *look;
+    double exposure;      /* finite */
+    double gamma;         /* > 0, finite */
+} dwv_display_options_t;
+#define DWV_DISPLAY_OPTIONS_INIT {sizeof(dwv_display_options_t), 0u, NULL, NULL, NULL, NULL, 0.0, 1.0}
+/* Writes an 8-bit sRGB-encoded (as the display says) RGBA PNG of the image through the view. */
+DWV_API dwv_result_t dwv_image_write_display_png(const dwv_image_t *image, const char *path,
+                                                 const dwv_display_options_t *display);
+/* The same pixels in memory: 4 x width x height bytes, as the PNG would hold them. */
+DWV_API dwv_result_t dwv_image_to_display(const dwv_image_t *image, const dwv_display_options_t *display,
+                                          uint8_t *rgba8, uint64_t size);
+
+/* ---------------------------------------------------------------------------------------------
+ * Scene files (JSON, docs/scene-format.md) and the built-in default scene.
+ * ------------------------------------------------------------------------------------------- */
+/* Reads a scene file and the meshes it references (OBJ, PLY) into a new committed scene; bake
+ * settings in the file (resolution, samples, technique...) go into *options, which should
+ * come in as DWV_BAKE_OPTIONS_INIT (it may be NULL). */
+DWV_API dwv_result_t dwv_scene_load(const char *path, dwv_scene_t **scene, dwv_bake_options_t *options);
+/* The same from JSON text in memory; relative mesh paths resolve against base_dir (NULL: "."). */
+DWV_API dwv_result_t dwv_scene_load_json(const char *json, uint64_t size, const char *base_dir,
+                                         dwv_scene_t **scene, dwv_bake_options_t *options);
+/* The default scene: a thin back-lit translucent leaf-like shell beside a thick front-lit
+ * wax-like shape, committed; *options gets its resolution and samples. */
+DWV_API dwv_result_t dwv_scene_create_default(dwv_scene_t **scene, dwv_bake_options_t *options);
 
 #ifdef __cplusplus
 }

@@ -33,6 +33,9 @@ const char *dwv_result_string(dwv_result_t result)
     case DWV_ERROR_OUT_OF_MEMORY: return "out of memory";
     case DWV_ERROR_INTERNAL: return "internal error";
     case DWV_ERROR_INVALID_STATE: return "call out of order";
+    case DWV_ERROR_CANCELLED: return "cancelled";
+    case DWV_ERROR_IO: return "input/output error";
+    case DWV_ERROR_FORMAT: return "malformed file";
     default: return "unknown result code";
     }
 }

@@ -1,0 +1,29 @@
+/* A baked (or caller-made) image with what its bake measured: the object behind dwv_image_t.
+ * Written once by whoever makes it, read-only afterwards, shared by reference count. */
+#ifndef DWV_BAKE_IMAGE_H
+#define DWV_BAKE_IMAGE_H
+
+#include <stdatomic.h>
+#include <stdint.h>
+
+#include "dwivedi.h"
+
+typedef struct dwvb_image {
+    atomic_uint references;
+    uint32_t width, height;
+    float *rgba;           /* 4 x width x height, row 0 at the top */
+    float *variance;       /* 3 x width x height: variance of the pixel mean, per channel */
+    uint32_t *samples;     /* width x height */
+    dwv_bake_stats_t stats;            /* error_vs_time_count = the length of error_vs_time */
+    dwv_error_point_t *error_vs_time;  /* one point per completed pass; may be NULL if count is 0 */
+    uint32_t error_vs_time_capacity;
+} dwvb_image;
+
+/* A zeroed image of the given size with reference count 1 (stats zeroed but struct_size set),
+ * or NULL when out of memory; the caller checked the size. */
+dwvb_image *dwvb_image_new(uint32_t width, uint32_t height);
+/* Appends a point to the error-against-time series; 0 on success, -1 out of memory. */
+int dwvb_image_add_error_point(dwvb_image *image, dwv_error_point_t point);
+void dwvb_image_free(dwvb_image *image);
+
+#endif
