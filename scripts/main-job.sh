@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
-# The main job on its default settings: set up, build, then the diffusion-length report
-# (bench of the four v0 methods against the mpmath table, plots and table into out/report/).
+# The main job on its default settings: set up, build, then bake the built-in default scene (a thin
+# back-lit leaf-like shell beside a thick front-lit wax-like shape) into out/default.exr (scene
+# linear, with variance and sample counts), out/default.png (display image) and out/default.json.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
-build/dwivedi bench v0
-/usr/bin/python3 tools/v0_report.py --cli build/dwivedi --out out/report
-echo "main job: report written to out/report/"
+mkdir -p out
+build/dwivedi bake --out out/default
+echo "main job: wrote out/default.exr, out/default.png and out/default.json"

@@ -59,6 +59,8 @@ static void help(FILE *out)
             "                    fast_domain {the same four}, ns_per_call}], sampler {function,\n"
             "                    albedo, ns_per_call}; an error with nothing to compare is null\n",
             TIMING_REPEATS, (unsigned long long)DEFAULT_CALLS);
+    fprintf(out, "\n");
+    cli_bench_bake_help(out);
 }
 
 /* ---- the reference table -------------------------------------------------------------------- */
@@ -475,6 +477,7 @@ static void print_text(const char *source, const reference_table *table, size_t 
 
 static int run(int argc, char **argv)
 {
+    if (argc > 1 && strcmp(argv[1], "bake") == 0) return cli_bench_bake(argc - 1, argv + 1);
     const char *subject = NULL, *reference_path = NULL;
     uint64_t calls = DEFAULT_CALLS;
     int json = 0;
@@ -494,8 +497,8 @@ static int run(int argc, char **argv)
             subject = argv[i];
         }
     }
-    if (!subject) return cli_usage_error(VERB, "name what to benchmark: v0");
-    if (strcmp(subject, "v0") != 0) return cli_usage_error(VERB, "unknown benchmark '%.64s' (v0)", subject);
+    if (!subject) return cli_usage_error(VERB, "name what to benchmark: v0 or bake");
+    if (strcmp(subject, "v0") != 0) return cli_usage_error(VERB, "unknown benchmark '%.64s' (v0 or bake)", subject);
 
     char *text;
     if (reference_path) {
@@ -569,4 +572,4 @@ static int run(int argc, char **argv)
     return status;
 }
 
-const cli_verb cli_verb_bench = {"bench", "error against run time of the v0 methods (bench v0)", run, help};
+const cli_verb cli_verb_bench = {"bench", "benchmarks: v0 methods (bench v0), the baker (bench bake)", run, help};

@@ -18,6 +18,11 @@ typedef struct cli_verb {
 extern const cli_verb cli_verb_v0;
 extern const cli_verb cli_verb_bench;
 extern const cli_verb cli_verb_estimate;
+extern const cli_verb cli_verb_bake;
+
+/* `dwivedi bench bake` (bench_bake.c), reached through the bench verb. */
+int cli_bench_bake(int argc, char **argv);
+void cli_bench_bake_help(FILE *out);
 
 /* Prints "dwivedi VERB: message" on stderr as one line and returns CLI_USAGE. */
 int cli_usage_error(const char *verb, const char *format, ...)

@@ -1,0 +1,376 @@
+/* dwivedi bake: bakes a scene file (or the built-in default scene) into PREFIX.exr (scene-linear,
+ * with variance and sample counts), PREFIX.png (through an OCIO view) and PREFIX.json (stats).
+ * The three are written under temporary names and renamed into place only once all three are
+ * complete, so a failed or cancelled bake leaves the previous outputs as they were. */
+#define _POSIX_C_SOURCE 200809L
+#include <errno.h>
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "cli.h"
+#include "dwivedi.h"
+
+static const char verb[] = "bake";
+
+static void help(FILE *out)
+{
+    fprintf(out,
+            "usage: dwivedi bake [SCENE.json] --out PREFIX [--spp N] [--time SECONDS] [--error REL]\n"
+            "           [--technique T] [--threads N] [--seed S] [--width W] [--height H]\n"
+            "           [--ocio CONFIG] [--display NAME] [--view NAME] [--look NAME]\n"
+            "           [--exposure E] [--gamma G] [--quiet]\n\n"
+            "Bakes SCENE.json (docs/scene-format.md), or without it the built-in default scene: a thin\n"
+            "back-lit leaf-like shell beside a thick front-lit wax-like shape. Writes\n"
+            "  PREFIX.exr   float RGBA, scene-linear Rec.709, plus variance and sample-count layers\n"
+            "  PREFIX.png   the display image through an OpenColorIO view\n"
+            "  PREFIX.json  spp, seconds, estimated_relative_error, mean_rgb, events, features,\n"
+            "               error_vs_time and more\n"
+            "all three only when the bake completes: a failed or cancelled (Ctrl-C) bake exits non-zero\n"
+            "and leaves earlier outputs untouched.\n\n"
+            "  --spp N        samples per pixel (default: the scene's); the budgets --spp, --time and\n"
+            "                 --error stop the bake at whichever comes first\n"
+            "  --time S       wall-time budget in seconds          --error R  target relative error\n"
+            "  --technique T  auto (default), classical, poe, closest, incident, backward, cycles\n"
+            "  --threads N    worker threads (default: all cores); the image does not depend on it\n"
+            "  --seed S       random seed (default: the scene's, else 0)\n"
+            "  --width W, --height H   image size (default: the scene's)\n"
+            "  --ocio CONFIG  OpenColorIO config (default: $OCIO, else the config dwivedi ships)\n"
+            "  --display, --view, --look, --exposure, --gamma   colour management as in Blender\n"
+            "  --quiet        no progress bar (it is shown only on a terminal anyway)\n");
+}
+
+static volatile sig_atomic_t interrupted = 0;
+
+static void on_interrupt(int signal_number)
+{
+    (void)signal_number;
+    interrupted = 1;
+}
+
+typedef struct bake_flags {
+    const char *scene_path, *prefix;
+    dwv_display_options_t display;
+    int quiet;
+} bake_flags;
+
+/* Parses argv into flags and options (the scene's own settings already in *o). Returns 0 or CLI_USAGE. */
+static int parse_overrides(int argc, char **argv, bake_flags *f, dwv_bake_options_t *o, int apply)
+{
+    for (int i = 1; i < argc; ++i) {
+        const char *flag = argv[i], *value = NULL;
+        if (strcmp(flag, "--quiet") == 0) {
+            f->quiet = 1;
+            continue;
+        }
+        if (flag[0] != '-' || flag[1] == '\0') {
+            if (f->scene_path && f->scene_path != flag)
+                return cli_usage_error(verb, "one scene file only ('%.64s' and '%.64s')", f->scene_path, flag);
+            f->scene_path = flag;
+            continue;
+        }
+        static const char *const flags[] = {"--out",     "--spp",   "--time",    "--error",   "--technique",
+                                            "--threads", "--seed",  "--width",   "--height",  "--ocio",
+                                            "--display", "--view",  "--look",    "--exposure", "--gamma"};
+        int known = 0;
+        for (size_t k = 0; k < sizeof flags / sizeof flags[0]; ++k) known |= strcmp(flag, flags[k]) == 0;
+        if (!known) return cli_usage_error(verb, "unknown argument '%.64s'", flag);
+        if (!(value = cli_flag_value(verb, argc, argv, &i))) return CLI_USAGE;
+        uint64_t whole;
+        double number;
+        if (strcmp(flag, "--out") == 0) {
+            if (value[0] == '\0') return cli_usage_error(verb, "--out: the prefix is empty");
+            f->prefix = value;
+        } else if (strcmp(flag, "--ocio") == 0) {
+            f->display.config_path = value;
+        } else if (strcmp(flag, "--display") == 0) {
+            f->display.display = value;
+        } else if (strcmp(flag, "--view") == 0) {
+            f->display.view = value;
+        } else if (strcmp(flag, "--look") == 0) {
+            f->display.look = value;
+        } else if (strcmp(flag, "--exposure") == 0) {
+            if (cli_parse_double(verb, flag, value, &f->display.exposure)) return CLI_USAGE;
+        } else if (strcmp(flag, "--gamma") == 0) {
+            if (cli_parse_double(verb, flag, value, &f->display.gamma)) return CLI_USAGE;
+        } else if (strcmp(flag, "--technique") == 0) {
+            dwv_technique_t technique;
+            if (dwv_technique_from_name(value, &technique) != DWV_SUCCESS)
+                return cli_usage_error(verb, "--technique: %s", dwv_last_error_message());
+            if (apply) o->technique = technique;
+        } else if (strcmp(flag, "--time") == 0 || strcmp(flag, "--error") == 0) {
+            if (cli_parse_double(verb, flag, value, &number)) return CLI_USAGE;
+            if (apply) *(flag[2] == 't' ? &o->time_limit : &o->target_error) = number;
+        } else {
+            if (cli_parse_u64(verb, flag, value, &whole)) return CLI_USAGE;
+            if (strcmp(flag, "--spp") == 0) {
+                if (apply) o->samples = whole;
+            } else if (strcmp(flag, "--seed") == 0) {
+                if (apply) o->seed = whole;
+            } else {
+                if (whole > UINT32_MAX) return cli_usage_error(verb, "%s: '%.64s' is too large", flag, value);
+                uint32_t *target = strcmp(flag, "--threads") == 0 ? &o->threads
+                                   : strcmp(flag, "--width") == 0 ? &o->width
+                                                                  : &o->height;
+                if (apply) *target = (uint32_t)whole;
+            }
+        }
+    }
+    return 0;
+}
+
+typedef struct progress_state {
+    int show;
+    int drawn;
+} progress_state;
+
+static void draw_progress(progress_state *state, const dwv_bake_progress_t *p)
+{
+    if (!state->show) return;
+    enum { WIDTH = 30 };
+    double fraction = p->fraction < 0.0 ? 0.0 : p->fraction > 1.0 ? 1.0 : p->fraction;
+    int filled = (int)(fraction * WIDTH + 0.5);
+    char bar[WIDTH + 1];
+    for (int i = 0; i < WIDTH; ++i) bar[i] = i < filled ? '#' : '.';
+    bar[WIDTH] = '\0';
+    fprintf(stderr, "\r[%s] %3.0f%%  %6.1f s  %llu spp  error ", bar, 100.0 * fraction, p->seconds,
+            (unsigned long long)p->samples_per_pixel);
+    if (isfinite(p->estimated_relative_error)) fprintf(stderr, "%7.3g%%  ", 100.0 * p->estimated_relative_error);
+    else fprintf(stderr, "    --   ");
+    fflush(stderr);
+    state->drawn = 1;
+}
+
+static void end_progress(progress_state *state)
+{
+    if (state->drawn) fputc('\n', stderr);
+    state->drawn = 0;
+}
+
+/* path = prefix + suffix, or NULL after reporting when it does not fit. */
+static char *join(const char *prefix, const char *suffix)
+{
+    size_t a = strlen(prefix), b = strlen(suffix);
+    char *path = malloc(a + b + 1);
+    if (!path) {
+        fprintf(stderr, "dwivedi bake: out of memory\n");
+        return NULL;
+    }
+    memcpy(path, prefix, a);
+    memcpy(path + a, suffix, b + 1);
+    return path;
+}
+
+static void json_string(FILE *out, const char *text)
+{
+    fputc('"', out);
+    for (const unsigned char *c = (const unsigned char *)text; *c; ++c) {
+        if (*c == '"' || *c == '\\') fprintf(out, "\\%c", *c);
+        else if (*c < 0x20) fprintf(out, "\\u%04x", *c);
+        else fputc(*c, out);
+    }
+    fputc('"', out);
+}
+
+static void json_triple(FILE *out, const double v[3])
+{
+    fputc('[', out);
+    for (int c = 0; c < 3; ++c) {
+        if (c) fputs(", ", out);
+        cli_json_number(out, v[c]);
+    }
+    fputc(']', out);
+}
+
+/* Writes the stats as JSON to `path`; 0 or -1 after reporting. */
+static int write_stats_json(const char *path, const dwv_image_t *image, const dwv_bake_options_t *o,
+                            const char *scene_name)
+{
+    dwv_bake_stats_t s = DWV_BAKE_STATS_INIT;
+    uint32_t count = 0;
+    dwv_error_point_t *points = NULL;
+    if (dwv_image_stats(image, &s) != DWV_SUCCESS ||
+        dwv_image_error_vs_time(image, NULL, 0u, &count) != DWV_SUCCESS) {
+        fprintf(stderr, "dwivedi bake: %s\n", dwv_last_error_message());
+        return -1;
+    }
+    if (count > 0u) {
+        points = calloc(count, sizeof *points);
+        if (!points || dwv_image_error_vs_time(image, points, count, &count) != DWV_SUCCESS) {
+            fprintf(stderr, "dwivedi bake: %s\n", points ? dwv_last_error_message() : "out of memory");
+            free(points);
+            return -1;
+        }
+    }
+    FILE *out = fopen(path, "wb");
+    if (!out) {
+        fprintf(stderr, "dwivedi bake: cannot write %s: %s\n", path, strerror(errno));
+        free(points);
+        return -1;
+    }
+    fprintf(out, "{\n  \"scene\": ");
+    json_string(out, scene_name);
+    fprintf(out, ",\n  \"library_version\": \"%s\",\n  \"technique\": \"%s\",\n  \"width\": %u,\n  \"height\": %u,\n",
+            dwv_version_string(), dwv_technique_name(s.technique) ? dwv_technique_name(s.technique) : "?", o->width,
+            o->height);
+    fprintf(out, "  \"spp\": %llu,\n  \"samples\": %llu,\n  \"walks\": %llu,\n  \"events\": %llu,\n  \"seconds\": ",
+            (unsigned long long)s.samples_per_pixel, (unsigned long long)s.samples, (unsigned long long)s.walks,
+            (unsigned long long)s.events);
+    cli_json_number(out, s.seconds);
+    fprintf(out, ",\n  \"estimated_relative_error\": ");
+    cli_json_number(out, s.estimated_relative_error);
+    fprintf(out, ",\n  \"mean_rgb\": ");
+    json_triple(out, s.mean_rgb);
+    fprintf(out, ",\n  \"truncated_weight\": ");
+    json_triple(out, s.truncated_weight);
+    fprintf(out, ",\n  \"threads\": %u,\n  \"warnings\": %llu,\n  \"features\": [", s.threads,
+            (unsigned long long)s.warnings);
+    int first = 1;
+    for (uint32_t bit = 1u; bit != 0u; bit <<= 1) {
+        if (!(s.features & bit) || !dwv_feature_name(bit)) continue;
+        fprintf(out, "%s\"%s\"", first ? "" : ", ", dwv_feature_name(bit));
+        first = 0;
+    }
+    fprintf(out, "],\n  \"error_vs_time\": [");
+    for (uint32_t i = 0; i < count; ++i) {
+        fprintf(out, "%s\n    {\"seconds\": ", i ? "," : "");
+        cli_json_number(out, points[i].seconds);
+        fprintf(out, ", \"estimated_relative_error\": ");
+        cli_json_number(out, points[i].estimated_relative_error);
+        fprintf(out, ", \"spp\": %llu}", (unsigned long long)points[i].samples_per_pixel);
+    }
+    fprintf(out, "%s]\n}\n", count ? "\n  " : "");
+    free(points);
+    int failed = ferror(out);
+    failed |= fflush(out) != 0;
+    failed |= fsync(fileno(out)) != 0;
+    if (fclose(out) != 0 || failed) {
+        fprintf(stderr, "dwivedi bake: cannot write %s: %s\n", path, strerror(errno));
+        remove(path);
+        return -1;
+    }
+    return 0;
+}
+
+/* Writes the three outputs under temporary names, then renames them into place. */
+static int write_outputs(const char *prefix, const dwv_image_t *image, const dwv_bake_options_t *o,
+                         const dwv_display_options_t *display, const char *scene_name)
+{
+    static const char *const final_suffix[3] = {".exr", ".png", ".json"};
+    char temp_suffix[3][64];
+    for (int k = 0; k < 3; ++k)
+        snprintf(temp_suffix[k], sizeof temp_suffix[k], ".partial-%ld%s", (long)getpid(), final_suffix[k]);
+    char *final_path[3] = {0}, *temp_path[3] = {0};
+    int status = -1, written = 0;
+    for (int k = 0; k < 3; ++k) {
+        if (!(final_path[k] = join(prefix, final_suffix[k])) || !(temp_path[k] = join(prefix, temp_suffix[k])))
+            goto done;
+    }
+    if (dwv_image_write_exr(image, temp_path[0]) != DWV_SUCCESS) {
+        fprintf(stderr, "dwivedi bake: %s\n", dwv_last_error_message());
+        goto done;
+    }
+    written = 1;
+    if (dwv_image_write_display_png(image, temp_path[1], display) != DWV_SUCCESS) {
+        fprintf(stderr, "dwivedi bake: %s\n", dwv_last_error_message());
+        goto done;
+    }
+    written = 2;
+    if (write_stats_json(temp_path[2], image, o, scene_name) != 0) goto done;
+    written = 3;
+    for (int k = 0; k < 3; ++k) {
+        if (rename(temp_path[k], final_path[k]) != 0) {
+            fprintf(stderr, "dwivedi bake: cannot rename %s to %s: %s\n", temp_path[k], final_path[k],
+                    strerror(errno));
+            goto done;
+        }
+    }
+    written = 0;
+    status = 0;
+done:
+    for (int k = 0; k < written; ++k) remove(temp_path[k]);
+    for (int k = 0; k < 3; ++k) {
+        free(final_path[k]);
+        free(temp_path[k]);
+    }
+    return status;
+}
+
+static int run(int argc, char **argv)
+{
+    bake_flags f = {NULL, NULL, DWV_DISPLAY_OPTIONS_INIT, 0};
+    dwv_bake_options_t o = DWV_BAKE_OPTIONS_INIT;
+    /* first pass: syntax and the scene path; the scene's settings come next, then the flags win */
+    if (parse_overrides(argc, argv, &f, &o, 0)) return CLI_USAGE;
+    if (!f.prefix) return cli_usage_error(verb, "--out PREFIX is required");
+
+    dwv_scene_t *scene = NULL;
+    dwv_result_t r = f.scene_path ? dwv_scene_load(f.scene_path, &scene, &o) : dwv_scene_create_default(&scene, &o);
+    if (r != DWV_SUCCESS) {
+        fprintf(stderr, "dwivedi bake: %s\n", dwv_last_error_message());
+        return CLI_FAILED;
+    }
+    if (parse_overrides(argc, argv, &f, &o, 1)) {
+        dwv_scene_release(scene);
+        return CLI_USAGE;
+    }
+
+    progress_state progress = {!f.quiet && isatty(STDERR_FILENO), 0};
+    struct sigaction action, old_int, old_term;
+    memset(&action, 0, sizeof action);
+    action.sa_handler = on_interrupt;
+    sigemptyset(&action.sa_mask);
+    sigaction(SIGINT, &action, &old_int);
+    sigaction(SIGTERM, &action, &old_term);
+
+    dwv_bake_t *bake = NULL;
+    dwv_image_t *image = NULL;
+    int exit_code = CLI_FAILED;
+    r = dwv_bake_start(scene, &o, &bake);
+    if (r != DWV_SUCCESS) {
+        fprintf(stderr, "dwivedi bake: %s\n", dwv_last_error_message());
+        exit_code = r == DWV_ERROR_OUT_OF_MEMORY ? CLI_FAILED : CLI_USAGE;
+        goto done;
+    }
+    for (int32_t finished = 0; !finished;) {
+        if (dwv_bake_wait(bake, 0.1, &finished) != DWV_SUCCESS) break;
+        if (interrupted) {
+            dwv_bake_cancel(bake);
+            interrupted = 0;
+        }
+        dwv_bake_progress_t p = DWV_BAKE_PROGRESS_INIT;
+        if (dwv_bake_progress(bake, &p) == DWV_SUCCESS) draw_progress(&progress, &p);
+    }
+    end_progress(&progress);
+    r = dwv_bake_finish(bake, &image);
+    if (r == DWV_ERROR_CANCELLED) {
+        fprintf(stderr, "dwivedi bake: cancelled; nothing written\n");
+        exit_code = 130;
+        goto done;
+    }
+    if (r != DWV_SUCCESS) {
+        fprintf(stderr, "dwivedi bake: %s\n", dwv_last_error_message());
+        goto done;
+    }
+    if (write_outputs(f.prefix, image, &o, &f.display, f.scene_path ? f.scene_path : "default") != 0) goto done;
+
+    dwv_bake_stats_t s = DWV_BAKE_STATS_INIT;
+    dwv_image_stats(image, &s);
+    printf("baked %ux%u, %llu spp, %.2f s, estimated relative error %.3g%%, %.3g M events/s\n", o.width, o.height,
+           (unsigned long long)s.samples_per_pixel, s.seconds, 100.0 * s.estimated_relative_error,
+           s.seconds > 0.0 ? 1e-6 * (double)s.events / s.seconds : 0.0);
+    printf("wrote %s.exr, %s.png, %s.json\n", f.prefix, f.prefix, f.prefix);
+    exit_code = CLI_OK;
+done:
+    dwv_image_release(image);
+    dwv_bake_release(bake);
+    dwv_scene_release(scene);
+    sigaction(SIGINT, &old_int, NULL);
+    sigaction(SIGTERM, &old_term, NULL);
+    return exit_code;
+}
+
+const cli_verb cli_verb_bake = {"bake", "bake a scene (or the default scene) to EXR, PNG and JSON", run, help};

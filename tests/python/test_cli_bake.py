@@ -1,0 +1,133 @@
+"""`dwivedi bake` end to end: the default scene and a scene file bake into PREFIX.exr/.png/.json;
+bad scenes and flags fail with a message and leave earlier outputs alone; Ctrl-C (SIGINT) cancels
+cleanly, also leaving earlier outputs alone; the time budget stops a bake. Standard library only.
+"""
+import json
+import os
+import shutil
+import signal
+import subprocess
+import tempfile
+import time
+import unittest
+
+from cli_helpers import USAGE, assert_bad_usage, run_cli
+
+SMALL = ["--width", "48", "--height", "27", "--spp", "4", "--quiet"]
+JSON_KEYS = {"spp", "seconds", "estimated_relative_error", "mean_rgb", "events", "features", "error_vs_time"}
+
+
+def outputs(prefix):
+    return [prefix + suffix for suffix in (".exr", ".png", ".json")]
+
+
+def snapshot(folder):
+    """Every file in folder with its bytes."""
+    result = {}
+    for name in sorted(os.listdir(folder)):
+        with open(os.path.join(folder, name), "rb") as handle:
+            result[name] = handle.read()
+    return result
+
+
+class BakeCli(unittest.TestCase):
+    def setUp(self):
+        self.folder = tempfile.mkdtemp(prefix="dwivedi-bake-")
+        self.prefix = os.path.join(self.folder, "out")
+
+    def tearDown(self):
+        shutil.rmtree(self.folder, ignore_errors=True)
+
+    def bake(self, *args):
+        done = run_cli("bake", "--out", self.prefix, *SMALL, *args)
+        self.assertEqual(done.returncode, 0, done.stderr)
+        with open(self.prefix + ".json") as handle:
+            return json.load(handle)
+
+    def test_default_scene_writes_three_outputs(self):
+        stats = self.bake("--threads", "2")
+        self.assertLessEqual(JSON_KEYS, set(stats))
+        self.assertEqual(stats["spp"], 4)
+        self.assertGreater(stats["events"], 0, "the default scene has subsurface materials")
+        self.assertTrue(all(value > 0 for value in stats["mean_rgb"]), stats["mean_rgb"])
+        self.assertIn("subsurface", stats["features"])
+        self.assertGreaterEqual(len(stats["error_vs_time"]), 1)
+        for path in outputs(self.prefix):
+            self.assertGreater(os.path.getsize(path), 0, path)
+        with open(self.prefix + ".png", "rb") as handle:
+            self.assertEqual(handle.read(8), b"\x89PNG\r\n\x1a\n")
+        with open(self.prefix + ".exr", "rb") as handle:
+            self.assertEqual(handle.read(4), b"\x76\x2f\x31\x01")  # OpenEXR magic number
+        self.assertEqual([name for name in os.listdir(self.folder) if "partial" in name], [])
+
+    def test_same_seed_same_image_for_any_thread_count(self):
+        self.bake("--threads", "1", "--seed", "7")
+        with open(self.prefix + ".exr", "rb") as handle:
+            one = handle.read()
+        self.bake("--threads", "2", "--seed", "7")
+        with open(self.prefix + ".exr", "rb") as handle:
+            two = handle.read()
+        self.assertEqual(one, two)
+
+    def test_bad_scene_fails_and_keeps_earlier_outputs(self):
+        self.bake()
+        before = snapshot(self.folder)
+        bad = os.path.join(self.folder, "bad.json")
+        with open(bad, "w") as handle:
+            handle.write('{"version": 1, "meshes": [')
+        done = run_cli("bake", bad, "--out", self.prefix, *SMALL)
+        self.assertEqual(done.returncode, 1, done.stderr)
+        self.assertIn("bad.json", done.stderr)
+        os.remove(bad)
+        self.assertEqual(snapshot(self.folder), before)
+        done = run_cli("bake", os.path.join(self.folder, "missing.json"), "--out", self.prefix, *SMALL)
+        self.assertEqual(done.returncode, 1, done.stderr)
+        self.assertIn("missing.json", done.stderr)
+        self.assertEqual(snapshot(self.folder), before)
+
+    def test_bad_flags(self):
+        assert_bad_usage(self, ["bake"], "dwivedi bake:", ["--out"])
+        assert_bad_usage(self, ["bake", "--out", self.prefix, "--spp", "many"], "dwivedi bake:", ["--spp"])
+        assert_bad_usage(self, ["bake", "--out", self.prefix, "--technique", "magic"], "dwivedi bake:", ["magic"])
+        assert_bad_usage(self, ["bake", "--out", self.prefix, "--frobnicate"], "dwivedi bake:", ["--frobnicate"])
+        done = run_cli("bake", "--out", self.prefix, "--spp", "0", "--quiet")
+        self.assertEqual(done.returncode, USAGE, done.stderr)
+        self.assertIn("samples", done.stderr)
+        done = run_cli("bake", "--out", self.prefix, *SMALL, "--view", "No Such View")
+        self.assertEqual(done.returncode, 1, done.stderr)
+        self.assertIn("No Such View", done.stderr)
+        self.assertEqual(os.listdir(self.folder), [])
+
+    def test_unwritable_folder_fails_cleanly(self):
+        done = run_cli("bake", "--out", os.path.join(self.folder, "no", "such", "dir", "x"), *SMALL)
+        self.assertEqual(done.returncode, 1, done.stderr)
+        self.assertIn("no/such/dir", done.stderr)
+        self.assertEqual(os.listdir(self.folder), [])
+
+    def test_interrupt_cancels_and_keeps_earlier_outputs(self):
+        self.bake()
+        before = snapshot(self.folder)
+        cli = os.environ["DWIVEDI_CLI"]
+        process = subprocess.Popen([cli, "bake", "--out", self.prefix, "--spp", "100000", "--quiet"],
+                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        time.sleep(1.5)
+        sent = time.monotonic()
+        process.send_signal(signal.SIGINT)
+        stdout, stderr = process.communicate(timeout=30)
+        waited = time.monotonic() - sent
+        self.assertNotEqual(process.returncode, 0, stderr)
+        self.assertIn("cancelled", stderr)
+        self.assertEqual(snapshot(self.folder), before)
+        print(f"SIGINT to exit: {waited:.3f} s")
+
+    def test_time_budget_stops_the_bake(self):
+        started = time.monotonic()
+        stats = self.bake("--spp", "1000000", "--time", "1.5")
+        elapsed = time.monotonic() - started
+        self.assertLess(stats["spp"], 1000000)
+        self.assertGreater(stats["spp"], 0)
+        print(f"--time 1.5: bake {stats['seconds']:.2f} s, command {elapsed:.2f} s, {stats['spp']} spp")
+
+
+if __name__ == "__main__":
+    unittest.main()
