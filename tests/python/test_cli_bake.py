@@ -129,5 +129,26 @@ class BakeCli(unittest.TestCase):
         print(f"--time 1.5: bake {stats['seconds']:.2f} s, command {elapsed:.2f} s, {stats['spp']} spp")
 
 
+class BakeReport(unittest.TestCase):
+    """tools/bake_report.py --quick end to end (Debian's interpreter has matplotlib)."""
+
+    def test_report_writes_every_file(self):
+        folder = tempfile.mkdtemp(prefix="dwivedi-bake-report-")
+        try:
+            script = os.path.join(os.environ["DWIVEDI_SOURCE_DIR"], "tools", "bake_report.py")
+            done = subprocess.run(["/usr/bin/python3", script, "--cli", os.environ["DWIVEDI_CLI"], "--out", folder,
+                                   "--quick"], capture_output=True, text=True, timeout=300)
+            self.assertEqual(done.returncode, 0, done.stderr)
+            self.assertEqual(sorted(os.listdir(folder)), ["bake_report.json", "bake_report.md", "bake_rmse.png"])
+            with open(os.path.join(folder, "bake_report.json")) as handle:
+                figures = json.load(handle)
+            self.assertTrue(figures["threads_bit_identical"])
+            self.assertGreater(figures["memory"]["bytes_per_triangle"], 0)
+            self.assertEqual(set(figures["rmse"]), {"classical", "poe", "closest", "incident", "backward",
+                                                    "cycles", "auto"})
+        finally:
+            shutil.rmtree(folder, ignore_errors=True)
+
+
 if __name__ == "__main__":
     unittest.main()
