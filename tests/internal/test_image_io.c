@@ -18,6 +18,7 @@
 #include <math.h>
 #include <openexr.h>
 #include <png.h>
+#include <pthread.h>
 #include <signal.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -503,6 +504,61 @@ static void test_exposure_gamma_look(void)
     dwv_image_release(image);
 }
 
+/* Views differ (so agreeing with ocioconvert view by view means something), and calls from two
+ * threads at once (the built-in config is parsed once and shared) give the one-thread bytes. */
+typedef struct job {
+    dwv_image_t *image;
+    const char *view;
+    uint8_t *bytes;
+    dwv_result_t result;
+} job;
+
+static void *run_job(void *arg)
+{
+    job *j = arg;
+    for (int k = 0; k < 4 && j->result == DWV_SUCCESS; ++k) {
+        dwv_display_options_t o = DWV_DISPLAY_OPTIONS_INIT;
+        o.view = j->view;
+        j->result = dwv_image_to_display(j->image, &o, j->bytes, (uint64_t)W * H * 4);
+    }
+    return NULL;
+}
+
+static void test_views_and_threads(void)
+{
+    dwvb_image *img = make_image();
+    dwv_image_t *image = dwv_image_handle(img);
+    unsetenv("OCIO");
+    uint8_t *alone[2], *together[2];
+    const char *views[2] = {"Standard", "Filmic"};
+    for (int v = 0; v < 2; ++v) {
+        alone[v] = malloc((size_t)W * H * 4);
+        together[v] = malloc((size_t)W * H * 4);
+        dwv_display_options_t o = DWV_DISPLAY_OPTIONS_INIT;
+        o.view = views[v];
+        CHECK(dwv_image_to_display(image, &o, alone[v], (uint64_t)W * H * 4) == DWV_SUCCESS, "%s",
+              dwv_last_error_message());
+    }
+    int worst = 0;
+    for (size_t i = 0; i < (size_t)W * H * 4; ++i) {
+        int d = abs((int)alone[0][i] - (int)alone[1][i]);
+        if (d > worst) worst = d;
+    }
+    CHECK(worst > 20, "Standard and Filmic differ (by up to %d levels)", worst);
+    job jobs[2] = {{image, views[0], together[0], DWV_SUCCESS}, {image, views[1], together[1], DWV_SUCCESS}};
+    pthread_t threads[2];
+    for (int t = 0; t < 2; ++t) pthread_create(&threads[t], NULL, run_job, &jobs[t]);
+    for (int t = 0; t < 2; ++t) pthread_join(threads[t], NULL);
+    for (int v = 0; v < 2; ++v) {
+        CHECK(jobs[v].result == DWV_SUCCESS, "thread %d: %d", v, jobs[v].result);
+        CHECK(memcmp(alone[v], together[v], (size_t)W * H * 4) == 0, "%s: two threads give the one-thread bytes",
+              views[v]);
+        free(alone[v]);
+        free(together[v]);
+    }
+    dwv_image_release(image);
+}
+
 static void test_non_finite_pixels(void)
 {
     dwvb_image *img = dwvb_image_new(4, 1);
@@ -713,6 +769,7 @@ int main(void)
     test_display_against_ocioconvert("Filmic", 0);
     test_display_against_ocioconvert("Filmic", 1);
     test_exposure_gamma_look();
+    test_views_and_threads();
     test_non_finite_pixels();
     test_atomic_writes();
     test_arguments();
