@@ -17,8 +17,8 @@ extern "C" {
  * OpenColorIO, gamma, then [0, 1] clamped and rounded to 8 bits. `options` was validated by the
  * caller (exposure finite, gamma > 0 and finite); the names are checked here against the config
  * (DWV_ERROR_UNKNOWN_NAME with the valid names in the message). Non-finite inputs never reach the
- * bytes as garbage: NaN becomes 0, +-infinity the largest finite float of its sign, before and after
- * the transform (so NaN shows as black, +infinity as the brightest value the view makes). */
+ * bytes as garbage: NaN becomes 0 and, after the exposure, values are clamped to +-65504 (the
+ * largest half float), so +infinity shows as the brightest value the view makes. */
 dwv_result_t dwvio_to_display(const float *rgba, uint32_t width, uint32_t height,
                               const dwv_display_options_t *options, uint8_t *out, char *message, size_t size);
 
