@@ -15,6 +15,7 @@
 #ifndef DWIVEDI_H
 #define DWIVEDI_H
 
+#include <stddef.h> /* NULL, in the *_INIT macros */
 #include <stdint.h>
 
 #ifdef __cplusplus
