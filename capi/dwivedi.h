@@ -280,7 +280,7 @@ typedef struct dwv_estimate_options_t {
     uint32_t struct_size; /* sizeof(dwv_estimate_options_t): set by DWV_ESTIMATE_OPTIONS_INIT */
     dwv_shape_t shape;
     double thickness;         /* slab, in the units of 1/sigma_t, finite and > 0 */
-    double radius;            /* sphere, finite and > 0 */
+    double radius;            /* sphere, in [1e-100, 1e100] */
     dwv_medium_t medium;
     dwv_incidence_t incidence;
     double incidence_cosine;  /* in (0, 1] */
