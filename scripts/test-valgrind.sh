@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # valgrind memcheck of the C tests and of `dwivedi estimate` on every shape and technique, from an
 # existing build (default build/, as scripts/test.sh makes it). Fails on any memcheck error or
-# definitely lost block. Usage: scripts/test-valgrind.sh [build-dir]
+# definitely lost block, and helgrind (data races) on the thread-safety test. Usage: scripts/test-valgrind.sh [build-dir]
 #
 # Left out, with the reason: the statistical walk tests (tests/unit/test_walk_{agreement,halfspace,
 # slab,energy,channels,bookkeeping}.c, tests/internal/test_walk_planted.c) and the Dwivedi sampling
@@ -45,6 +45,14 @@ for exe in "$build"/tests/unit_test_* "$build"/tests/internal_test_*; do
   if [[ $name =~ $skip ]]; then echo "skip  $name (statistical: see the top of this script)"; continue; fi
   run "$name" "$exe"
 done
+
+# Data races: helgrind on the thread-safety test (concurrent kernels, estimates, handles).
+if [ -x "$build/tests/unit_test_thread_safety" ]; then
+  memcheck_saved=("${memcheck[@]}")
+  memcheck=(valgrind -q --tool=helgrind --error-exitcode=99)
+  run "helgrind-unit_test_thread_safety" "$build/tests/unit_test_thread_safety"
+  memcheck=("${memcheck_saved[@]}")
+fi
 
 cli="$build/dwivedi"
 for technique in auto classical poe closest incident backward cycles; do
