@@ -10,11 +10,24 @@
  *
  * Thread safety: every function in this header is pure or touches only the objects passed to it
  * and the calling thread's error message, so any function may be called from any number of
- * threads at once, as long as no two threads write the same object.
+ * threads at once, as long as no two threads write the same object. In particular:
+ *   - The kernels (diffusion length, eigenfunction, sampling, pdfs, random numbers) are pure: any
+ *     number of threads may share one const dwv_dwivedi_t; results do not depend on threads.
+ *   - Error messages are per thread: a failing call sets only the calling thread's message, and
+ *     the pointer from dwv_last_error_message is valid in that thread until its next failing call.
+ *   - dwv_estimate may run on several threads at once; each run starts worker threads of its own
+ *     and its result is the same for any thread count (fixed blocks, counter-based numbers).
+ *   - Handles (walks, scenes, bakes, images) count references atomically: retain and release may be
+ *     called from any thread. A walk handle changes at every step: one thread at a time per walk
+ *     (use one handle per thread). Images are read-only once made, and committed scenes may be
+ *     baked from any number of threads at once; a bake's wait, progress and cancel may be called
+ *     from any thread while it runs.
+ * (tests/unit/test_thread_safety.c checks the kernels, messages, estimates and handles.)
  */
 #ifndef DWIVEDI_H
 #define DWIVEDI_H
 
+#include <stddef.h> /* NULL, in the *_INIT macros */
 #include <stdint.h>
 
 #ifdef __cplusplus
@@ -279,7 +292,7 @@ typedef struct dwv_estimate_options_t {
     uint32_t struct_size; /* sizeof(dwv_estimate_options_t): set by DWV_ESTIMATE_OPTIONS_INIT */
     dwv_shape_t shape;
     double thickness;         /* slab, in the units of 1/sigma_t, finite and > 0 */
-    double radius;            /* sphere, finite and > 0 */
+    double radius;            /* sphere, in [1e-100, 1e100] */
     dwv_medium_t medium;
     dwv_incidence_t incidence;
     double incidence_cosine;  /* in (0, 1] */

@@ -366,6 +366,17 @@ def c_compiler(build_dir):
     return shutil.which("cc")
 
 
+def sanitizer_flags(build_dir):
+    """The sanitizer flags of a DWV_SANITIZE build (CMakeCache.txt): its archive needs their runtime."""
+    cache = os.path.join(build_dir, "CMakeCache.txt")
+    if os.path.exists(cache):
+        with open(cache, encoding="utf-8", errors="replace") as text:
+            for line in text:
+                if line.startswith("DWV_SANITIZE:") and line.split("=", 1)[1].strip().upper() in ("ON", "1", "TRUE", "YES"):
+                    return ["-fsanitize=address,undefined", "-fno-sanitize-recover=all"]
+    return []
+
+
 class MixtureProgram:
     """The compiled mixture program, kept running; one request at a time."""
 
@@ -380,7 +391,7 @@ class MixtureProgram:
         with open(source, "w", encoding="ascii") as out:
             out.write(MIXTURE_PROGRAM)
         command = [compiler, "-O2", "-std=c11", "-I", os.path.join(SOURCE_DIR, "src"), "-I",
-                   os.path.join(SOURCE_DIR, "capi"), source, archive, "-lm", "-pthread", "-o", self.path]
+                   os.path.join(SOURCE_DIR, "capi"), source, archive, "-lm", "-pthread", "-o", self.path] + sanitizer_flags(build_dir)
         done = subprocess.run(command, capture_output=True, text=True)
         if done.returncode != 0:
             raise ReportError("could not build the mixture program against %s: %s"

@@ -110,6 +110,13 @@ dwv_result_t dwv_estimate(const dwv_estimate_options_t *options, dwv_estimate_re
         break;
     case DWV_SHAPE_SPHERE:
         DWV_TRY(check_positive(fn, "radius", options->radius));
+        /* The sphere's exit and closest-point distances square lengths of the order of the radius
+         * (src/walk/geometry.c), and the incident technique measures distances to its poles: beyond
+         * about 1e154 (and below 1e-154) those squares over- (under-)flow, which made exits score
+         * 0 or infinity. [1e-100, 1e100] keeps a wide margin either way. */
+        if (options->radius < 1e-100 || options->radius > 1e100)
+            return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: radius = %.17g is outside [1e-100, 1e100]", fn,
+                            options->radius);
         setup.shape.kind = DWVW_SPHERE;
         setup.shape.radius = options->radius;
         break;
