@@ -25,7 +25,7 @@ static inline void test_mesh_free(test_mesh *m)
 }
 
 /* The box [x0, x1] x [y0, y1] x [z0, z1]: 8 vertices, 12 triangles, UVs per corner (each face
- * a square in its own cell of a 3 x 2 grid). */
+ * a rectangle inside its own cell of a 3 x 2 grid, with gaps between them). */
 static inline test_mesh test_box(double x0, double y0, double z0, double x1, double y1, double z1)
 {
     test_mesh m = {8u, 12u, malloc(24 * sizeof(float) + sizeof(float)), malloc(36 * sizeof(uint32_t)),
@@ -42,8 +42,8 @@ static inline test_mesh test_box(double x0, double y0, double z0, double x1, dou
         const uint32_t *q = quads[f];
         uint32_t tri[2][3] = {{q[0], q[1], q[2]}, {q[0], q[2], q[3]}};
         double cu = (f % 3) / 3.0, cv = (f / 3) / 2.0;
-        double corner_uv[4][2] = {{cu + 0.02, cv + 0.02}, {cu + 0.31, cv + 0.02}, {cu + 0.31, cv + 0.48},
-                                  {cu + 0.02, cv + 0.48}};
+        double corner_uv[4][2] = {{cu + 0.05, cv + 0.05}, {cu + 0.28, cv + 0.05}, {cu + 0.28, cv + 0.45},
+                                  {cu + 0.05, cv + 0.45}};
         int corner_of[2][3] = {{0, 1, 2}, {0, 2, 3}};
         for (int t = 0; t < 2; ++t) {
             for (int k = 0; k < 3; ++k) {
