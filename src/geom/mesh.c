@@ -16,7 +16,8 @@ int dwvg_mesh_init(dwvg_mesh *mesh, uint32_t vertex_count, uint32_t triangle_cou
 {
     memset(mesh, 0, sizeof *mesh);
     size_t nv = (size_t)vertex_count, nt = (size_t)triangle_count;
-    mesh->positions = malloc(nv * 3u * sizeof *mesh->positions);
+    /* One float of padding: Embree reads shared vertex buffers 16 bytes at a time. */
+    mesh->positions = malloc((nv * 3u + 1u) * sizeof *mesh->positions);
     mesh->indices = malloc(nt * 3u * sizeof *mesh->indices);
     if (normals) mesh->normals = malloc(nv * 3u * sizeof *mesh->normals);
     if (uvs) mesh->uvs = malloc(nt * 6u * sizeof *mesh->uvs);
@@ -27,6 +28,7 @@ int dwvg_mesh_init(dwvg_mesh *mesh, uint32_t vertex_count, uint32_t triangle_cou
     mesh->vertex_count = vertex_count;
     mesh->triangle_count = triangle_count;
     mesh->material_id = material_id;
+    mesh->positions[3u * nv] = 0.0f;
     for (size_t v = 0; v < nv; ++v) {
         double x = positions[3 * v], y = positions[3 * v + 1], z = positions[3 * v + 2];
         mesh->positions[3 * v] = (float)(m[0] * x + m[1] * y + m[2] * z + m[3]);

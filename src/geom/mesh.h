@@ -12,7 +12,7 @@
 
 typedef struct dwvg_mesh {
     uint32_t vertex_count, triangle_count, material_id;
-    float *positions;  /* 3 x vertex_count, world space */
+    float *positions;  /* 3 x vertex_count, world space (plus one float of padding for Embree) */
     uint32_t *indices; /* 3 x triangle_count, counter-clockwise seen from outside (Blender's
                           convention), the order reversed when the transform mirrors */
     float *normals;    /* 3 x vertex_count, world space, unit; NULL: flat shading */

@@ -1,0 +1,306 @@
+#include "embree.h"
+
+#include <embree3/rtcore.h>
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static dwvw_vec3 vertex(const dwvg_mesh *mesh, uint32_t index)
+{
+    const float *p = mesh->positions + 3u * (size_t)index;
+    return dwvw_v(p[0], p[1], p[2]);
+}
+
+static void corners(const dwvg_mesh *mesh, uint32_t prim, dwvw_vec3 *a, dwvw_vec3 *b, dwvw_vec3 *c)
+{
+    const uint32_t *i = mesh->indices + 3u * (size_t)prim;
+    *a = vertex(mesh, i[0]);
+    *b = vertex(mesh, i[1]);
+    *c = vertex(mesh, i[2]);
+}
+
+static dwvw_vec3 cross(dwvw_vec3 a, dwvw_vec3 b)
+{
+    return dwvw_v(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+
+dwvw_vec3 dwvg_geometric_normal(const dwvg_mesh *mesh, uint32_t prim)
+{
+    dwvw_vec3 a, b, c;
+    corners(mesh, prim, &a, &b, &c);
+    dwvw_vec3 n = cross(dwvw_sub(b, a), dwvw_sub(c, a));
+    double length = dwvw_length(n);
+    return length > 0.0 && isfinite(length) ? dwvw_scale(n, 1.0 / length) : dwvw_v(0.0, 0.0, 0.0);
+}
+
+double dwvg_triangle_area(const dwvg_mesh *mesh, uint32_t prim)
+{
+    dwvw_vec3 a, b, c;
+    corners(mesh, prim, &a, &b, &c);
+    double area = 0.5 * dwvw_length(cross(dwvw_sub(b, a), dwvw_sub(c, a)));
+    return isfinite(area) ? area : 0.0;
+}
+
+dwvw_vec3 dwvg_point(const dwvg_mesh *mesh, uint32_t prim, double u, double v)
+{
+    dwvw_vec3 a, b, c;
+    corners(mesh, prim, &a, &b, &c);
+    return dwvw_add(a, dwvw_add(dwvw_scale(dwvw_sub(b, a), u), dwvw_scale(dwvw_sub(c, a), v)));
+}
+
+dwvw_vec3 dwvg_shading_normal(const dwvg_mesh *mesh, uint32_t prim, double u, double v, dwvw_vec3 geometric)
+{
+    if (!mesh->normals) return geometric;
+    const uint32_t *i = mesh->indices + 3u * (size_t)prim;
+    const float *n0 = mesh->normals + 3u * (size_t)i[0], *n1 = mesh->normals + 3u * (size_t)i[1],
+                *n2 = mesh->normals + 3u * (size_t)i[2];
+    double w = 1.0 - u - v;
+    dwvw_vec3 n = dwvw_v(w * n0[0] + u * n1[0] + v * n2[0], w * n0[1] + u * n1[1] + v * n2[1],
+                         w * n0[2] + u * n1[2] + v * n2[2]);
+    double length = dwvw_length(n);
+    if (!(length > 1e-6)) return geometric;
+    n = dwvw_scale(n, 1.0 / length);
+    /* A shading normal on the far side of the surface would light the wrong hemisphere. */
+    return dwvw_dot(n, geometric) > 0.0 ? n : geometric;
+}
+
+static void embree_error(void *user, enum RTCError code, const char *text)
+{
+    (void)text;
+    dwvg_world *world = user;
+    int expected = 0;
+    atomic_compare_exchange_strong(&world->embree_error, &expected, (int)code);
+}
+
+static bool embree_memory(void *user, ssize_t bytes, bool post)
+{
+    (void)post;
+    dwvg_world *world = user;
+    atomic_fetch_add(&world->embree_bytes, (long long)bytes);
+    return true;
+}
+
+static int failed(dwvg_world *world, char *message, size_t size, const char *what)
+{
+    int code = atomic_load(&world->embree_error);
+    if (code) snprintf(message, size, "Embree failed while %s (error %d)", what, code);
+    else snprintf(message, size, "out of memory while %s", what);
+    dwvg_world_free(world);
+    return -1;
+}
+
+int dwvg_world_build(dwvg_world *world, const dwvg_mesh *meshes, uint32_t count, char *message, size_t size)
+{
+    memset(world, 0, sizeof *world);
+    atomic_init(&world->embree_bytes, 0);
+    atomic_init(&world->embree_error, 0);
+    world->meshes = meshes;
+    double largest = 0.0;
+    for (uint32_t m = 0; m < count; ++m) {
+        const dwvg_mesh *mesh = &meshes[m];
+        world->triangles += mesh->triangle_count;
+        for (uint32_t t = 0; t < mesh->triangle_count; ++t)
+            if (!(dwvg_triangle_area(mesh, t) > 0.0)) ++world->warnings;
+        for (size_t i = 0; i < 3u * (size_t)mesh->vertex_count; ++i)
+            if (isfinite(mesh->positions[i])) largest = fmax(largest, fabs((double)mesh->positions[i]));
+    }
+    world->epsilon = 0x1p-17 * fmax(largest, 1e-30);
+
+    RTCDevice device = rtcNewDevice(NULL);
+    if (!device) {
+        snprintf(message, size, "Embree could not create a device (error %d)", (int)rtcGetDeviceError(NULL));
+        return -1;
+    }
+    world->device = device;
+    rtcSetDeviceErrorFunction(device, embree_error, world);
+    rtcSetDeviceMemoryMonitorFunction(device, embree_memory, world);
+    world->mesh_scenes = calloc(count ? count : 1u, sizeof *world->mesh_scenes);
+    if (!world->mesh_scenes) return failed(world, message, size, "listing the meshes");
+    world->mesh_count = count;
+    RTCScene top = rtcNewScene(device);
+    if (!top) return failed(world, message, size, "creating the top-level scene");
+    world->top = top;
+    /* Robust traversal: a walk must not slip out of a closed mesh through an edge between two
+     * triangles. */
+    rtcSetSceneFlags(top, RTC_SCENE_FLAG_ROBUST);
+    for (uint32_t m = 0; m < count; ++m) {
+        const dwvg_mesh *mesh = &meshes[m];
+        RTCScene scene = rtcNewScene(device);
+        if (!scene) return failed(world, message, size, "creating a mesh scene");
+        world->mesh_scenes[m] = scene;
+        rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+        RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+        if (!geometry) return failed(world, message, size, "creating a triangle geometry");
+        rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, mesh->positions, 0,
+                                   3u * sizeof(float), mesh->vertex_count);
+        rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, mesh->indices, 0,
+                                   3u * sizeof(uint32_t), mesh->triangle_count);
+        rtcCommitGeometry(geometry);
+        rtcAttachGeometryByID(scene, geometry, 0);
+        rtcReleaseGeometry(geometry);
+        rtcCommitScene(scene);
+        if (atomic_load(&world->embree_error)) return failed(world, message, size, "building a mesh's BVH");
+
+        RTCGeometry instance = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
+        if (!instance) return failed(world, message, size, "creating an instance");
+        rtcSetGeometryInstancedScene(instance, scene);
+        static const float identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+        rtcSetGeometryTransform(instance, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, identity);
+        rtcCommitGeometry(instance);
+        rtcAttachGeometryByID(top, instance, m);
+        rtcReleaseGeometry(instance);
+    }
+    rtcCommitScene(top);
+    if (atomic_load(&world->embree_error)) return failed(world, message, size, "building the top-level BVH");
+    return 0;
+}
+
+void dwvg_world_free(dwvg_world *world)
+{
+    if (world->mesh_scenes)
+        for (uint32_t m = 0; m < world->mesh_count; ++m)
+            if (world->mesh_scenes[m]) rtcReleaseScene(world->mesh_scenes[m]);
+    free(world->mesh_scenes);
+    if (world->top) rtcReleaseScene(world->top);
+    if (world->device) rtcReleaseDevice(world->device);
+    world->mesh_scenes = NULL;
+    world->top = world->device = NULL;
+    world->mesh_count = 0;
+}
+
+static void make_ray(struct RTCRayHit *rh, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar)
+{
+    rh->ray.org_x = (float)o.x;
+    rh->ray.org_y = (float)o.y;
+    rh->ray.org_z = (float)o.z;
+    rh->ray.dir_x = (float)d.x;
+    rh->ray.dir_y = (float)d.y;
+    rh->ray.dir_z = (float)d.z;
+    rh->ray.tnear = (float)tnear;
+    rh->ray.tfar = tfar < (double)FLT_MAX ? (float)tfar : INFINITY;
+    rh->ray.time = 0.0f;
+    rh->ray.mask = 0xffffffffu;
+    rh->ray.id = 0;
+    rh->ray.flags = 0;
+    rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh->hit.primID = RTC_INVALID_GEOMETRY_ID;
+    rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+}
+
+static int trace(RTCScene scene, int instanced, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar, dwvg_hit *hit)
+{
+    struct RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    struct RTCRayHit rh;
+    make_ray(&rh, o, d, tnear, tfar);
+    rtcIntersect1(scene, &context, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 0;
+    hit->mesh = instanced ? rh.hit.instID[0] : 0u;
+    hit->prim = rh.hit.primID;
+    hit->t = rh.ray.tfar;
+    hit->u = rh.hit.u;
+    hit->v = rh.hit.v;
+    return 1;
+}
+
+int dwvg_intersect(const dwvg_world *world, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar, dwvg_hit *hit)
+{
+    if (world->mesh_count == 0) return 0;
+    return trace(world->top, 1, o, d, tnear, tfar, hit);
+}
+
+int dwvg_intersect_mesh(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, double tnear,
+                        double tfar, dwvg_hit *hit)
+{
+    if (!trace(world->mesh_scenes[mesh], 0, o, d, tnear, tfar, hit)) return 0;
+    hit->mesh = mesh;
+    return 1;
+}
+
+int dwvg_occluded(const dwvg_world *world, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar)
+{
+    if (world->mesh_count == 0 || !(tfar > tnear)) return 0;
+    struct RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    struct RTCRayHit rh;
+    make_ray(&rh, o, d, tnear, tfar);
+    rtcOccluded1(world->top, &context, &rh.ray);
+    return rh.ray.tfar < 0.0f; /* Embree marks an occluded ray with tfar = -inf */
+}
+
+/* The barycentrics (u, v) of the point of triangle abc closest to p (Ericson, Real-Time
+ * Collision Detection, Sec. 5.1.5: Voronoi regions of the vertices, edges and face in turn). */
+static void closest_on_triangle(dwvw_vec3 p, dwvw_vec3 a, dwvw_vec3 b, dwvw_vec3 c, double *u, double *v)
+{
+    dwvw_vec3 ab = dwvw_sub(b, a), ac = dwvw_sub(c, a), ap = dwvw_sub(p, a);
+    double d1 = dwvw_dot(ab, ap), d2 = dwvw_dot(ac, ap);
+    if (d1 <= 0.0 && d2 <= 0.0) { *u = 0.0; *v = 0.0; return; }
+    dwvw_vec3 bp = dwvw_sub(p, b);
+    double d3 = dwvw_dot(ab, bp), d4 = dwvw_dot(ac, bp);
+    if (d3 >= 0.0 && d4 <= d3) { *u = 1.0; *v = 0.0; return; }
+    double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) { *u = d1 / (d1 - d3); *v = 0.0; return; }
+    dwvw_vec3 cp = dwvw_sub(p, c);
+    double d5 = dwvw_dot(ab, cp), d6 = dwvw_dot(ac, cp);
+    if (d6 >= 0.0 && d5 <= d6) { *u = 0.0; *v = 1.0; return; }
+    double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) { *u = 0.0; *v = d2 / (d2 - d6); return; }
+    double va = d3 * d6 - d5 * d4;
+    if (va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0) {
+        double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        *u = 1.0 - w;
+        *v = w;
+        return;
+    }
+    double inv = 1.0 / (va + vb + vc);
+    *u = vb * inv;
+    *v = vc * inv;
+}
+
+typedef struct closest_query {
+    const dwvg_mesh *mesh;
+    dwvw_vec3 p;
+    dwvg_hit best;
+    int found;
+} closest_query;
+
+static bool closest_callback(struct RTCPointQueryFunctionArguments *args)
+{
+    closest_query *q = args->userPtr;
+    uint32_t prim = args->primID;
+    if (!(dwvg_triangle_area(q->mesh, prim) > 0.0)) return false;
+    dwvw_vec3 a, b, c;
+    corners(q->mesh, prim, &a, &b, &c);
+    double u, v;
+    closest_on_triangle(q->p, a, b, c, &u, &v);
+    dwvw_vec3 x = dwvg_point(q->mesh, prim, u, v);
+    double distance = dwvw_length(dwvw_sub(x, q->p));
+    if (!(distance < args->query->radius) && q->found) return false;
+    q->best.prim = prim;
+    q->best.u = u;
+    q->best.v = v;
+    q->best.t = distance;
+    q->found = 1;
+    args->query->radius = (float)distance;
+    return true;
+}
+
+int dwvg_closest_mesh(const dwvg_world *world, uint32_t mesh, dwvw_vec3 p, dwvg_hit *hit)
+{
+    struct RTCPointQuery query;
+    query.x = (float)p.x;
+    query.y = (float)p.y;
+    query.z = (float)p.z;
+    query.time = 0.0f;
+    query.radius = INFINITY;
+    struct RTCPointQueryContext context;
+    rtcInitPointQueryContext(&context);
+    closest_query q = {.mesh = &world->meshes[mesh], .p = p, .found = 0};
+    rtcPointQuery(world->mesh_scenes[mesh], &query, &context, closest_callback, &q);
+    if (!q.found) return 0;
+    *hit = q.best;
+    hit->mesh = mesh;
+    return 1;
+}

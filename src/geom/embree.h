@@ -1,0 +1,61 @@
+/* The scene's triangle meshes in Embree 3: one device per scene, one Embree scene per mesh (the
+ * walks inside a mesh trace and query only that mesh), and a top-level scene that instances them
+ * all for camera and shadow rays (instances share the meshes' BVHs, so the geometry is stored
+ * once). Vertex and index buffers are shared with dwvg_mesh, not copied. */
+#ifndef DWV_GEOM_EMBREE_H
+#define DWV_GEOM_EMBREE_H
+
+#include <stdatomic.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "mesh.h"
+#include "walk/vec3.h"
+
+typedef struct dwvg_world {
+    void *device;         /* RTCDevice */
+    void *top;            /* RTCScene of instances, instance id = mesh index */
+    void **mesh_scenes;   /* RTCScene per mesh */
+    const dwvg_mesh *meshes;
+    uint32_t mesh_count;
+    double epsilon;       /* ray offset: 2^-17 of the scene's largest coordinate (about 64 float
+                             ulps there), so it scales with the scene and clears float rounding */
+    uint64_t warnings;    /* zero-area or non-finite triangles (Embree skips them) */
+    uint64_t triangles;
+    atomic_llong embree_bytes; /* what Embree holds now (its memory monitor) */
+    atomic_int embree_error;   /* the first Embree error code, 0 if none */
+} dwvg_world;
+
+typedef struct dwvg_hit {
+    uint32_t mesh, prim;
+    double t;
+    double u, v; /* barycentrics of corners 1 and 2 */
+} dwvg_hit;
+
+/* Builds the device and scenes for `count` meshes (kept by pointer: they must outlive the world).
+ * 0 on success; -1 with a message in `message` (Embree's error, or no memory). */
+int dwvg_world_build(dwvg_world *world, const dwvg_mesh *meshes, uint32_t count, char *message, size_t size);
+void dwvg_world_free(dwvg_world *world);
+
+/* The first surface along unit d from o within (tnear, tfar): 1 and *hit, or 0. */
+int dwvg_intersect(const dwvg_world *world, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar, dwvg_hit *hit);
+/* Whether anything blocks the segment (tnear, tfar) along d from o. */
+int dwvg_occluded(const dwvg_world *world, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar);
+/* As dwvg_intersect, against one mesh only. */
+int dwvg_intersect_mesh(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, double tnear,
+                        double tfar, dwvg_hit *hit);
+/* The point of `mesh` closest to p (rtcPointQuery with our own point-triangle distance): 1 and
+ * *hit (t = the distance), or 0 if the mesh has no valid triangle. */
+int dwvg_closest_mesh(const dwvg_world *world, uint32_t mesh, dwvw_vec3 p, dwvg_hit *hit);
+
+/* The unit outward geometric normal of a triangle, (v1 - v0) x (v2 - v0) normalised (zero for a
+ * degenerate one). */
+dwvw_vec3 dwvg_geometric_normal(const dwvg_mesh *mesh, uint32_t prim);
+/* The interpolated vertex normal at barycentrics (u, v), turned to the side of `geometric`; the
+ * geometric normal where the mesh has none or they cancel. */
+dwvw_vec3 dwvg_shading_normal(const dwvg_mesh *mesh, uint32_t prim, double u, double v, dwvw_vec3 geometric);
+dwvw_vec3 dwvg_point(const dwvg_mesh *mesh, uint32_t prim, double u, double v);
+/* A triangle's area (0 for degenerate or non-finite ones). */
+double dwvg_triangle_area(const dwvg_mesh *mesh, uint32_t prim);
+
+#endif
