@@ -5,7 +5,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(build-essential cmake pkg-config binutils python3 python3-mpmath python3-numpy python3-matplotlib
-          libopenexr-dev openexr libopencolorio-dev opencolorio-tools libpng-dev
+          libopenexr-dev openexr libopencolorio-dev opencolorio-tools libpng-dev libcjson-dev libassimp-dev
           abigail-tools valgrind clang-14 libclang-rt-14-dev)
 
 missing=()
