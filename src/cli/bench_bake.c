@@ -6,7 +6,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "cli.h"
@@ -30,13 +29,6 @@ void cli_bench_bake_help(FILE *out)
             "              pixel: relative RMSE (RMSE / mean of the reference) against a reference\n"
             "              of --reference-spp (default 1024) by `auto` with another seed, and seconds\n"
             "Run nothing else heavy meanwhile; times are figures, not checks.\n");
-}
-
-static double now_seconds(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
 /* Resident set size in bytes, from /proc/self/statm; 0 where unavailable. */
