@@ -450,6 +450,11 @@ static void setup_guides(dwvb_bake *bake)
         /* Incident guiding needs lit patches; where a mesh has none (no light reaches it) it
          * aims at the closest surface point instead, as auto does. */
         if (technique == DWVW_INCIDENT && scene->patch_count[m] == 0) technique = DWVW_CLOSEST;
+        /* Auto leaves media to classical sampling below albedo 0.2 (dwvw_auto_weights); Cycles'
+         * floor raises every lower albedo to exactly 0.2, where walks average about 1.25 events
+         * and guiding has nothing to gain, so those stay classical too. */
+        if (technique == DWVW_AUTO && material->medium.albedo[material->medium.guide_channel] <= DWVB_MIN_ALPHA)
+            technique = DWVW_CLASSICAL;
         dwvw_guide_init(&bake->guides[m], technique, &material->medium, scene->patches[m], scene->patch_count[m]);
         bake->needs_closest[m] = dwvw_guide_needs_closest(&bake->guides[m]);
         if (!mesh_used(bake, m)) continue;
