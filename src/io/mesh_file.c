@@ -18,6 +18,7 @@
 #include <assimp/scene.h>
 
 #include "api/error.h"
+#include "io/ply_check.h"
 
 /* Assimp keeps its last error in one global string, so imports are taken one at a time: the
  * message read after a failed import is then that import's own. */
@@ -147,6 +148,7 @@ dwv_result_t dwvio_mesh_file_read(const char *path, dwvio_mesh_data *mesh)
     FILE *probe = fopen(path, "rb");
     if (!probe) return dwv_fail(DWV_ERROR_IO, "mesh file '%s': %s", path, strerror(errno));
     fclose(probe);
+    if (has_extension(path, ".ply")) DWV_TRY(dwvio_ply_check(path));
 
     /* Triangulate polygons; bake the node hierarchy into the vertices; drop points and lines;
      * let Assimp check its own output (indices in range and the like). */
