@@ -573,6 +573,21 @@ static void test_mesh_files(void)
     expect_failure("ASCII PLY line short of values",
                    "{\"version\": 1, " MATERIAL ", \"meshes\": [{\"material\": \"m\", \"file\": \"few.ply\"}]}",
                    DWV_ERROR_FORMAT, "meshes[0].file", "too few");
+    /* A well-formed binary PLY whose first coordinate is a tiny denormal: Assimp 5.2 flagged its
+     * triangle as a polygon and its triangulation asserted (abort); now a message or a scene. */
+    const char denormal[] = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                            "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                            "\x06\0\0\0\0\0\0\0\0\0\0\0\0\0\0\0\0\0\x80\x3f\0\0\0\0\0\0\0\0\0\0\0\0\0\0\x80\x3f"
+                            "\x03\0\0\0\0\x01\0\0\0\x02\0\0\0";
+    write_file("denormal.ply", denormal, sizeof denormal - 1);
+    {
+        const char *json = "{\"version\": 1, " MATERIAL ", \"meshes\": [{\"material\": \"m\", \"file\": \"denormal.ply\"}]}";
+        dwv_scene_t *scene = NULL;
+        dwv_result_t r = dwv_scene_load_json(json, strlen(json), temp_dir, &scene, NULL);
+        CHECK((r == DWV_SUCCESS) == (scene != NULL) && (r == DWV_SUCCESS || strstr(dwv_last_error_message(), "denormal.ply")),
+              "denormal PLY: %d %s", (int)r, dwv_last_error_message());
+        dwv_scene_release(scene);
+    }
     /* A well-formed binary PLY loads. */
     const char binary[] = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
                           "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
