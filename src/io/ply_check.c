@@ -74,6 +74,17 @@ static unsigned split(char *line, char **tokens, unsigned max)
     return n;
 }
 
+/* Element and property names: [A-Za-z_][A-Za-z0-9_]* (Assimp's reader reads numbers out of
+ * names that begin with digits, and then asks for gigabytes: found by fuzzing). */
+static int is_name(const char *s)
+{
+    if (!((*s >= 'A' && *s <= 'Z') || (*s >= 'a' && *s <= 'z') || *s == '_')) return 0;
+    for (++s; *s; ++s)
+        if (!((*s >= 'A' && *s <= 'Z') || (*s >= 'a' && *s <= 'z') || (*s >= '0' && *s <= '9') || *s == '_'))
+            return 0;
+    return 1;
+}
+
 static int parse_count(const char *s, uint64_t *out)
 {
     if (!*s) return 0;
@@ -135,7 +146,7 @@ static dwv_result_t read_header(const char *path, const unsigned char *text, siz
             return dwv_fail(DWV_ERROR_FORMAT, "mesh file '%s': PLY header line %u comes before 'format'", path,
                             line_number);
         if (strcmp(tokens[0], "element") == 0) {
-            if (n != 3 || h->element_count >= MAX_ELEMENTS)
+            if (n != 3 || h->element_count >= MAX_ELEMENTS || !is_name(tokens[1]))
                 return dwv_fail(DWV_ERROR_FORMAT, "mesh file '%s': PLY header line %u: bad 'element' (or more than %u)",
                                 path, line_number, MAX_ELEMENTS);
             element *e = &h->elements[h->element_count++];
@@ -155,6 +166,9 @@ static dwv_result_t read_header(const char *path, const unsigned char *text, siz
                                 line_number, MAX_PROPERTIES);
             property *p = &e->properties[e->property_count++];
             int integer = 0;
+            if (!is_name(tokens[n - 1u]))
+                return dwv_fail(DWV_ERROR_FORMAT, "mesh file '%s': PLY header line %u: a property name must be a word",
+                                path, line_number);
             if (n == 5 && strcmp(tokens[1], "list") == 0) {
                 p->is_list = 1;
                 p->count_size = type_size(tokens[2], &integer);
@@ -210,8 +224,10 @@ static dwv_result_t check_binary(const char *path, const unsigned char *text, si
                     if (size - at < p->count_size) goto short_body;
                     uint64_t items = read_count(text + at, p->count_size, big);
                     at += p->count_size;
-                    if (items > MAX_LIST_ITEMS)
-                        return dwv_fail(DWV_ERROR_FORMAT, "mesh file '%s': a PLY list of %llu items (more than %u)",
+                    /* Empty lists too: Assimp 5.2 turns them into faces of no corners and crashes in
+                     * its post-processing (found by fuzzing). */
+                    if (items < 1u || items > MAX_LIST_ITEMS)
+                        return dwv_fail(DWV_ERROR_FORMAT, "mesh file '%s': a PLY list of %llu items (1 to %u allowed)",
                                         path, (unsigned long long)items, MAX_LIST_ITEMS);
                     bytes = items * p->item_size;
                 }
@@ -294,12 +310,11 @@ static dwv_result_t check_ascii(const char *path, const unsigned char *text, siz
                                     path, (unsigned long long)line);
                 if (e->properties[property_index].is_list) {
                     uint64_t items = 0;
-                    if (!parse_count_token(text + start, cursor - start, &items))
+                    if (!parse_count_token(text + start, cursor - start, &items) || items < 1u)
                         return dwv_fail(DWV_ERROR_FORMAT, "mesh file '%s': body line %llu of the PLY: a list count "
-                                        "that is not a whole number up to %u", path, (unsigned long long)line,
+                                        "that is not a whole number from 1 to %u", path, (unsigned long long)line,
                                         MAX_LIST_ITEMS);
-                    if (items > 0) in_list = 1, list_left = items;
-                    else ++property_index;
+                    in_list = 1, list_left = items;
                 } else {
                     ++property_index;
                 }

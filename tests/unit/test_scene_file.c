@@ -588,6 +588,21 @@ static void test_mesh_files(void)
               "denormal PLY: %d %s", (int)r, dwv_last_error_message());
         dwv_scene_release(scene);
     }
+    /* More of what fuzzing found Assimp 5.2 mishandles: a name that starts with digits (it asked
+     * for gigabytes) and an empty list (a face of no corners, a crash in its post-processing). */
+    const char digits[] = "ply\nformat ascii 1.0\nelement 3333333333333333vertex 3\nproperty float x\nproperty float y\n"
+                          "property float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n";
+    write_file("digits.ply", digits, sizeof digits - 1);
+    expect_failure("PLY element name of digits",
+                   "{\"version\": 1, " MATERIAL ", \"meshes\": [{\"material\": \"m\", \"file\": \"digits.ply\"}]}",
+                   DWV_ERROR_FORMAT, "meshes[0].file", "element");
+    const char empty_list[] = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                              "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n"
+                              "0 0 0\n1 0 0\n0 1 0\n0\n3 0 1 2\n";
+    write_file("empty_list.ply", empty_list, sizeof empty_list - 1);
+    expect_failure("PLY empty list",
+                   "{\"version\": 1, " MATERIAL ", \"meshes\": [{\"material\": \"m\", \"file\": \"empty_list.ply\"}]}",
+                   DWV_ERROR_FORMAT, "meshes[0].file", "list");
     /* A well-formed binary PLY loads. */
     const char binary[] = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
                           "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
