@@ -29,10 +29,11 @@
 
 #define PI 3.14159265358979323846
 
-/* Default bake: 16:9, enough samples that the leaf's transmitted glow is recognisable. */
+/* Default bake: 16:9; 128 samples: about 28 s of CPU (14 s on two cores) for this engine at
+ * commit f7aebb7, measured on the shared build machine (64 samples: 14.3 s of CPU). */
 #define DEFAULT_WIDTH 480u
 #define DEFAULT_HEIGHT 270u
-#define DEFAULT_SAMPLES 64u
+#define DEFAULT_SAMPLES 128u
 
 static int allocate(dwvio_mesh_data *mesh, uint32_t vertices, uint32_t triangles)
 {

@@ -158,7 +158,7 @@ static void test_default_scene(void)
     dwv_scene_t *scene = NULL;
     dwv_bake_options_t options = DWV_BAKE_OPTIONS_INIT;
     CHECK(dwv_scene_create_default(&scene, &options) == DWV_SUCCESS && scene, "%s", dwv_last_error_message());
-    CHECK(options.width == 480u && options.height == 270u && options.samples == 64u, "default options %u x %u",
+    CHECK(options.width == 480u && options.height == 270u && options.samples == 128u, "default options %u x %u",
           options.width, options.height);
     double black[3] = {0, 0, 0};
     CHECK(scene && dwv_scene_set_world(scene, black, 0.0) == DWV_ERROR_INVALID_STATE, "default scene not committed");
