@@ -392,6 +392,20 @@ def write_markdown(path, cases, kernel_rows, meta):
             cells.append("%.3f s / %.0f" % (max(c["seconds"] for c in cs), max(c["events_per_walk"] for c in cs))
                          if cs else "-")
         lines.append("| %s | %s |" % (t, " | ".join(cells)))
+    lines += ["", "## Walks: largest truncated weight per walk, per technique and albedo", "",
+              "Weight that walks still carried when the event cap ended them (reported, never dropped). Where it is "
+              "not 0 the reference check brackets the reference between the estimate and the estimate plus this "
+              "weight, so on the half-space at albedo >= 0.9999 (cap 2 x 10^4) it is looser than 5 standard errors. "
+              "At albedo 1 every technique's weights are exactly 1 (v0 is infinite: the guided distributions are "
+              "the isotropic one), so R + T + truncated = 1 holds exactly.", ""]
+    lines.append("| technique | " + " | ".join(alpha_label(a) for a in albedos) + " |")
+    lines.append("|---|" + "---|" * len(albedos))
+    for t in TECHNIQUES:
+        cells = []
+        for a in albedos:
+            cs = [c for c in cases if c["technique"] == t and c["albedo"] == a and c["status"] == "ran"]
+            cells.append("%.2g" % max(c["truncated"] or 0.0 for c in cs) if cs else "-")
+        lines.append("| %s | %s |" % (t, " | ".join(cells)))
     lines += ["", "## Radius 0", "",
               "The sphere of radius 0 has no interior; `dwv_estimate` refuses it (expected):", ""]
     for c in cases:
@@ -466,7 +480,19 @@ def main():
     parser.add_argument("--quick", action="store_true", help="a subset, for CI")
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--walks", type=int)
+    parser.add_argument("--from-json", help="rewrite the report from a stability.json of an earlier run")
     options = parser.parse_args()
+    if options.from_json:
+        with open(options.from_json) as f:
+            saved = json.load(f)
+        out = options.out or os.path.dirname(os.path.abspath(options.from_json))
+        meta = saved["meta"]
+        for key in ("longest", "most_events", "most_truncated"):
+            meta[key] = tuple(meta[key])
+        write_markdown(os.path.join(out, "stability.md"), saved["walks"], saved["kernels"], meta)
+        write_plot(os.path.join(out, "stability.png"), saved["walks"])
+        print("rewrote %s/stability.md from %s" % (out, options.from_json))
+        return 0
     if not os.path.exists(options.cli):
         raise SystemExit("stability_report: no CLI at %s (build first, or --cli)" % options.cli)
     library = options.library or os.path.join(os.path.dirname(os.path.abspath(options.cli)), "libdwivedi.so.1")
