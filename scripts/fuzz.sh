@@ -5,7 +5,8 @@
 # A crash stops the run and leaves the input in build-fuzz/crashes/<name>/: add it to
 # tests/fuzz/regressions/<name>/ (the replay tests run it in every build), then fix the bug.
 # New coverage found stays in build-fuzz/corpus/<name>/; to grow the committed corpus, merge it:
-#   build-fuzz/tests/fuzz/fuzz_<name> -merge=1 tests/fuzz/corpus/<name> build-fuzz/corpus/<name>
+#   build-fuzz/tests/fuzz/fuzz_<name> -merge=1 -use_counters=0 tests/fuzz/corpus/<name> build-fuzz/corpus/<name>
+# (-use_counters=0 keeps one input per new edge, not per hit count: a small corpus)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-60}

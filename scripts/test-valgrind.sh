@@ -46,6 +46,15 @@ for exe in "$build"/tests/unit_test_* "$build"/tests/internal_test_*; do
   run "$name" "$exe"
 done
 
+# The fuzz corpora and regressions, replayed (tests/fuzz/replay.c).
+for exe in "$build"/tests/replay_*; do
+  [ -x "$exe" ] || continue
+  name=${exe##*/replay_}
+  inputs=()
+  for dir in tests/fuzz/corpus/"$name" tests/fuzz/regressions/"$name"; do [ -d "$dir" ] && inputs+=("$dir"); done
+  [ ${#inputs[@]} -gt 0 ] && run "replay_$name" "$exe" "${inputs[@]}"
+done
+
 # Data races: helgrind on the thread-safety test (concurrent kernels, estimates, handles).
 if [ -x "$build/tests/unit_test_thread_safety" ]; then
   memcheck_saved=("${memcheck[@]}")

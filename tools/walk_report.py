@@ -341,7 +341,7 @@ int main(void)
         }
         /* The same arithmetic as dwv_estimate in src/api/walk_api.c. */
         double n = (double)walks, mean = totals.sum[0] / n;
-        double variance = fmax(0.0, (totals.sum_squares[0] - n * mean * mean) / (n - 1.0));
+        double variance = totals.m2[0] / (n - 1.0); /* as dwv_estimate (src/api/walk_api.c) */
         printf("{\"mean\": %.17g, \"variance\": %.17g, \"walks\": %llu, \"events\": %llu, \"seconds\": %.17g, "
                "\"cpu_seconds\": %.17g, \"truncated_walks\": %llu, \"patches\": %d, "
                "\"q\": [%.17g, %.17g, %.17g, %.17g, %.17g]}\n",

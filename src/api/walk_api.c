@@ -170,7 +170,7 @@ dwv_result_t dwv_estimate(const dwv_estimate_options_t *options, dwv_estimate_re
     for (int c = 0; c < 3; ++c) {
         int used = c < setup.medium.channels;
         double mean = used ? totals.sum[c] / n : 0.0;
-        double variance = used ? fmax(0.0, (totals.sum_squares[c] - n * mean * mean) / (n - 1.0)) : 0.0;
+        double variance = used ? totals.m2[c] / (n - 1.0) : 0.0;
         result->mean[c] = mean;
         result->variance[c] = variance;
         result->std_error[c] = sqrt(variance / n);

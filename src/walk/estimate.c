@@ -52,7 +52,8 @@ static double exit_score(const dwvw_estimate_setup *setup, dwvw_vec3 n)
 
 typedef struct block_totals {
     double sum[DWVW_MAX_CHANNELS], sum_squares[DWVW_MAX_CHANNELS], truncated_weight[DWVW_MAX_CHANNELS];
-    uint64_t events, truncated_walks;
+    double m2[DWVW_MAX_CHANNELS]; /* squared deviations from the block's mean (Welford) */
+    uint64_t events, truncated_walks, walks;
 } block_totals;
 
 typedef struct run_state {
@@ -95,9 +96,17 @@ static void run_walk(const dwvw_estimate_setup *setup, uint64_t index, block_tot
     for (int c = 0; c < setup->medium.channels; ++c) {
         if (walk.status == DWVW_TRUNCATED) out->truncated_weight[c] += walk.weight[c];
         double x = walk.weight[c] * score;
+        /* Welford (Knuth TAOCP 2, 4.2.2): m2 += k/(k+1) (x - mean of the k before)^2. The variance
+         * as sum_squares - n mean^2 cancels when scores agree to 8 digits (all near 1 in a thin
+         * slab at albedo ~1): it came out 0 where it was ~1e-18 and the standard error was 0. */
+        if (out->walks > 0) {
+            double k = (double)out->walks, deviation = x - out->sum[c] / k;
+            out->m2[c] += deviation * deviation * (k / (k + 1.0));
+        }
         out->sum[c] += x;
         out->sum_squares[c] += x * x;
     }
+    ++out->walks;
     if (walk.status == DWVW_TRUNCATED) ++out->truncated_walks;
 }
 
@@ -148,6 +157,17 @@ int dwvw_estimate_run(const dwvw_estimate_setup *setup, dwvw_estimate_totals *to
         }
         totals->events += state.blocks[b].events;
         totals->truncated_walks += state.blocks[b].truncated_walks;
+    }
+    /* Blocks' squared deviations about the overall mean (Chan, Golub, LeVeque 1979): in block
+     * order, so the result is the same for any thread count. */
+    for (int c = 0; c < DWVW_MAX_CHANNELS; ++c) {
+        double mean = setup->walks ? totals->sum[c] / (double)setup->walks : 0.0;
+        totals->m2[c] = 0.0;
+        for (uint32_t b = 0; b < state.block_count; ++b) {
+            const block_totals *block = &state.blocks[b];
+            double n = (double)block->walks, shift = block->walks ? block->sum[c] / n - mean : 0.0;
+            totals->m2[c] += block->m2[c] + n * shift * shift;
+        }
     }
     free(state.blocks);
     clock_gettime(CLOCK_MONOTONIC, &stop);

@@ -23,6 +23,7 @@ typedef struct dwvw_estimate_setup {
 typedef struct dwvw_estimate_totals {
     double sum[DWVW_MAX_CHANNELS], sum_squares[DWVW_MAX_CHANNELS];
     double truncated_weight[DWVW_MAX_CHANNELS]; /* weight held by walks the event cap ended */
+    double m2[DWVW_MAX_CHANNELS]; /* sum of squared deviations of the scores from their mean */
     uint64_t events, truncated_walks;
     double seconds;
 } dwvw_estimate_totals;

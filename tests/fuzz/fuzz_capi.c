@@ -321,17 +321,58 @@ static void op_walk(reader *r)
     dwv_walk_release(walk);
 }
 
+/* One entry point with one of its pointer arguments NULL (the others valid or fuzzed): refused. */
+static void op_null(reader *r)
+{
+    uint8_t which = byte(r);
+    double a = real(r), x = 0.0;
+    float xf = 0.0f;
+    dwv_dwivedi_t dist = DWV_DWIVEDI_INIT;
+    (void)dwv_dwivedi_init(&dist, unit(r), DWV_V0_EXACT);
+    dwv_estimate_options_t o = DWV_ESTIMATE_OPTIONS_INIT;
+    dwv_estimate_result_t res = DWV_ESTIMATE_RESULT_INIT;
+    dwv_medium_t m = DWV_MEDIUM_INIT;
+    dwv_walk_t *walk = NULL;
+    dwv_image_t *image = NULL;
+    int32_t needs = 0;
+    const double v[3] = {0.0, 0.0, 1.0};
+    dwv_result_t code;
+    prime();
+    switch (which % 16u) {
+    case 0: code = dwv_diffusion_length(a, DWV_V0_EXACT, NULL); break;
+    case 1: code = dwv_dwivedi_sample(which & 16u ? &dist : NULL, a, which & 16u ? NULL : &x); break;
+    case 2: code = dwv_dwivedi_pdf_f(which & 16u ? &dist : NULL, (float)a, which & 16u ? NULL : &xf); break;
+    case 3: code = dwv_dwivedi_sample_pdf(which & 16u ? &dist : NULL, a, NULL); break;
+    case 4: code = dwv_hg_sample_pdf(a, a, which & 16u ? &x : NULL, which & 16u ? NULL : &x); break;
+    case 5: code = dwv_exponential_sample_f((float)a, (float)a, NULL); break;
+    case 6: code = dwv_eigenfunction(a, a, a, NULL); break;
+    case 7: code = dwv_estimate(which & 16u ? &o : NULL, which & 16u ? NULL : &res); break;
+    case 8: code = dwv_walk_create(which & 16u ? &m : NULL, DWV_TECHNIQUE_AUTO, NULL, 1u, 0, 0,
+                                   which & 32u ? &walk : NULL); break;
+    case 9: code = dwv_walk_begin(NULL, 0, v, v, v); break;
+    case 10: code = dwv_walk_sample(NULL, NULL, NULL); break;
+    case 11: code = dwv_walk_report(NULL, a, NULL, NULL); break;
+    case 12: code = dwv_walk_needs_closest(NULL, &needs); break;
+    case 13: code = dwv_image_create(1u + byte(r), 1u + byte(r), NULL, which & 16u ? &image : NULL); break;
+    case 14: code = dwv_random_uniform(u64(r), u64(r), u64(r), u32(r), NULL); break;
+    default: code = dwv_technique_from_name(NULL, NULL); break;
+    }
+    require(code != DWV_SUCCESS && walk == NULL && image == NULL, "a NULL pointer was accepted");
+    check(code, "a call with a NULL pointer");
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     reader r = {data, size, 0};
     for (int op = 0; op < 8 && r.at < r.size; ++op) {
-        switch (byte(&r) % 4u) {
+        switch (byte(&r) % 5u) {
         case 0: op_kernels(&r); break;
         case 1: op_names(&r); break;
         case 2: op_estimate(&r); break;
-        default: op_walk(&r); break;
+        case 3: op_walk(&r); break;
+        default: op_null(&r); break;
         }
     }
     return 0;
