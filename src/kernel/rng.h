@@ -41,4 +41,15 @@ static inline float dwvk_rng_uniform_f(uint64_t key, uint32_t dimension)
     return (float)(dwvk_rng_u64(key, dimension) >> 40) * 0x1.0p-24f;
 }
 
+/* Two 24-bit uniforms from one 64-bit draw: bits 63..40 and 39..16 (each uniform on [0, 1) in
+ * steps of 2^-24, never 1, independent: SplitMix64's output bits are). One hash for two numbers. */
+typedef struct dwvk_uniform_pair_f { float a, b; } dwvk_uniform_pair_f;
+
+static inline dwvk_uniform_pair_f dwvk_rng_uniform_pair_f(uint64_t key, uint32_t dimension)
+{
+    uint64_t bits = dwvk_rng_u64(key, dimension);
+    dwvk_uniform_pair_f pair = {(float)(bits >> 40) * 0x1.0p-24f, (float)((bits >> 16) & 0xffffffu) * 0x1.0p-24f};
+    return pair;
+}
+
 #endif

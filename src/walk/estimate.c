@@ -59,25 +59,30 @@ typedef struct run_state {
     const dwvw_estimate_setup *setup;
     uint64_t block_size;
     uint32_t block_count;
+    dwvw_walker walker;
     atomic_uint next_block;
     block_totals *blocks;
 } run_state;
 
-static void run_walk(const dwvw_estimate_setup *setup, uint64_t index, block_totals *out)
+static const dwvw_vec3 ENTRY_POINT = {0.0, 0.0, 0.0}, ENTRY_NORMAL = {0.0, 0.0, -1.0}; /* outward */
+
+/* The entry direction of a walk: dimensions 0 and 1 of its key. */
+static dwvw_vec3 entry_direction(const dwvw_estimate_setup *setup, uint64_t key)
 {
-    const dwvw_vec3 origin = {0.0, 0.0, 0.0}, outward = {0.0, 0.0, -1.0};
-    uint64_t key = dwvk_rng_key(setup->seed, index, 0);
-    dwvw_vec3 direction;
     if (setup->incidence_diffuse) {
         /* Cosine-weighted: mu = sqrt(u). */
         double u = dwvk_rng_uniform_d(key, 0), mu = sqrt(u);
-        direction = dwvw_direction_about(dwvw_v(0.0, 0.0, 1.0), mu, 1.0 - mu, 1.0 + mu, dwvk_rng_uniform_d(key, 1));
-    } else {
-        double mu = setup->incidence_cosine;
-        direction = dwvw_v(sqrt((1.0 - mu) * (1.0 + mu)), 0.0, mu);
+        return dwvw_direction_about(dwvw_v(0.0, 0.0, 1.0), mu, 1.0 - mu, 1.0 + mu, dwvk_rng_uniform_d(key, 1));
     }
+    double mu = setup->incidence_cosine;
+    return dwvw_v(sqrt((1.0 - mu) * (1.0 + mu)), 0.0, mu);
+}
+
+static void general_walk(const dwvw_estimate_setup *setup, uint64_t key, dwvw_walk_end *end)
+{
     dwvw_walk walk;
-    dwvw_walk_begin(&walk, &setup->medium, &setup->guide, key, setup->max_events, origin, direction, outward);
+    dwvw_walk_begin(&walk, &setup->medium, &setup->guide, key, setup->max_events, ENTRY_POINT,
+                    entry_direction(setup, key), ENTRY_NORMAL);
     int needs_closest = dwvw_guide_needs_closest(&setup->guide);
     while (walk.status == DWVW_RUNNING) {
         if (needs_closest) {
@@ -90,15 +95,232 @@ static void run_walk(const dwvw_estimate_setup *setup, uint64_t index, block_tot
         double hit = dwvw_shape_exit(&setup->shape, walk.position, walk.direction, &hit_normal);
         dwvw_walk_complete(&walk, hit, hit_normal);
     }
-    out->events += walk.events;
-    double score = walk.status == DWVW_EXITED ? exit_score(setup, walk.exit_normal) : 0.0;
+    end->status = walk.status;
+    end->events = walk.events;
+    for (int c = 0; c < DWVW_MAX_CHANNELS; ++c) end->weight[c] = walk.weight[c];
+    end->exit_normal = walk.exit_normal;
+}
+
+/* ---- the fast paths -------------------------------------------------------------------------
+ * They draw the same random numbers as dwvw_walk_sample / dwvw_walk_complete (same dimensions,
+ * same kernels, same arithmetic for directions and distances), so they make the same walks; only
+ * the weight is formed differently. Grey medium, one component, weight 1 in its one channel.
+ *
+ * Classical alone: f / p = alpha sigma p_phase e^(-sigma t) / (p_phase sigma e^(-sigma t)) = alpha
+ * per scattering event and 1 for the exit, so the weight is alpha^events: no pdf, no exponential.
+ *
+ * One guided component about a fixed unit axis n, isotropic phase 1/(4 pi), at a scattering event
+ * after a sampled direction w (mu = w.n, stretch s = 1 - kappa mu, a = 2 kappa / L):
+ *   f = alpha (1/(4 pi)) sigma e^(-sigma t)
+ *   p = (a / (4 pi s)) sigma s e^(-sigma s t)               (direction pdf x stretched flight)
+ *   f / p = (alpha / a) e^(-sigma (1 - s) t) = (alpha / a) e^(-sigma kappa (t w).n):
+ * the stretch cancels, and t w is the event's displacement. The first step keeps the entry
+ * direction (pdf 1 for every technique, phase 1): f / p = (alpha / s0) e^(-sigma kappa (t w).n).
+ * The exit step has no albedo and no sigma: (s / a) e^(-sigma kappa (t w).n), or for an exit on
+ * the first step e^(-sigma kappa (t w).n). Summed over the steps, the displacements add up to the
+ * position less the entry point, so
+ *   log weight = sum of the log constants - sigma kappa (x - x_entry).n,
+ * one multiply-add per event for the Russian roulette test (weight < threshold, in logs), and one
+ * exponential per walk (or per roulette below the threshold). */
+
+static void add_flight(dwvw_vec3 *position, dwvw_vec3 direction, double t)
+{
+    *position = dwvw_madd(*position, direction, t);
+}
+
+/* The Russian roulette of dwvw_walk_complete on a weight exp(log_weight) after `events` events:
+ * 0 if the walk ends (absorbed), 1 if it goes on unchanged, 2 if it goes on with its weight raised
+ * to the threshold (*log_weight = its log). */
+static int roulette(uint64_t key, uint32_t events, double *log_weight)
+{
+    static const double log_threshold = -2.9957322735539909; /* log(DWVW_ROULETTE_THRESHOLD) */
+    if (!(*log_weight < log_threshold)) return 1;
+    double weight = exp(*log_weight);
+    if (!(weight > 0.0)) return 0;
+    double survive = weight / DWVW_ROULETTE_THRESHOLD;
+    if (dwvk_rng_uniform_d(key, dwvw_event_dim(events - 1u) + DWVW_DIM_ROULETTE) >= survive) return 0;
+    *log_weight = log_threshold; /* weight / survive */
+    return 2;
+}
+
+static inline void classical_walk_in(const dwvw_estimate_setup *setup, dwvw_shape_kind kind, uint64_t key,
+                                     dwvw_walk_end *end)
+{
+    const dwvw_medium *m = &setup->medium;
+    const double sigma = m->sigma_t[0], albedo = m->albedo[0];
+    const float g = (float)m->g;
+    dwvw_vec3 position = ENTRY_POINT, direction = entry_direction(setup, key), normal;
+    double weight = 1.0;
+    uint32_t events = 0;
+    for (;;) {
+        uint32_t dim = dwvw_event_dim(events);
+        if (events > 0) direction = dwvw_classical_direction(direction, g, dwvk_rng_uniform_pair_f(key, dim + DWVW_DIM_DIRECTION));
+        double t = dwvw_flight(sigma, dwvk_rng_uniform_f(key, dim + DWVW_DIM_DISTANCE));
+        double hit = dwvw_shape_exit_inline(&setup->shape, kind, position, direction, &normal);
+        if (hit <= t) {
+            end->status = DWVW_EXITED;
+            break;
+        }
+        add_flight(&position, direction, t);
+        ++events;
+        weight *= albedo;
+        if (!(weight > 0.0)) {
+            end->status = DWVW_ABSORBED;
+            break;
+        }
+        if (weight < DWVW_ROULETTE_THRESHOLD) {
+            double survive = weight / DWVW_ROULETTE_THRESHOLD;
+            if (dwvk_rng_uniform_d(key, dwvw_event_dim(events - 1u) + DWVW_DIM_ROULETTE) >= survive) {
+                end->status = DWVW_ABSORBED;
+                break;
+            }
+            weight /= survive;
+        }
+        if (events >= setup->max_events) {
+            end->status = DWVW_TRUNCATED;
+            break;
+        }
+    }
+    end->events = events;
+    end->weight[0] = end->status == DWVW_ABSORBED ? 0.0 : weight;
+    end->weight[1] = end->weight[2] = 0.0;
+    end->exit_normal = normal;
+}
+
+static void classical_walk(const dwvw_estimate_setup *setup, uint64_t key, dwvw_walk_end *end)
+{
+    switch (setup->shape.kind) {
+    case DWVW_HALFSPACE: classical_walk_in(setup, DWVW_HALFSPACE, key, end); return;
+    case DWVW_SLAB: classical_walk_in(setup, DWVW_SLAB, key, end); return;
+    case DWVW_SPHERE: classical_walk_in(setup, DWVW_SPHERE, key, end); return;
+    }
+}
+
+/* The axis of a single guided component fixed for the whole walk, if the setup has one. */
+static int fixed_guide_axis(const dwvw_estimate_setup *setup, dwvw_vec3 *axis)
+{
+    const dwvw_guide *guide = &setup->guide;
+    int halfspace = setup->shape.kind == DWVW_HALFSPACE;
+    if (guide->q_classical != 0.0) return 0;
+    if (guide->q_poe == 1.0 && guide->q_closest == 0.0 && guide->q_incident == 0.0 && guide->q_backward == 0.0) {
+        *axis = ENTRY_NORMAL;
+        return 1;
+    }
+    /* The half-space's closest point is always on its one plane, and the first step's probe into it
+     * finds no opposite interface, so closest and backward guide about the entry normal. */
+    if (halfspace && guide->q_closest == 1.0 && guide->q_poe == 0.0 && guide->q_incident == 0.0 &&
+        guide->q_backward == 0.0) {
+        *axis = ENTRY_NORMAL;
+        return 1;
+    }
+    if (halfspace && guide->q_backward == 1.0 && guide->q_poe == 0.0 && guide->q_closest == 0.0 &&
+        guide->q_incident == 0.0) {
+        *axis = ENTRY_NORMAL;
+        return 1;
+    }
+    if (guide->q_incident == 1.0 && guide->patch_count == 1 && guide->q_poe == 0.0 && guide->q_closest == 0.0 &&
+        guide->q_backward == 0.0) {
+        *axis = guide->patches[0].normal;
+        return 1;
+    }
+    return 0;
+}
+
+/* Inline with a constant `kind`: each shape gets its own loop with its exit test inlined. */
+static inline void guided_walk_in(const dwvw_estimate_setup *setup, dwvw_shape_kind kind, uint64_t key,
+                                  dwvw_walk_end *end)
+{
+    const dwvw_medium *m = &setup->medium;
+    dwvw_vec3 axis = ENTRY_NORMAL;
+    fixed_guide_axis(setup, &axis);
+    const dwvw_frame frame = dwvw_frame_about(axis);
+    const double sigma = m->sigma_t[0];
+    const double log_per_event = log(m->albedo[0] / m->dwivedi.albedo_eff);
+    dwvw_vec3 position = ENTRY_POINT, direction = entry_direction(setup, key), normal;
+    uint32_t events = 0;
+    /* log weight = log_constants - sigma x exponent, exponent = sum over steps of (1 - s) t. */
+    double log_constants = 0.0, exponent = 0.0, log_weight = 0.0;
+    for (;;) {
+        uint32_t dim = dwvw_event_dim(events);
+        if (events > 0)
+            direction = dwvw_guided_direction(&frame, &m->dwivedi_event,
+                                              dwvk_rng_uniform_pair_f(key, dim + DWVW_DIM_DIRECTION));
+        double stretch = dwvk_dwivedi_stretch_d(&m->dwivedi, dwvw_cosine(direction, axis));
+        double t = dwvw_flight(sigma * stretch, dwvk_rng_uniform_f(key, dim + DWVW_DIM_DISTANCE));
+        double hit = dwvw_shape_exit_inline(&setup->shape, kind, position, direction, &normal);
+        if (hit <= t) {
+            add_flight(&position, direction, hit);
+            exponent += (1.0 - stretch) * hit;
+            if (events > 0) log_constants += log(stretch / m->dwivedi.albedo_eff);
+            log_weight = log_constants - sigma * exponent;
+            end->status = DWVW_EXITED;
+            break;
+        }
+        add_flight(&position, direction, t);
+        exponent += (1.0 - stretch) * t;
+        log_constants += events > 0 ? log_per_event : log(m->albedo[0] / stretch);
+        ++events;
+        log_weight = log_constants - sigma * exponent;
+        int fate = roulette(key, events, &log_weight);
+        if (fate == 0) {
+            end->status = DWVW_ABSORBED;
+            break;
+        }
+        if (fate == 2) log_constants = log_weight + sigma * exponent;
+        if (events >= setup->max_events) {
+            end->status = DWVW_TRUNCATED;
+            break;
+        }
+    }
+    double weight = end->status == DWVW_ABSORBED ? 0.0 : exp(log_weight);
+    end->events = events;
+    end->weight[0] = isfinite(weight) ? weight : 0.0;
+    end->weight[1] = end->weight[2] = 0.0;
+    end->exit_normal = normal;
+}
+
+static void guided_walk(const dwvw_estimate_setup *setup, uint64_t key, dwvw_walk_end *end)
+{
+    switch (setup->shape.kind) {
+    case DWVW_HALFSPACE: guided_walk_in(setup, DWVW_HALFSPACE, key, end); return;
+    case DWVW_SLAB: guided_walk_in(setup, DWVW_SLAB, key, end); return;
+    case DWVW_SPHERE: guided_walk_in(setup, DWVW_SPHERE, key, end); return;
+    }
+}
+
+dwvw_walker dwvw_estimate_walker(const dwvw_estimate_setup *setup)
+{
+    dwvw_vec3 axis;
+    if (setup->general_path || setup->medium.channels != 1) return DWVW_WALKER_GENERAL;
+    const dwvw_guide *g = &setup->guide;
+    if (g->q_classical == 1.0 && g->q_poe == 0.0 && g->q_closest == 0.0 && g->q_incident == 0.0 && g->q_backward == 0.0)
+        return DWVW_WALKER_CLASSICAL;
+    if (setup->medium.g == 0.0 && fixed_guide_axis(setup, &axis)) return DWVW_WALKER_GUIDED;
+    return DWVW_WALKER_GENERAL;
+}
+
+void dwvw_estimate_walk(const dwvw_estimate_setup *setup, dwvw_walker walker, uint64_t index, dwvw_walk_end *end)
+{
+    uint64_t key = dwvk_rng_key(setup->seed, index, 0);
+    switch (walker) {
+    case DWVW_WALKER_CLASSICAL: classical_walk(setup, key, end); return;
+    case DWVW_WALKER_GUIDED: guided_walk(setup, key, end); return;
+    case DWVW_WALKER_GENERAL: break;
+    }
+    general_walk(setup, key, end);
+}
+
+static void add_walk(const dwvw_estimate_setup *setup, const dwvw_walk_end *end, block_totals *out)
+{
+    out->events += end->events;
+    double score = end->status == DWVW_EXITED ? exit_score(setup, end->exit_normal) : 0.0;
     for (int c = 0; c < setup->medium.channels; ++c) {
-        if (walk.status == DWVW_TRUNCATED) out->truncated_weight[c] += walk.weight[c];
-        double x = walk.weight[c] * score;
+        if (end->status == DWVW_TRUNCATED) out->truncated_weight[c] += end->weight[c];
+        double x = end->weight[c] * score;
         out->sum[c] += x;
         out->sum_squares[c] += x * x;
     }
-    if (walk.status == DWVW_TRUNCATED) ++out->truncated_walks;
+    if (end->status == DWVW_TRUNCATED) ++out->truncated_walks;
 }
 
 static void *worker(void *arg)
@@ -111,7 +333,11 @@ static void *worker(void *arg)
         uint64_t end = first + state->block_size;
         if (end > state->setup->walks) end = state->setup->walks;
         block_totals *out = &state->blocks[block];
-        for (uint64_t i = first; i < end; ++i) run_walk(state->setup, i, out);
+        for (uint64_t i = first; i < end; ++i) {
+            dwvw_walk_end walk;
+            dwvw_estimate_walk(state->setup, state->walker, i, &walk);
+            add_walk(state->setup, &walk, out);
+        }
     }
     return NULL;
 }
@@ -122,6 +348,7 @@ int dwvw_estimate_run(const dwvw_estimate_setup *setup, dwvw_estimate_totals *to
     clock_gettime(CLOCK_MONOTONIC, &start);
     run_state state;
     state.setup = setup;
+    state.walker = dwvw_estimate_walker(setup);
     /* Blocks depend on the walk count only, never on the threads: fixed summation order. */
     state.block_size = (setup->walks + MAX_BLOCKS - 1) / MAX_BLOCKS;
     if (state.block_size < 256) state.block_size = 256;
