@@ -48,7 +48,9 @@ typedef struct dwvk_uniform_pair_f { float a, b; } dwvk_uniform_pair_f;
 static inline dwvk_uniform_pair_f dwvk_rng_uniform_pair_f(uint64_t key, uint32_t dimension)
 {
     uint64_t bits = dwvk_rng_u64(key, dimension);
-    dwvk_uniform_pair_f pair = {(float)(bits >> 40) * 0x1.0p-24f, (float)((bits >> 16) & 0xffffffu) * 0x1.0p-24f};
+    /* Through int32_t: one signed conversion instruction, exact below 2^24. */
+    dwvk_uniform_pair_f pair = {(float)(int32_t)(bits >> 40) * 0x1.0p-24f,
+                                (float)(int32_t)((bits >> 16) & 0xffffffu) * 0x1.0p-24f};
     return pair;
 }
 

@@ -55,15 +55,6 @@ typedef struct block_totals {
     uint64_t events, truncated_walks;
 } block_totals;
 
-typedef struct run_state {
-    const dwvw_estimate_setup *setup;
-    uint64_t block_size;
-    uint32_t block_count;
-    dwvw_walker walker;
-    atomic_uint next_block;
-    block_totals *blocks;
-} run_state;
-
 static const dwvw_vec3 ENTRY_POINT = {0.0, 0.0, 0.0}, ENTRY_NORMAL = {0.0, 0.0, -1.0}; /* outward */
 
 /* The entry direction of a walk: dimensions 0 and 1 of its key. */
@@ -123,6 +114,17 @@ static void general_walk(const dwvw_estimate_setup *setup, uint64_t key, dwvw_wa
  * one multiply-add per event for the Russian roulette test (weight < threshold, in logs), and one
  * exponential per walk (or per roulette below the threshold). */
 
+/* What a run's fast path needs, worked out once per run. */
+typedef struct fast_plan {
+    dwvw_walker walker;
+    dwvw_vec3 axis;          /* guided: the fixed axis */
+    dwvw_frame turned[4];    /* its frame and the frame's quarter turns */
+    double log_per_event;    /* log(alpha / a) */
+    double inv_albedo_eff;   /* 1 / a */
+    int first_known;         /* the entry direction is the same for every walk: */
+    double log_first;        /*   log(alpha / s0), s0 its stretch */
+} fast_plan;
+
 static void add_flight(dwvw_vec3 *position, dwvw_vec3 direction, double t)
 {
     *position = dwvw_madd(*position, direction, t);
@@ -131,9 +133,10 @@ static void add_flight(dwvw_vec3 *position, dwvw_vec3 direction, double t)
 /* The Russian roulette of dwvw_walk_complete on a weight exp(log_weight) after `events` events:
  * 0 if the walk ends (absorbed), 1 if it goes on unchanged, 2 if it goes on with its weight raised
  * to the threshold (*log_weight = its log). */
+#define DWVW_LOG_ROULETTE_THRESHOLD -2.9957322735539909 /* log(DWVW_ROULETTE_THRESHOLD) */
 static int roulette(uint64_t key, uint32_t events, double *log_weight)
 {
-    static const double log_threshold = -2.9957322735539909; /* log(DWVW_ROULETTE_THRESHOLD) */
+    const double log_threshold = DWVW_LOG_ROULETTE_THRESHOLD;
     if (!(*log_weight < log_threshold)) return 1;
     double weight = exp(*log_weight);
     if (!(weight > 0.0)) return 0;
@@ -143,6 +146,7 @@ static int roulette(uint64_t key, uint32_t events, double *log_weight)
     return 2;
 }
 
+/* Inline with a constant `kind`: each shape gets its own loop with its exit test inlined. */
 static inline void classical_walk_in(const dwvw_estimate_setup *setup, dwvw_shape_kind kind, uint64_t key,
                                      dwvw_walk_end *end)
 {
@@ -154,7 +158,8 @@ static inline void classical_walk_in(const dwvw_estimate_setup *setup, dwvw_shap
     uint32_t events = 0;
     for (;;) {
         uint32_t dim = dwvw_event_dim(events);
-        if (events > 0) direction = dwvw_classical_direction(direction, g, dwvk_rng_uniform_pair_f(key, dim + DWVW_DIM_DIRECTION));
+        if (events > 0)
+            direction = dwvw_classical_direction(direction, g, dwvk_rng_uniform_pair_f(key, dim + DWVW_DIM_DIRECTION));
         double t = dwvw_flight(sigma, dwvk_rng_uniform_f(key, dim + DWVW_DIM_DISTANCE));
         double hit = dwvw_shape_exit_inline(&setup->shape, kind, position, direction, &normal);
         if (hit <= t) {
@@ -226,65 +231,65 @@ static int fixed_guide_axis(const dwvw_estimate_setup *setup, dwvw_vec3 *axis)
     return 0;
 }
 
-/* Inline with a constant `kind`: each shape gets its own loop with its exit test inlined. */
-static inline void guided_walk_in(const dwvw_estimate_setup *setup, dwvw_shape_kind kind, uint64_t key,
-                                  dwvw_walk_end *end)
+static inline void guided_walk_in(const dwvw_estimate_setup *setup, const fast_plan *plan, dwvw_shape_kind kind,
+                                  uint64_t key, dwvw_walk_end *end)
 {
     const dwvw_medium *m = &setup->medium;
-    dwvw_vec3 axis = ENTRY_NORMAL;
-    fixed_guide_axis(setup, &axis);
-    const dwvw_frame frame = dwvw_frame_about(axis);
-    const double sigma = m->sigma_t[0];
-    const double log_per_event = log(m->albedo[0] / m->dwivedi.albedo_eff);
+    const double sigma = m->sigma_t[0], log_per_event = plan->log_per_event;
+    const uint32_t max_events = setup->max_events;
     dwvw_vec3 position = ENTRY_POINT, direction = entry_direction(setup, key), normal;
     uint32_t events = 0;
     /* log weight = log_constants - sigma x exponent, exponent = sum over steps of (1 - s) t. */
-    double log_constants = 0.0, exponent = 0.0, log_weight = 0.0;
+    double log_constants = 0.0, exponent = 0.0, log_weight = 0.0, last_factor = 1.0;
     for (;;) {
+        /* The first step (events = 0) keeps the entry direction: its constant is log(alpha / s0). */
         uint32_t dim = dwvw_event_dim(events);
         if (events > 0)
-            direction = dwvw_guided_direction(&frame, &m->dwivedi_event,
-                                              dwvk_rng_uniform_pair_f(key, dim + DWVW_DIM_DIRECTION));
-        double stretch = dwvk_dwivedi_stretch_d(&m->dwivedi, dwvw_cosine(direction, axis));
+            direction = dwvw_guided_direction_turned(plan->turned, &m->dwivedi_event,
+                                                     dwvk_rng_uniform_pair_f(key, dim + DWVW_DIM_DIRECTION));
+        double stretch = dwvk_dwivedi_stretch_d(&m->dwivedi, dwvw_cosine(direction, plan->axis));
         double t = dwvw_flight(sigma * stretch, dwvk_rng_uniform_f(key, dim + DWVW_DIM_DISTANCE));
         double hit = dwvw_shape_exit_inline(&setup->shape, kind, position, direction, &normal);
         if (hit <= t) {
             add_flight(&position, direction, hit);
             exponent += (1.0 - stretch) * hit;
-            if (events > 0) log_constants += log(stretch / m->dwivedi.albedo_eff);
             log_weight = log_constants - sigma * exponent;
+            if (events > 0) last_factor = stretch * plan->inv_albedo_eff; /* s / a */
             end->status = DWVW_EXITED;
             break;
         }
         add_flight(&position, direction, t);
         exponent += (1.0 - stretch) * t;
-        log_constants += events > 0 ? log_per_event : log(m->albedo[0] / stretch);
+        if (events > 0) log_constants += log_per_event;
+        else log_constants = plan->first_known ? plan->log_first : log(m->albedo[0] / stretch);
         ++events;
         log_weight = log_constants - sigma * exponent;
-        int fate = roulette(key, events, &log_weight);
-        if (fate == 0) {
-            end->status = DWVW_ABSORBED;
-            break;
+        if (log_weight < DWVW_LOG_ROULETTE_THRESHOLD) {
+            int fate = roulette(key, events, &log_weight);
+            if (fate == 0) {
+                end->status = DWVW_ABSORBED;
+                break;
+            }
+            if (fate == 2) log_constants = log_weight + sigma * exponent;
         }
-        if (fate == 2) log_constants = log_weight + sigma * exponent;
-        if (events >= setup->max_events) {
+        if (events >= max_events) {
             end->status = DWVW_TRUNCATED;
             break;
         }
     }
-    double weight = end->status == DWVW_ABSORBED ? 0.0 : exp(log_weight);
+    double weight = end->status == DWVW_ABSORBED ? 0.0 : exp(log_weight) * last_factor;
     end->events = events;
     end->weight[0] = isfinite(weight) ? weight : 0.0;
     end->weight[1] = end->weight[2] = 0.0;
     end->exit_normal = normal;
 }
 
-static void guided_walk(const dwvw_estimate_setup *setup, uint64_t key, dwvw_walk_end *end)
+static void guided_walk(const dwvw_estimate_setup *setup, const fast_plan *plan, uint64_t key, dwvw_walk_end *end)
 {
     switch (setup->shape.kind) {
-    case DWVW_HALFSPACE: guided_walk_in(setup, DWVW_HALFSPACE, key, end); return;
-    case DWVW_SLAB: guided_walk_in(setup, DWVW_SLAB, key, end); return;
-    case DWVW_SPHERE: guided_walk_in(setup, DWVW_SPHERE, key, end); return;
+    case DWVW_HALFSPACE: guided_walk_in(setup, plan, DWVW_HALFSPACE, key, end); return;
+    case DWVW_SLAB: guided_walk_in(setup, plan, DWVW_SLAB, key, end); return;
+    case DWVW_SPHERE: guided_walk_in(setup, plan, DWVW_SPHERE, key, end); return;
     }
 }
 
@@ -299,15 +304,42 @@ dwvw_walker dwvw_estimate_walker(const dwvw_estimate_setup *setup)
     return DWVW_WALKER_GENERAL;
 }
 
-void dwvw_estimate_walk(const dwvw_estimate_setup *setup, dwvw_walker walker, uint64_t index, dwvw_walk_end *end)
+static void make_plan(const dwvw_estimate_setup *setup, dwvw_walker walker, fast_plan *plan)
+{
+    const dwvw_medium *m = &setup->medium;
+    memset(plan, 0, sizeof *plan);
+    plan->walker = walker;
+    if (walker != DWVW_WALKER_GUIDED) return;
+    plan->axis = ENTRY_NORMAL;
+    fixed_guide_axis(setup, &plan->axis);
+    dwvw_frame frame = dwvw_frame_about(plan->axis);
+    for (int q = 0; q < 4; ++q) plan->turned[q] = dwvw_frame_turned(&frame, q);
+    plan->log_per_event = log(m->albedo[0] / m->dwivedi.albedo_eff);
+    plan->inv_albedo_eff = 1.0 / m->dwivedi.albedo_eff;
+    plan->first_known = !setup->incidence_diffuse;
+    if (plan->first_known) {
+        double s0 = dwvk_dwivedi_stretch_d(&m->dwivedi, dwvw_cosine(entry_direction(setup, 0u), plan->axis));
+        plan->log_first = log(m->albedo[0] / s0);
+    }
+}
+
+static void walk_with_plan(const dwvw_estimate_setup *setup, const fast_plan *plan, uint64_t index,
+                           dwvw_walk_end *end)
 {
     uint64_t key = dwvk_rng_key(setup->seed, index, 0);
-    switch (walker) {
+    switch (plan->walker) {
     case DWVW_WALKER_CLASSICAL: classical_walk(setup, key, end); return;
-    case DWVW_WALKER_GUIDED: guided_walk(setup, key, end); return;
+    case DWVW_WALKER_GUIDED: guided_walk(setup, plan, key, end); return;
     case DWVW_WALKER_GENERAL: break;
     }
     general_walk(setup, key, end);
+}
+
+void dwvw_estimate_walk(const dwvw_estimate_setup *setup, dwvw_walker walker, uint64_t index, dwvw_walk_end *end)
+{
+    fast_plan plan;
+    make_plan(setup, walker, &plan);
+    walk_with_plan(setup, &plan, index, end);
 }
 
 static void add_walk(const dwvw_estimate_setup *setup, const dwvw_walk_end *end, block_totals *out)
@@ -323,6 +355,15 @@ static void add_walk(const dwvw_estimate_setup *setup, const dwvw_walk_end *end,
     if (end->status == DWVW_TRUNCATED) ++out->truncated_walks;
 }
 
+typedef struct run_state {
+    const dwvw_estimate_setup *setup;
+    uint64_t block_size;
+    uint32_t block_count;
+    fast_plan plan;
+    atomic_uint next_block;
+    block_totals *blocks;
+} run_state;
+
 static void *worker(void *arg)
 {
     run_state *state = arg;
@@ -335,7 +376,7 @@ static void *worker(void *arg)
         block_totals *out = &state->blocks[block];
         for (uint64_t i = first; i < end; ++i) {
             dwvw_walk_end walk;
-            dwvw_estimate_walk(state->setup, state->walker, i, &walk);
+            walk_with_plan(state->setup, &state->plan, i, &walk);
             add_walk(state->setup, &walk, out);
         }
     }
@@ -348,7 +389,7 @@ int dwvw_estimate_run(const dwvw_estimate_setup *setup, dwvw_estimate_totals *to
     clock_gettime(CLOCK_MONOTONIC, &start);
     run_state state;
     state.setup = setup;
-    state.walker = dwvw_estimate_walker(setup);
+    make_plan(setup, dwvw_estimate_walker(setup), &state.plan);
     /* Blocks depend on the walk count only, never on the threads: fixed summation order. */
     state.block_size = (setup->walks + MAX_BLOCKS - 1) / MAX_BLOCKS;
     if (state.block_size < 256) state.block_size = 256;

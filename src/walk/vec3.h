@@ -32,6 +32,21 @@ static inline dwvw_frame dwvw_frame_about(dwvw_vec3 n)
     return f;
 }
 
+/* The frame turned by q quarter turns about its axis: (t, s) -> (s, -t) per turn. With a frame turned
+ * by q, dwvw_frame_direction of azimuth (c, s) is bit for bit that of the original frame with
+ * (c, s) turned by q (dwvk_quarter_turns_f): the same products, negated or added in the other
+ * order, both exact. */
+static inline dwvw_frame dwvw_frame_turned(const dwvw_frame *f, int q)
+{
+    dwvw_frame r = *f;
+    for (int i = 0; i < (q & 3); ++i) {
+        dwvw_vec3 t = r.t;
+        r.t = r.s;
+        r.s = dwvw_scale(t, -1.0);
+    }
+    return r;
+}
+
 /* The direction with cosine mu to the frame's axis, sine sin_theta (from 1 -+ mu without
  * cancellation) and azimuth `azimuth` (a point of the unit circle, dwvk_azimuth_f). Renormalised in
  * double: the single-precision inputs leave it unit only to ~3e-7, and hosts and the analytic

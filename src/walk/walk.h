@@ -163,6 +163,18 @@ static inline dwvw_vec3 dwvw_guided_direction(const dwvw_frame *frame, const dwv
     return dwvw_frame_direction(frame, s.cos_theta, s.sin_theta, dwvk_azimuth_f(u.b));
 }
 
+/* The same about a fixed axis, with its frame's four quarter turns made in advance
+ * (turned[q] = dwvw_frame_turned(frame, q)): bit for bit dwvw_guided_direction, without turning
+ * the azimuth per event. */
+static inline dwvw_vec3 dwvw_guided_direction_turned(const dwvw_frame turned[4], const dwvk_dwivedi_event_f *d,
+                                                     dwvk_uniform_pair_f u)
+{
+    dwvk_dwivedi_event_cosine_f s = dwvk_dwivedi_event_sample_f(d, u.a);
+    int32_t q;
+    dwvk_unit2_f azimuth = dwvk_azimuth_quadrant_f(u.b, &q);
+    return dwvw_frame_direction(&turned[q], s.cos_theta, s.sin_theta, azimuth);
+}
+
 /* The cosine of unit `direction` to unit `axis`, held in [-1, 1]. */
 static inline double dwvw_cosine(dwvw_vec3 direction, dwvw_vec3 axis)
 {
