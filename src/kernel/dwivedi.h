@@ -67,8 +67,13 @@ static inline dwvk_dwivedi_f dwvk_dwivedi_to_float(dwvk_dwivedi_d d)
 typedef struct dwvk_dwivedi_event_f {
     float log_ratio;                     /* L; 2^-100 for kappa = 0 (see below) */
     float u_split;                       /* the u at which mu = 0: log1p(kappa) / L */
-    float v_plus_one, v_minus_one;       /* (1 + kappa) / kappa, (1 - kappa) / kappa */
-    float one_plus_kappa, one_minus_kappa;
+    /* Per branch, [0] for u > u_split (mu > 0), [1] for u <= u_split (mu <= 0), indexed rather
+     * than chosen by a branch: u decides it at random, so a branch would be mispredicted half the
+     * time. */
+    float offset[2];                     /* 1, 0: x = (offset - u) L */
+    float v_pm_one[2];                   /* v - 1, v + 1 = (1 -+ kappa) / kappa */
+    float one_mp_kappa[2];               /* 1 - kappa, 1 + kappa */
+    float sign[2];                       /* -1, 1: mu = sign (small - 1) */
 } dwvk_dwivedi_event_f;
 
 /* cos_theta is exact only to float's absolute rounding near +-1; `nearer` = 1 - |mu| (the smaller
@@ -84,15 +89,19 @@ static inline dwvk_dwivedi_event_f dwvk_dwivedi_event_from(dwvk_dwivedi_d d)
     if (d.kappa > 0.0) {
         e.log_ratio = (float)d.log_ratio;
         e.u_split = (float)(log1p(d.kappa) / d.log_ratio);
-        e.v_plus_one = (float)((1.0 + d.kappa) / d.kappa);
-        e.v_minus_one = (float)(d.one_minus_kappa / d.kappa);
+        e.v_pm_one[1] = (float)((1.0 + d.kappa) / d.kappa);
+        e.v_pm_one[0] = (float)(d.one_minus_kappa / d.kappa);
     } else {
         e.log_ratio = 0x1p-100f;
         e.u_split = 0.5f;
-        e.v_plus_one = e.v_minus_one = 0x1p101f;
+        e.v_pm_one[0] = e.v_pm_one[1] = 0x1p101f;
     }
-    e.one_plus_kappa = (float)(1.0 + d.kappa);
-    e.one_minus_kappa = (float)d.one_minus_kappa;
+    e.offset[0] = 1.0f;
+    e.offset[1] = 0.0f;
+    e.one_mp_kappa[0] = (float)d.one_minus_kappa;
+    e.one_mp_kappa[1] = (float)(1.0 + d.kappa);
+    e.sign[0] = -1.0f;
+    e.sign[1] = 1.0f;
     return e;
 }
 
@@ -104,21 +113,21 @@ static inline dwvk_dwivedi_event_f dwvk_dwivedi_event_from(dwvk_dwivedi_d d)
  * where stretch = 1 - mu/v = (1 + kappa) exp(-uL). Each form is a product of non-negative terms
  * (1 + expm1 >= 1/2 on the first branch, >= 1 on the second): no cancellation anywhere, for any
  * albedo, and the stretch keeps its relative accuracy down to its floor 1 - kappa (2^-20 at the
- * clamp). Branch-free: the branch only picks constants and the argument. u in [0, 1]; for the
+ * clamp). Branch-free: the branch only indexes constants. u in [0, 1]; for the
  * walk's 24-bit uniforms 1 - u is exact. Measured against dwvk_dwivedi_sample_pdf_d in
  * tests/internal/test_fastmath.c. */
 static inline dwvk_dwivedi_event_cosine_f dwvk_dwivedi_event_sample_f(const dwvk_dwivedi_event_f *d, float u)
 {
     int low = u <= d->u_split;
-    float x = low ? -u * d->log_ratio : (1.0f - u) * d->log_ratio;
+    float x = (d->offset[low] - u) * d->log_ratio; /* -uL or (1 - u)L, both exact forms of u */
     float e = dwvk_expm1_fast_f(x);
     /* 1 + mu (low) or 1 - mu: at most 1 (at u_split), past it only by rounding, so 2 - small >= 1. */
-    float small = (low ? d->v_plus_one : d->v_minus_one) * fabsf(e);
+    float small = d->v_pm_one[low] * fabsf(e);
     dwvk_dwivedi_event_cosine_f s;
-    s.cos_theta = low ? small - 1.0f : 1.0f - small;
+    s.cos_theta = d->sign[low] * (small - 1.0f); /* small - 1 or 1 - small, exactly */
     s.sin_theta = sqrtf(small * (2.0f - small));
     s.nearer = small;
-    s.stretch = (low ? d->one_plus_kappa : d->one_minus_kappa) * (1.0f + e);
+    s.stretch = d->one_mp_kappa[low] * (1.0f + e);
     return s;
 }
 

@@ -241,14 +241,17 @@ static inline void guided_walk_in(const dwvw_estimate_setup *setup, const fast_p
     uint32_t events = 0;
     /* log weight = log_constants - sigma x exponent, exponent = sum over steps of (1 - s) t. */
     double log_constants = 0.0, exponent = 0.0, log_weight = 0.0, last_factor = 1.0;
-    for (;;) {
+    /* The RNG counter of this event's direction dimension, stepped by additions (dwvk_rng_counter). */
+    const uint64_t event_step = (uint64_t)DWVW_DIMS_PER_EVENT * DWVK_GOLDEN_GAMMA;
+    const uint64_t to_distance = (uint64_t)(DWVW_DIM_DISTANCE - DWVW_DIM_DIRECTION) * DWVK_GOLDEN_GAMMA;
+    uint64_t counter = dwvk_rng_counter(key, dwvw_event_dim(0) + DWVW_DIM_DIRECTION);
+    for (;; counter += event_step) {
         /* The first step (events = 0) keeps the entry direction: its constant is log(alpha / s0). */
-        uint32_t dim = dwvw_event_dim(events);
         if (events > 0)
             direction = dwvw_guided_direction_turned(plan->turned, &m->dwivedi_event,
-                                                     dwvk_rng_uniform_pair_f(key, dim + DWVW_DIM_DIRECTION));
+                                                     dwvk_uniform_pair_f_from_bits(dwvk_mix64(counter)));
         double stretch = dwvk_dwivedi_stretch_d(&m->dwivedi, dwvw_cosine(direction, plan->axis));
-        double t = dwvw_flight(sigma * stretch, dwvk_rng_uniform_f(key, dim + DWVW_DIM_DISTANCE));
+        double t = dwvw_flight(sigma * stretch, dwvk_uniform_f_from_bits(dwvk_mix64(counter + to_distance)));
         double hit = dwvw_shape_exit_inline(&setup->shape, kind, position, direction, &normal);
         if (hit <= t) {
             add_flight(&position, direction, hit);

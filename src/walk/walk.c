@@ -279,7 +279,9 @@ dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 h
         for (int k = 0; k < components; ++k) {
             if (!(qp[k] > 0.0)) continue;
             double stretch = walk->component_stretch[k];
-            denominator += qp[k] * (exited ? 1.0 : stretch) * exp(sigma_t * (1.0 - stretch) * t);
+            /* The classical component (stretch 1) has exp(0) = 1: skip the call. */
+            double decay = stretch == 1.0 ? 1.0 : exp(sigma_t * (1.0 - stretch) * t);
+            denominator += qp[k] * (exited ? 1.0 : stretch) * decay;
         }
         double ratio = walk->phase * (exited ? 1.0 : m->albedo[0]) / denominator;
         walk->weight[0] *= isfinite(ratio) ? ratio : 0.0;
