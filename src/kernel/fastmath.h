@@ -2,8 +2,9 @@
  * that a scattering event calls no libm function. Each states its domain and its error bound; the
  * bounds are measured against double-precision libm in tests/internal/test_fastmath.c.
  *
- * The polynomials are Cephes' single-precision ones (S. L. Moshier, Cephes Math Library 2.2,
- * expf.c / logf.c / sinf.c / cosf.c), with the range reductions written here. Plain C: no
+ * The polynomials of expm1 and the azimuth are Cephes' single-precision ones (S. L. Moshier,
+ * Cephes Math Library 2.2, expf.c / sinf.c), with the range reductions written here; log is
+ * table-driven, with a table from tools/gen_log_table.py. Plain C: no
  * compiler extension, no reliance on -ffast-math (the reductions depend on IEEE rounding). */
 #ifndef DWV_KERNEL_FASTMATH_H
 #define DWV_KERNEL_FASTMATH_H
@@ -11,6 +12,8 @@
 #include <math.h>
 #include <stdint.h>
 #include <string.h>
+
+#include "log_table.h"
 
 static inline uint32_t dwvk_float_bits(float x)
 {
@@ -45,33 +48,35 @@ static inline float dwvk_expm1_fast_f(float x)
     return scale * p + (scale - 1.0f);
 }
 
-/* log(x) for positive normal x, absolute error below 1.5e-7 for x in [1/2, 2] and relative error
- * below 1.5e-7 elsewhere (measured 9e-8 and 7e-8). x = 2^e m with m in [sqrt(1/2), sqrt(2)), read
- * from the bits; f = m - 1 is exact (Sterbenz), so log(1 - u) keeps full relative accuracy for
- * small u where 1 - u is exact; log(m) = f - f^2/2 + f^3 P(f) with Cephes' degree-8 P, and
- * e ln2 added in two parts. */
-static inline float dwvk_log_fast_f(float x)
+/* log(x) for positive normal float x, in double: absolute error below 1e-9 for x in [1/2, 2],
+ * relative error below 1e-9 elsewhere, and for x in [0.984375, 1) (log(1 - u), u small) relative
+ * error below 2e-8 (measured 1.9e-10, 2.7e-10 and 1.2e-8: tests/internal/test_fastmath.c). Table-driven (as
+ * in ARM's optimized-routines logf, with a table of our own, tools/gen_log_table.py):
+ * x = 2^k z, z in [0.703125, 1.40625) read from the bits, then log x = k ln2 + log c + log1p(r)
+ * with r = z / c - 1 = z invc - 1 exact in double (invc has 21 significant bits) and |r| < 1/64,
+ * so log1p(r) = r - r^2/2 + r^3/3 - r^4/4 to 1.2e-8 relative (r^4 / 5). The interval just below
+ * 1 has invc = 1 (log c = 0), so log(1 - u) = log1p(-u) there keeps its relative accuracy. */
+static inline double dwvk_log_fast(float x)
 {
     uint32_t bits = dwvk_float_bits(x);
-    /* The exponent field of x / sqrt(1/2), biased by 128 so that the shift is of an unsigned
-     * value (x positive normal: no wrap-around). */
-    int32_t e = (int32_t)((bits - 0x3f3504f3u + 0x40000000u) >> 23) - 128;
-    float m = dwvk_bits_float(bits - ((uint32_t)e << 23));
-    float f = m - 1.0f, z = f * f, fe = (float)e;
-    float y = (((((((( 7.0376836292e-2f * f - 1.1514610310e-1f) * f + 1.1676998740e-1f) * f - 1.2420140846e-1f) * f +
-                   1.4249322787e-1f) * f - 1.6668057665e-1f) * f + 2.0000714765e-1f) * f - 2.4999993993e-1f) * f +
-               3.3333331174e-1f) * f * z;
-    y += -2.12194440e-4f * fe;
-    y += -0.5f * z;
-    return (f + y) + 0.693359375f * fe;
+    uint32_t offset = bits - DWVK_LOG_TABLE_OFF;
+    uint32_t i = (offset >> DWVK_LOG_TABLE_SHIFT) % DWVK_LOG_TABLE_SIZE;
+    /* k = floor(offset / 2^23) as a signed number, biased by 128 so that the shift is unsigned
+     * (x positive normal: no wrap-around). */
+    int32_t k = (int32_t)((offset + 0x40000000u) >> 23) - 128;
+    double z = (double)dwvk_bits_float(bits - ((uint32_t)k << 23));
+    double r = z * DWVK_LOG_TABLE[i][0] - 1.0;
+    double r2 = r * r;
+    double log1p_r = r + r2 * (-0.5 + r * (0.33333333333333333 - 0.25 * r));
+    return (double)k * 0.69314718055994531 + DWVK_LOG_TABLE[i][1] + log1p_r;
 }
 
 /* An exponential free flight in units of 1/sigma: -log(1 - u) for u = i 2^-24, i in [0, 2^24)
  * (the walk's 24-bit uniforms), where 1 - u is exact and at least 2^-24, so the result is finite,
- * at most 24 ln 2 = 16.6, with the relative error of dwvk_log_fast_f. */
-static inline float dwvk_free_flight_f(float u)
+ * at most 24 ln 2 = 16.6, with the relative error of dwvk_log_fast. */
+static inline double dwvk_free_flight(float u)
 {
-    return -dwvk_log_fast_f(1.0f - u);
+    return -dwvk_log_fast(1.0f - u);
 }
 
 typedef struct dwvk_unit2_f { float c, s; } dwvk_unit2_f;

@@ -185,7 +185,7 @@ static inline double dwvw_cosine(dwvw_vec3 direction, dwvw_vec3 axis)
 /* A free flight of extinction sigma (> 0) from a 24-bit uniform. */
 static inline double dwvw_flight(double sigma, float u)
 {
-    return (double)dwvk_free_flight_f(u) / sigma;
+    return dwvk_free_flight(u) / sigma;
 }
 
 /* The mixture weights `auto` uses for a medium: see the definition for the heuristic. */
