@@ -123,6 +123,7 @@ typedef struct fast_plan {
     double inv_albedo_eff;   /* 1 / a */
     int first_known;         /* the entry direction is the same for every walk: */
     double log_first;        /*   log(alpha / s0), s0 its stretch */
+    double q_guided;         /* mixture: the guided component's weight (the rest is classical) */
 } fast_plan;
 
 static void add_flight(dwvw_vec3 *position, dwvw_vec3 direction, double t)
@@ -201,34 +202,33 @@ static void classical_walk(const dwvw_estimate_setup *setup, uint64_t key, dwvw_
     }
 }
 
-/* The axis of a single guided component fixed for the whole walk, if the setup has one. */
-static int fixed_guide_axis(const dwvw_estimate_setup *setup, dwvw_vec3 *axis)
+/* The guided part of a setup when it is one component about an axis fixed for the whole walk:
+ * its weight q (the rest is classical) and axis; 0 if the guided part is anything else. */
+static double fixed_guide(const dwvw_estimate_setup *setup, dwvw_vec3 *axis)
 {
     const dwvw_guide *guide = &setup->guide;
     int halfspace = setup->shape.kind == DWVW_HALFSPACE;
-    if (guide->q_classical != 0.0) return 0;
-    if (guide->q_poe == 1.0 && guide->q_closest == 0.0 && guide->q_incident == 0.0 && guide->q_backward == 0.0) {
+    int parts = (guide->q_poe > 0.0) + (guide->q_closest > 0.0) + (guide->q_incident > 0.0) + (guide->q_backward > 0.0);
+    if (parts != 1) return 0.0;
+    if (guide->q_poe > 0.0) {
         *axis = ENTRY_NORMAL;
-        return 1;
+        return guide->q_poe;
     }
     /* The half-space's closest point is always on its one plane, and the first step's probe into it
-     * finds no opposite interface, so closest and backward guide about the entry normal. */
-    if (halfspace && guide->q_closest == 1.0 && guide->q_poe == 0.0 && guide->q_incident == 0.0 &&
-        guide->q_backward == 0.0) {
+     * finds no opposite interface, so there closest and backward guide about the entry normal. */
+    if (halfspace && guide->q_closest > 0.0) {
         *axis = ENTRY_NORMAL;
-        return 1;
+        return guide->q_closest;
     }
-    if (halfspace && guide->q_backward == 1.0 && guide->q_poe == 0.0 && guide->q_closest == 0.0 &&
-        guide->q_incident == 0.0) {
+    if (halfspace && guide->q_backward > 0.0) {
         *axis = ENTRY_NORMAL;
-        return 1;
+        return guide->q_backward;
     }
-    if (guide->q_incident == 1.0 && guide->patch_count == 1 && guide->q_poe == 0.0 && guide->q_closest == 0.0 &&
-        guide->q_backward == 0.0) {
+    if (guide->q_incident > 0.0 && guide->patch_count == 1) {
         *axis = guide->patches[0].normal;
-        return 1;
+        return guide->q_incident;
     }
-    return 0;
+    return 0.0;
 }
 
 static inline void guided_walk_in(const dwvw_estimate_setup *setup, const fast_plan *plan, dwvw_shape_kind kind,
@@ -296,6 +296,89 @@ static void guided_walk(const dwvw_estimate_setup *setup, const fast_plan *plan,
     }
 }
 
+/* Classical (weight q0) and one guided component about a fixed axis (weight q1): `auto` wherever
+ * it has one lit patch (or none, on the half-space), `cycles` on the half-space. Each step's
+ * weight is the general path's f / (q0 p_classical + q1 p_guided), formed with the same
+ * arithmetic as dwvw_walk_complete (one exponential per step), for any anisotropy; what the fast
+ * path saves is the per-event mixture bookkeeping. */
+static inline void mixture_walk_in(const dwvw_estimate_setup *setup, const fast_plan *plan, dwvw_shape_kind kind,
+                                   uint64_t key, dwvw_walk_end *end)
+{
+    const dwvw_medium *m = &setup->medium;
+    const double sigma = m->sigma_t[0], albedo = m->albedo[0];
+    const double q0 = setup->guide.q_classical, q1 = plan->q_guided, total = q0 + q1;
+    const float g = (float)m->g;
+    dwvw_vec3 position = ENTRY_POINT, direction = entry_direction(setup, key), normal;
+    double weight = 1.0;
+    uint32_t events = 0;
+    for (;;) {
+        uint32_t dim = dwvw_event_dim(events);
+        /* pick() of walk.c over {q0, q1}. */
+        int guided = !(dwvk_rng_uniform_d(key, dim + DWVW_DIM_COMPONENT) * total < q0);
+        double phase = 1.0, pdf_guided = 1.0;
+        double stretch;
+        if (events > 0) {
+            dwvk_uniform_pair_f u = dwvk_rng_uniform_pair_f(key, dim + DWVW_DIM_DIRECTION);
+            dwvw_vec3 previous = direction;
+            direction = guided ? dwvw_guided_direction_turned(plan->turned, &m->dwivedi_event, u)
+                               : dwvw_classical_direction(previous, g, u);
+            phase = g == 0.0f ? DWVK_INV_FOUR_PI : dwvk_hg_pdf_f(g, (float)dwvw_cosine(previous, direction));
+            stretch = dwvk_dwivedi_stretch_d(&m->dwivedi, dwvw_cosine(direction, plan->axis));
+            pdf_guided = m->guided_pdf_scale / stretch;
+        } else {
+            stretch = dwvk_dwivedi_stretch_d(&m->dwivedi, dwvw_cosine(direction, plan->axis));
+        }
+        double t = dwvw_flight(sigma * (guided ? stretch : 1.0), dwvk_rng_uniform_f(key, dim + DWVW_DIM_DISTANCE));
+        double hit = dwvw_shape_exit_inline(&setup->shape, kind, position, direction, &normal);
+        int exited = hit <= t;
+        if (exited) t = hit;
+        /* dwvw_walk_complete's grey branch, term by term. */
+        double qp0 = q0 * phase, qp1 = q1 * pdf_guided, denominator = 0.0;
+        if (qp0 > 0.0) denominator += qp0 * 1.0 * 1.0;
+        if (qp1 > 0.0) {
+            double decay = stretch == 1.0 ? 1.0 : dwvk_exp_fast(sigma * (1.0 - stretch) * t);
+            denominator += qp1 * (exited ? 1.0 : stretch) * decay;
+        }
+        double ratio = phase * (exited ? 1.0 : albedo) / denominator;
+        weight *= isfinite(ratio) ? ratio : 0.0;
+        add_flight(&position, direction, t);
+        if (exited) {
+            end->status = DWVW_EXITED;
+            break;
+        }
+        ++events;
+        if (!(weight > 0.0)) {
+            end->status = DWVW_ABSORBED;
+            break;
+        }
+        if (weight < DWVW_ROULETTE_THRESHOLD) {
+            double survive = weight / DWVW_ROULETTE_THRESHOLD;
+            if (dwvk_rng_uniform_d(key, dwvw_event_dim(events - 1u) + DWVW_DIM_ROULETTE) >= survive) {
+                end->status = DWVW_ABSORBED;
+                break;
+            }
+            weight /= survive;
+        }
+        if (events >= setup->max_events) {
+            end->status = DWVW_TRUNCATED;
+            break;
+        }
+    }
+    end->events = events;
+    end->weight[0] = end->status == DWVW_ABSORBED ? 0.0 : weight;
+    end->weight[1] = end->weight[2] = 0.0;
+    end->exit_normal = normal;
+}
+
+static void mixture_walk(const dwvw_estimate_setup *setup, const fast_plan *plan, uint64_t key, dwvw_walk_end *end)
+{
+    switch (setup->shape.kind) {
+    case DWVW_HALFSPACE: mixture_walk_in(setup, plan, DWVW_HALFSPACE, key, end); return;
+    case DWVW_SLAB: mixture_walk_in(setup, plan, DWVW_SLAB, key, end); return;
+    case DWVW_SPHERE: mixture_walk_in(setup, plan, DWVW_SPHERE, key, end); return;
+    }
+}
+
 dwvw_walker dwvw_estimate_walker(const dwvw_estimate_setup *setup)
 {
     dwvw_vec3 axis;
@@ -303,8 +386,10 @@ dwvw_walker dwvw_estimate_walker(const dwvw_estimate_setup *setup)
     const dwvw_guide *g = &setup->guide;
     if (g->q_classical == 1.0 && g->q_poe == 0.0 && g->q_closest == 0.0 && g->q_incident == 0.0 && g->q_backward == 0.0)
         return DWVW_WALKER_CLASSICAL;
-    if (setup->medium.g == 0.0 && fixed_guide_axis(setup, &axis)) return DWVW_WALKER_GUIDED;
-    return DWVW_WALKER_GENERAL;
+    double q_guided = fixed_guide(setup, &axis);
+    if (!(q_guided > 0.0)) return DWVW_WALKER_GENERAL;
+    if (g->q_classical == 0.0 && q_guided == 1.0 && setup->medium.g == 0.0) return DWVW_WALKER_GUIDED;
+    return DWVW_WALKER_MIXTURE; /* a classical share, or anisotropic scattering */
 }
 
 static void make_plan(const dwvw_estimate_setup *setup, dwvw_walker walker, fast_plan *plan)
@@ -312,9 +397,9 @@ static void make_plan(const dwvw_estimate_setup *setup, dwvw_walker walker, fast
     const dwvw_medium *m = &setup->medium;
     memset(plan, 0, sizeof *plan);
     plan->walker = walker;
-    if (walker != DWVW_WALKER_GUIDED) return;
+    if (walker != DWVW_WALKER_GUIDED && walker != DWVW_WALKER_MIXTURE) return;
     plan->axis = ENTRY_NORMAL;
-    fixed_guide_axis(setup, &plan->axis);
+    plan->q_guided = fixed_guide(setup, &plan->axis);
     dwvw_frame frame = dwvw_frame_about(plan->axis);
     for (int q = 0; q < 4; ++q) plan->turned[q] = dwvw_frame_turned(&frame, q);
     plan->log_per_event = log(m->albedo[0] / m->dwivedi.albedo_eff);
@@ -333,6 +418,7 @@ static void walk_with_plan(const dwvw_estimate_setup *setup, const fast_plan *pl
     switch (plan->walker) {
     case DWVW_WALKER_CLASSICAL: classical_walk(setup, key, end); return;
     case DWVW_WALKER_GUIDED: guided_walk(setup, plan, key, end); return;
+    case DWVW_WALKER_MIXTURE: mixture_walk(setup, plan, key, end); return;
     case DWVW_WALKER_GENERAL: break;
     }
     general_walk(setup, key, end);

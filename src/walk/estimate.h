@@ -39,13 +39,19 @@ typedef struct dwvw_walk_end {
     dwvw_vec3 exit_normal;
 } dwvw_walk_end;
 
-/* Which walker dwvw_estimate_run uses for a setup. The fast paths are for walks of one component
- * (grey media only): classical alone, or one guided component whose axis is fixed for the whole
- * walk in an isotropic medium (poe; incident with one patch; closest and backward on the
- * half-space, where the closest normal is the entry normal and no opposite interface exists).
- * They make the same walks as the general path from the same random numbers, with the weight's
- * terms cancelled: see estimate.c. */
-typedef enum dwvw_walker { DWVW_WALKER_GENERAL = 0, DWVW_WALKER_CLASSICAL = 1, DWVW_WALKER_GUIDED = 2 } dwvw_walker;
+/* Which walker dwvw_estimate_run uses for a setup. The fast paths are for grey media whose guided
+ * part is one component about an axis fixed for the whole walk (poe; incident with one patch;
+ * closest and backward on the half-space, where the closest normal is the entry normal and no
+ * opposite interface exists): GUIDED for that component alone in an isotropic medium, MIXTURE for
+ * it with a classical share (auto, cycles), CLASSICAL for classical alone. They make the same walks
+ * as the general path from the same random numbers; GUIDED and CLASSICAL cancel the weight's
+ * terms (see estimate.c), MIXTURE forms it as the general path does. */
+typedef enum dwvw_walker {
+    DWVW_WALKER_GENERAL = 0,
+    DWVW_WALKER_CLASSICAL = 1,
+    DWVW_WALKER_GUIDED = 2,
+    DWVW_WALKER_MIXTURE = 3
+} dwvw_walker;
 dwvw_walker dwvw_estimate_walker(const dwvw_estimate_setup *setup);
 /* Walk number `index` of a setup, by the given walker (one that dwvw_estimate_walker allows, or
  * the general one). */

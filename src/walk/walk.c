@@ -280,7 +280,7 @@ dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 h
             if (!(qp[k] > 0.0)) continue;
             double stretch = walk->component_stretch[k];
             /* The classical component (stretch 1) has exp(0) = 1: skip the call. */
-            double decay = stretch == 1.0 ? 1.0 : exp(sigma_t * (1.0 - stretch) * t);
+            double decay = stretch == 1.0 ? 1.0 : dwvk_exp_fast(sigma_t * (1.0 - stretch) * t);
             denominator += qp[k] * (exited ? 1.0 : stretch) * decay;
         }
         double ratio = walk->phase * (exited ? 1.0 : m->albedo[0]) / denominator;
@@ -295,7 +295,7 @@ dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 h
                     if (!(walk->channel_p[c] > 0.0)) continue;
                     double sigma = m->sigma_t[c] * walk->component_stretch[k];
                     double density = exited ? 1.0 : sigma;
-                    denominator += qp[k] * walk->channel_p[c] * density * exp((m->sigma_t[cw] - sigma) * t);
+                    denominator += qp[k] * walk->channel_p[c] * density * dwvk_exp_fast((m->sigma_t[cw] - sigma) * t);
                 }
             }
             double f = walk->phase * (exited ? 1.0 : m->sigma_t[cw] * m->albedo[cw]);

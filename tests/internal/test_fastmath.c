@@ -2,6 +2,7 @@
  * domains where that is feasible (every 24-bit uniform the walk can draw), and the error bounds
  * their comments state (src/kernel/fastmath.h, src/kernel/dwivedi.h):
  *   dwvk_expm1_fast_f       relative error < 2.4e-7 on [-80, 80]
+ *   dwvk_exp_fast (double)  relative error < 6e-16 on [-708, 709.78]; overflow, underflow, NaN
  *   dwvk_log_fast           absolute < 1e-9 on [1/2, 2], relative < 1e-9 elsewhere and < 2e-8
  *                           on [0.984375, 1)
  *   dwvk_free_flight        relative < 2e-8 at every 24-bit u
@@ -80,6 +81,39 @@ static void test_expm1(void)
     double planted = expm1_worst(expm1_planted, -20.0f, 20.0f, 200000, &at);
     printf("  planted (r^2 coefficient 0.505): %.3g, rejected\n", planted);
     CHECK(planted >= EXPM1_TOLERANCE, "the planted expm1 passes: %.3g", planted);
+}
+
+/* ---- exp (double) ------------------------------------------------------------------------- */
+
+#define EXP_TOLERANCE 6e-16
+
+static void test_exp(void)
+{
+    /* libm's exp is correctly rounded to within 1 ulp on glibc; the bound allows for that. */
+    double worst = 0.0, at = 0.0;
+    for (long i = -2000000; i <= 2000000; ++i) {
+        double x = 709.78 * (double)i / 2000000.0;
+        if (x < -708.0) continue;
+        double exact = exp(x), got = dwvk_exp_fast(x);
+        double e = fabs(got - exact) / exact;
+        if (e > worst) worst = e, at = x;
+    }
+    for (long i = -1000000; i <= 1000000; ++i) { /* dense where the walk's exponents live */
+        double x = 40.0 * (double)i / 1000000.0;
+        double exact = exp(x), e = fabs(dwvk_exp_fast(x) - exact) / exact;
+        if (e > worst) worst = e, at = x;
+    }
+    printf("exp_fast: worst relative error %.3g at x = %.17g (bound %.3g)\n", worst, at, EXP_TOLERANCE);
+    CHECK(worst < EXP_TOLERANCE, "exp_fast: relative error %.3g at %.17g", worst, at);
+    CHECK(dwvk_exp_fast(0.0) == 1.0, "exp(0) = %a", dwvk_exp_fast(0.0));
+    CHECK(dwvk_exp_fast(710.0) == INFINITY && dwvk_exp_fast(INFINITY) == INFINITY, "exp overflow");
+    CHECK(dwvk_exp_fast(-746.0) == 0.0 && dwvk_exp_fast(-INFINITY) == 0.0, "exp underflow");
+    CHECK(isnan(dwvk_exp_fast(NAN)), "exp(NaN) = %g", dwvk_exp_fast(NAN));
+    /* Subnormal results: within an absolute 2^-1074 x a few of libm's. */
+    const double tiny[] = {-710.0, -730.5, -744.0};
+    for (size_t i = 0; i < sizeof tiny / sizeof tiny[0]; ++i)
+        CHECK(fabs(dwvk_exp_fast(tiny[i]) - exp(tiny[i])) <= 4.0 * 0x1p-1074 + 4e-16 * exp(tiny[i]),
+              "exp(%g) = %a, libm %a", tiny[i], dwvk_exp_fast(tiny[i]), exp(tiny[i]));
 }
 
 /* ---- log and the free flight --------------------------------------------------------------- */
@@ -227,6 +261,7 @@ static void test_dwivedi(void)
 int main(void)
 {
     test_expm1();
+    test_exp();
     test_log();
     test_azimuth();
     test_dwivedi();

@@ -1,14 +1,16 @@
 /* The estimator's fast paths (src/walk/estimate.c: classical alone, one guided component about a
- * fixed axis) against the general walk (dwvw_walk_sample / dwvw_walk_complete) from the same random
+ * fixed axis, and that component mixed with classical) against the general walk (dwvw_walk_sample / dwvw_walk_complete) from the same random
  * numbers:
  *   - dwvw_estimate_walker picks the fast path exactly where it applies (grey medium; classical
- *     alone; or one guided component with a fixed axis in an isotropic medium) and the general one
- *     elsewhere (colour, anisotropic guided, mixtures, closest and backward off the half-space);
+ *     alone; one guided component with a fixed axis, alone in an isotropic medium, else mixed with
+ *     classical) and the general one elsewhere (colour, two lit patches, closest and backward off
+ *     the half-space);
  *   - walk by walk, the fast path ends the same way (status, events, exit normal) with the same
- *     weight up to rounding: WEIGHT_TOLERANCE relative. The weight is formed differently (the fast
- *     path cancels the stretch and sums the exponents in logs; the general path multiplies ratios
- *     of double pdfs), so equality to the last bit is not expected; a weight off by one step's
- *     factor is off by far more than this;
+ *     weight up to rounding: WEIGHT_TOLERANCE relative. The guided and classical paths form the
+ *     weight differently (they cancel the stretch and sum the exponents in logs; the general path
+ *     multiplies ratios of double pdfs), so equality to the last bit is not expected there (the
+ *     mixture path repeats the general arithmetic and is bit-identical); a weight off by one
+ *     step's factor is off by far more than this;
  *   - dwvw_estimate_run gives the same mean (to WEIGHT_TOLERANCE) and the same event and truncation
  *     counts either way, and the fast path is bit-identical for 1, 2 and 3 threads;
  *   - planted: a fast-path weight without the first step's 1/s0 (a plausible slip when cancelling
@@ -66,10 +68,22 @@ static const fast_case CASES[] = {
      DWVW_WALKER_CLASSICAL, 0},
     {"halfspace classical 1, cap 50", DWVW_HALFSPACE, 0.0, DWVW_CLASSICAL, 1.0, 0.0, DWVW_LIGHT_FRONT, 0,
      DWVW_WALKER_CLASSICAL, 50},
+    {"halfspace poe 0.9 g 0.3", DWVW_HALFSPACE, 0.0, DWVW_POE, 0.9, 0.3, DWVW_LIGHT_FRONT, 0, DWVW_WALKER_MIXTURE, 0},
+    {"halfspace auto 0.99", DWVW_HALFSPACE, 0.0, DWVW_AUTO, 0.99, 0.0, DWVW_LIGHT_FRONT, 0, DWVW_WALKER_MIXTURE, 0},
+    {"halfspace auto 0.999 diffuse", DWVW_HALFSPACE, 0.0, DWVW_AUTO, 0.999, 0.0, DWVW_LIGHT_FRONT, 1,
+     DWVW_WALKER_MIXTURE, 0},
+    {"halfspace auto 0.1 (classical)", DWVW_HALFSPACE, 0.0, DWVW_AUTO, 0.1, 0.0, DWVW_LIGHT_FRONT, 0,
+     DWVW_WALKER_CLASSICAL, 0},
+    {"halfspace cycles 0.9", DWVW_HALFSPACE, 0.0, DWVW_CYCLES, 0.9, 0.0, DWVW_LIGHT_FRONT, 0, DWVW_WALKER_MIXTURE, 0},
+    {"slab 16 auto 0.99 back-lit", DWVW_SLAB, 16.0, DWVW_AUTO, 0.99, 0.0, DWVW_LIGHT_BACK, 0, DWVW_WALKER_MIXTURE, 0},
+    {"slab 1 auto 0.9 g 0.5 back-lit", DWVW_SLAB, 1.0, DWVW_AUTO, 0.9, 0.5, DWVW_LIGHT_BACK, 1, DWVW_WALKER_MIXTURE,
+     0},
+    {"sphere 4 auto 0.99 back-lit", DWVW_SPHERE, 4.0, DWVW_AUTO, 0.99, 0.0, DWVW_LIGHT_BACK, 0, DWVW_WALKER_MIXTURE,
+     0},
+    {"sphere 2 auto 1 g -0.3, cap 300", DWVW_SPHERE, 2.0, DWVW_AUTO, 1.0, -0.3, DWVW_LIGHT_BACK, 0,
+     DWVW_WALKER_MIXTURE, 300},
     /* The general path only. */
-    {"halfspace poe 0.9 g 0.3", DWVW_HALFSPACE, 0.0, DWVW_POE, 0.9, 0.3, DWVW_LIGHT_FRONT, 0, DWVW_WALKER_GENERAL, 0},
-    {"halfspace auto 0.99", DWVW_HALFSPACE, 0.0, DWVW_AUTO, 0.99, 0.0, DWVW_LIGHT_FRONT, 0, DWVW_WALKER_GENERAL, 0},
-    {"halfspace cycles 0.9", DWVW_HALFSPACE, 0.0, DWVW_CYCLES, 0.9, 0.0, DWVW_LIGHT_FRONT, 0, DWVW_WALKER_GENERAL, 0},
+    {"slab 4 cycles 0.9", DWVW_SLAB, 4.0, DWVW_CYCLES, 0.9, 0.0, DWVW_LIGHT_BACK, 0, DWVW_WALKER_GENERAL, 0},
     {"slab 4 closest 0.9", DWVW_SLAB, 4.0, DWVW_CLOSEST, 0.9, 0.0, DWVW_LIGHT_BACK, 0, DWVW_WALKER_GENERAL, 0},
     {"slab 4 backward 0.9", DWVW_SLAB, 4.0, DWVW_BACKWARD, 0.9, 0.0, DWVW_LIGHT_BACK, 0, DWVW_WALKER_GENERAL, 0},
     {"slab 4 incident 0.9 both lit", DWVW_SLAB, 4.0, DWVW_INCIDENT, 0.9, 0.0, DWVW_LIGHT_FRONT | DWVW_LIGHT_BACK, 0, DWVW_WALKER_GENERAL,
@@ -156,7 +170,7 @@ static void test_case(const fast_case *c)
     comparison r = compare_walks(&setup, walker, 0);
     printf("  %-34s %s: %llu walks, %llu events, %llu exited, %llu truncated; ends differ %llu, worst weight gap "
            "%.2e\n",
-           c->label, walker == DWVW_WALKER_GUIDED ? "guided" : "classical", (unsigned long long)setup.walks,
+           c->label, walker == DWVW_WALKER_GUIDED ? "guided" : walker == DWVW_WALKER_MIXTURE ? "mixture" : "classical", (unsigned long long)setup.walks,
            (unsigned long long)r.events, (unsigned long long)r.exited, (unsigned long long)r.truncated,
            (unsigned long long)r.differing_ends, r.worst_weight_gap);
     CHECK(r.differing_ends == 0, "%s: %llu walks end differently on the fast path", c->label,
