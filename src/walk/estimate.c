@@ -119,6 +119,15 @@ typedef struct fast_plan {
     dwvw_walker walker;
     dwvw_vec3 axis;          /* guided: the fixed axis */
     dwvw_frame turned[4];    /* its frame and the frame's quarter turns */
+    /* Where the turned frames are signed permutations (an axis along x, y or z: every axis of the
+     * analytic shapes), component i of a direction is sign[q][i] x (c, d, mu)[index[q][i]], and
+     * the cosine to the axis is axis_sign x direction[axis_index]: the same values as the full
+     * products, whose other terms are exact zeros. */
+    int aligned;
+    int index[4][3];
+    double sign[4][3];
+    int axis_index;
+    double axis_sign;
     double log_per_event;    /* log(alpha / a) */
     double inv_albedo_eff;   /* 1 / a */
     int first_known;         /* the entry direction is the same for every walk: */
@@ -129,6 +138,64 @@ typedef struct fast_plan {
 static void add_flight(dwvw_vec3 *position, dwvw_vec3 direction, double t)
 {
     *position = dwvw_madd(*position, direction, t);
+}
+
+static double component(dwvw_vec3 v, int i)
+{
+    return i == 0 ? v.x : i == 1 ? v.y : v.z;
+}
+
+/* Fills plan->aligned and its tables if the turned frames are signed permutations. */
+static void plan_alignment(fast_plan *plan)
+{
+    plan->aligned = 0;
+    for (int q = 0; q < 4; ++q) {
+        const dwvw_frame *f = &plan->turned[q];
+        for (int i = 0; i < 3; ++i) {
+            double parts[3] = {component(f->t, i), component(f->s, i), component(f->n, i)};
+            int nonzero = 0;
+            for (int j = 0; j < 3; ++j) {
+                if (parts[j] == 0.0) continue;
+                if (parts[j] != 1.0 && parts[j] != -1.0) return;
+                ++nonzero;
+                plan->index[q][i] = j;
+                plan->sign[q][i] = parts[j];
+            }
+            if (nonzero != 1) return;
+        }
+    }
+    int nonzero = 0;
+    for (int i = 0; i < 3; ++i) {
+        double a = component(plan->axis, i);
+        if (a == 0.0) continue;
+        if (a != 1.0 && a != -1.0) return;
+        ++nonzero;
+        plan->axis_index = i;
+        plan->axis_sign = a;
+    }
+    plan->aligned = nonzero == 1;
+}
+
+/* dwvw_guided_direction_turned for an aligned plan: the same values (dwvw_frame_direction's
+ * products with the frame's zeros and ones left out). */
+static inline dwvw_vec3 aligned_guided_direction(const fast_plan *plan, const dwvk_dwivedi_event_f *d,
+                                                 dwvk_uniform_pair_f u)
+{
+    dwvk_dwivedi_event_cosine_f s = dwvk_dwivedi_event_sample_f(d, u.a);
+    int32_t q;
+    dwvk_unit2_f azimuth = dwvk_azimuth_quadrant_f(u.b, &q);
+    double sin_theta = s.sin_theta;
+    double values[3] = {(double)azimuth.c * sin_theta, (double)azimuth.s * sin_theta, (double)s.cos_theta};
+    dwvw_vec3 w = dwvw_v(plan->sign[q][0] * values[plan->index[q][0]], plan->sign[q][1] * values[plan->index[q][1]],
+                         plan->sign[q][2] * values[plan->index[q][2]]);
+    return dwvw_scale(w, 1.5 - 0.5 * dwvw_dot(w, w));
+}
+
+/* dwvw_cosine(direction, plan->axis) for an aligned plan. */
+static inline double aligned_cosine(const fast_plan *plan, dwvw_vec3 direction)
+{
+    double mu = plan->axis_sign * component(direction, plan->axis_index);
+    return mu < -1.0 ? -1.0 : mu > 1.0 ? 1.0 : mu;
 }
 
 /* The Russian roulette of dwvw_walk_complete on a weight exp(log_weight) after `events` events:
@@ -247,10 +314,13 @@ static inline void guided_walk_in(const dwvw_estimate_setup *setup, const fast_p
     uint64_t counter = dwvk_rng_counter(key, dwvw_event_dim(0) + DWVW_DIM_DIRECTION);
     for (;; counter += event_step) {
         /* The first step (events = 0) keeps the entry direction: its constant is log(alpha / s0). */
-        if (events > 0)
-            direction = dwvw_guided_direction_turned(plan->turned, &m->dwivedi_event,
-                                                     dwvk_uniform_pair_f_from_bits(dwvk_mix64(counter)));
-        double stretch = dwvk_dwivedi_stretch_d(&m->dwivedi, dwvw_cosine(direction, plan->axis));
+        if (events > 0) {
+            dwvk_uniform_pair_f u = dwvk_uniform_pair_f_from_bits(dwvk_mix64(counter));
+            direction = plan->aligned ? aligned_guided_direction(plan, &m->dwivedi_event, u)
+                                      : dwvw_guided_direction_turned(plan->turned, &m->dwivedi_event, u);
+        }
+        double mu = plan->aligned ? aligned_cosine(plan, direction) : dwvw_cosine(direction, plan->axis);
+        double stretch = dwvk_dwivedi_stretch_d(&m->dwivedi, mu);
         double t = dwvw_flight(sigma * stretch, dwvk_uniform_f_from_bits(dwvk_mix64(counter + to_distance)));
         double hit = dwvw_shape_exit_inline(&setup->shape, kind, position, direction, &normal);
         if (hit <= t) {
@@ -316,18 +386,17 @@ static inline void mixture_walk_in(const dwvw_estimate_setup *setup, const fast_
         /* pick() of walk.c over {q0, q1}. */
         int guided = !(dwvk_rng_uniform_d(key, dim + DWVW_DIM_COMPONENT) * total < q0);
         double phase = 1.0, pdf_guided = 1.0;
-        double stretch;
         if (events > 0) {
             dwvk_uniform_pair_f u = dwvk_rng_uniform_pair_f(key, dim + DWVW_DIM_DIRECTION);
             dwvw_vec3 previous = direction;
-            direction = guided ? dwvw_guided_direction_turned(plan->turned, &m->dwivedi_event, u)
-                               : dwvw_classical_direction(previous, g, u);
+            direction = !guided       ? dwvw_classical_direction(previous, g, u)
+                        : plan->aligned ? aligned_guided_direction(plan, &m->dwivedi_event, u)
+                                        : dwvw_guided_direction_turned(plan->turned, &m->dwivedi_event, u);
             phase = g == 0.0f ? DWVK_INV_FOUR_PI : dwvk_hg_pdf_f(g, (float)dwvw_cosine(previous, direction));
-            stretch = dwvk_dwivedi_stretch_d(&m->dwivedi, dwvw_cosine(direction, plan->axis));
-            pdf_guided = m->guided_pdf_scale / stretch;
-        } else {
-            stretch = dwvk_dwivedi_stretch_d(&m->dwivedi, dwvw_cosine(direction, plan->axis));
         }
+        double stretch = dwvk_dwivedi_stretch_d(&m->dwivedi, plan->aligned ? aligned_cosine(plan, direction)
+                                                                           : dwvw_cosine(direction, plan->axis));
+        if (events > 0) pdf_guided = m->guided_pdf_scale / stretch;
         double t = dwvw_flight(sigma * (guided ? stretch : 1.0), dwvk_rng_uniform_f(key, dim + DWVW_DIM_DISTANCE));
         double hit = dwvw_shape_exit_inline(&setup->shape, kind, position, direction, &normal);
         int exited = hit <= t;
@@ -402,6 +471,7 @@ static void make_plan(const dwvw_estimate_setup *setup, dwvw_walker walker, fast
     plan->q_guided = fixed_guide(setup, &plan->axis);
     dwvw_frame frame = dwvw_frame_about(plan->axis);
     for (int q = 0; q < 4; ++q) plan->turned[q] = dwvw_frame_turned(&frame, q);
+    plan_alignment(plan);
     plan->log_per_event = log(m->albedo[0] / m->dwivedi.albedo_eff);
     plan->inv_albedo_eff = 1.0 / m->dwivedi.albedo_eff;
     plan->first_known = !setup->incidence_diffuse;

@@ -2,7 +2,6 @@
 
 #include <float.h>
 
-
 void dwvw_medium_init(dwvw_medium *medium, int channels, const double *sigma_t, const double *albedo, double g)
 {
     medium->channels = channels;
