@@ -7,6 +7,7 @@
 #include <tgmath.h>
 
 #include "diffusion_length.h"
+#include "fastmath.h"
 
 /* The sampling distribution's v is held at v >= 1 + 2^-20, i.e. 1 - kappa >= 2^-20 / (1 + 2^-20):
  * below that (alpha < ~0.137) the eigenfunction is a near-delta whose pdf would overflow. */
@@ -59,5 +60,75 @@ static inline dwvk_dwivedi_f dwvk_dwivedi_to_float(dwvk_dwivedi_d d)
 #include "dwivedi_real.h"
 #undef DWVK_REAL
 #undef DWVK_SUFFIX
+
+/* ---- the walk's per-event sampler ---------------------------------------------------------- */
+
+/* Per-medium constants of dwvk_dwivedi_event_sample_f, in single precision. */
+typedef struct dwvk_dwivedi_event_f {
+    float log_ratio;                     /* L; 2^-100 for kappa = 0 (see below) */
+    float u_split;                       /* the u at which mu = 0: log1p(kappa) / L */
+    /* Per branch, [0] for u > u_split (mu > 0), [1] for u <= u_split (mu <= 0), indexed rather
+     * than chosen by a branch: u decides it at random, so a branch would be mispredicted half the
+     * time. */
+    float offset[2];                     /* 1, 0: x = (offset - u) L */
+    float v_pm_one[2];                   /* v - 1, v + 1 = (1 -+ kappa) / kappa */
+    float one_mp_kappa[2];               /* 1 - kappa, 1 + kappa */
+    float sign[2];                       /* -1, 1: mu = sign (small - 1) */
+} dwvk_dwivedi_event_f;
+
+/* cos_theta is exact only to float's absolute rounding near +-1; `nearer` = 1 - |mu| (the smaller
+ * of 1 -+ mu) and sin_theta keep their relative accuracy there. */
+typedef struct dwvk_dwivedi_event_cosine_f { float cos_theta, sin_theta, stretch, nearer; } dwvk_dwivedi_event_cosine_f;
+
+/* From the double constants. kappa = 0 (albedo 1, v infinite) is the uniform distribution
+ * mu = 2u - 1; it is reached as the limit kappa -> 0 by taking L = 2^-100 and v +- 1 = 2 / L,
+ * which gives 1 + mu = 2u (1 + O(L)) and stretch 1 to single precision. */
+static inline dwvk_dwivedi_event_f dwvk_dwivedi_event_from(dwvk_dwivedi_d d)
+{
+    dwvk_dwivedi_event_f e;
+    if (d.kappa > 0.0) {
+        e.log_ratio = (float)d.log_ratio;
+        e.u_split = (float)(log1p(d.kappa) / d.log_ratio);
+        e.v_pm_one[1] = (float)((1.0 + d.kappa) / d.kappa);
+        e.v_pm_one[0] = (float)(d.one_minus_kappa / d.kappa);
+    } else {
+        e.log_ratio = 0x1p-100f;
+        e.u_split = 0.5f;
+        e.v_pm_one[0] = e.v_pm_one[1] = 0x1p101f;
+    }
+    e.offset[0] = 1.0f;
+    e.offset[1] = 0.0f;
+    e.one_mp_kappa[0] = (float)d.one_minus_kappa;
+    e.one_mp_kappa[1] = (float)(1.0 + d.kappa);
+    e.sign[0] = -1.0f;
+    e.sign[1] = 1.0f;
+    return e;
+}
+
+/* The inverse CDF of dwvk_dwivedi_sample_pdf with one exponential in place of two. Of 1 + mu and
+ * 1 - mu only the smaller needs its own form; the larger is 2 minus it, at least 1, exact to
+ * rounding. With x = uL and (v - 1) exp(L) = v + 1:
+ *   u <= u_split (mu <= 0):  1 + mu = (v + 1)(-expm1(-uL)),      stretch = (1 + kappa)(1 + expm1(-uL))
+ *   u >  u_split (mu > 0):   1 - mu = (v - 1) expm1((1 - u)L),   stretch = (1 - kappa)(1 + expm1((1 - u)L))
+ * where stretch = 1 - mu/v = (1 + kappa) exp(-uL). Each form is a product of non-negative terms
+ * (1 + expm1 >= 1/2 on the first branch, >= 1 on the second): no cancellation anywhere, for any
+ * albedo, and the stretch keeps its relative accuracy down to its floor 1 - kappa (2^-20 at the
+ * clamp). Branch-free: the branch only indexes constants. u in [0, 1]; for the
+ * walk's 24-bit uniforms 1 - u is exact. Measured against dwvk_dwivedi_sample_pdf_d in
+ * tests/internal/test_fastmath.c. */
+static inline dwvk_dwivedi_event_cosine_f dwvk_dwivedi_event_sample_f(const dwvk_dwivedi_event_f *d, float u)
+{
+    int low = u <= d->u_split;
+    float x = (d->offset[low] - u) * d->log_ratio; /* -uL or (1 - u)L, both exact forms of u */
+    float e = dwvk_expm1_fast_f(x);
+    /* 1 + mu (low) or 1 - mu: at most 1 (at u_split), past it only by rounding, so 2 - small >= 1. */
+    float small = d->v_pm_one[low] * fabsf(e);
+    dwvk_dwivedi_event_cosine_f s;
+    s.cos_theta = d->sign[low] * (small - 1.0f); /* small - 1 or 1 - small, exactly */
+    s.sin_theta = sqrtf(small * (2.0f - small));
+    s.nearer = small;
+    s.stretch = d->one_mp_kappa[low] * (1.0f + e);
+    return s;
+}
 
 #endif

@@ -25,9 +25,16 @@ static inline uint64_t dwvk_rng_key(uint64_t seed, uint64_t stream, uint64_t sam
     return dwvk_mix64(h + sample * DWVK_GOLDEN_GAMMA);
 }
 
+/* The counter that dimension `dimension` of `key` mixes; dimension d + j is this + j gamma, so a
+ * loop over dimensions can step it by additions. */
+static inline uint64_t dwvk_rng_counter(uint64_t key, uint32_t dimension)
+{
+    return key + (uint64_t)(dimension + 1u) * DWVK_GOLDEN_GAMMA;
+}
+
 static inline uint64_t dwvk_rng_u64(uint64_t key, uint32_t dimension)
 {
-    return dwvk_mix64(key + (uint64_t)(dimension + 1u) * DWVK_GOLDEN_GAMMA);
+    return dwvk_mix64(dwvk_rng_counter(key, dimension));
 }
 
 /* The top 53 (24) bits as a multiple of 2^-53 (2^-24): uniform on [0, 1), never 1. */
@@ -36,9 +43,30 @@ static inline double dwvk_rng_uniform_d(uint64_t key, uint32_t dimension)
     return (double)(dwvk_rng_u64(key, dimension) >> 11) * 0x1.0p-53;
 }
 
+/* The top 24 bits of a draw as a float uniform; through int32_t: one signed conversion, exact. */
+static inline float dwvk_uniform_f_from_bits(uint64_t bits)
+{
+    return (float)(int32_t)(bits >> 40) * 0x1.0p-24f;
+}
+
 static inline float dwvk_rng_uniform_f(uint64_t key, uint32_t dimension)
 {
-    return (float)(dwvk_rng_u64(key, dimension) >> 40) * 0x1.0p-24f;
+    return dwvk_uniform_f_from_bits(dwvk_rng_u64(key, dimension));
+}
+
+/* Two 24-bit uniforms from one 64-bit draw: bits 63..40 and 39..16 (each uniform on [0, 1) in
+ * steps of 2^-24, never 1, independent: SplitMix64's output bits are). One hash for two numbers. */
+typedef struct dwvk_uniform_pair_f { float a, b; } dwvk_uniform_pair_f;
+
+static inline dwvk_uniform_pair_f dwvk_uniform_pair_f_from_bits(uint64_t bits)
+{
+    dwvk_uniform_pair_f pair = {dwvk_uniform_f_from_bits(bits), (float)(int32_t)((bits >> 16) & 0xffffffu) * 0x1.0p-24f};
+    return pair;
+}
+
+static inline dwvk_uniform_pair_f dwvk_rng_uniform_pair_f(uint64_t key, uint32_t dimension)
+{
+    return dwvk_uniform_pair_f_from_bits(dwvk_rng_u64(key, dimension));
 }
 
 #endif

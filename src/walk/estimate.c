@@ -56,29 +56,25 @@ typedef struct block_totals {
     uint64_t events, truncated_walks, walks;
 } block_totals;
 
-typedef struct run_state {
-    const dwvw_estimate_setup *setup;
-    uint64_t block_size;
-    uint32_t block_count;
-    atomic_uint next_block;
-    block_totals *blocks;
-} run_state;
+static const dwvw_vec3 ENTRY_POINT = {0.0, 0.0, 0.0}, ENTRY_NORMAL = {0.0, 0.0, -1.0}; /* outward */
 
-static void run_walk(const dwvw_estimate_setup *setup, uint64_t index, block_totals *out)
+/* The entry direction of a walk: dimensions 0 and 1 of its key. */
+static dwvw_vec3 entry_direction(const dwvw_estimate_setup *setup, uint64_t key)
 {
-    const dwvw_vec3 origin = {0.0, 0.0, 0.0}, outward = {0.0, 0.0, -1.0};
-    uint64_t key = dwvk_rng_key(setup->seed, index, 0);
-    dwvw_vec3 direction;
     if (setup->incidence_diffuse) {
         /* Cosine-weighted: mu = sqrt(u). */
         double u = dwvk_rng_uniform_d(key, 0), mu = sqrt(u);
-        direction = dwvw_direction_about(dwvw_v(0.0, 0.0, 1.0), mu, 1.0 - mu, 1.0 + mu, dwvk_rng_uniform_d(key, 1));
-    } else {
-        double mu = setup->incidence_cosine;
-        direction = dwvw_v(sqrt((1.0 - mu) * (1.0 + mu)), 0.0, mu);
+        return dwvw_direction_about(dwvw_v(0.0, 0.0, 1.0), mu, 1.0 - mu, 1.0 + mu, dwvk_rng_uniform_d(key, 1));
     }
+    double mu = setup->incidence_cosine;
+    return dwvw_v(sqrt((1.0 - mu) * (1.0 + mu)), 0.0, mu);
+}
+
+static void general_walk(const dwvw_estimate_setup *setup, uint64_t key, dwvw_walk_end *end)
+{
     dwvw_walk walk;
-    dwvw_walk_begin(&walk, &setup->medium, &setup->guide, key, setup->max_events, origin, direction, outward);
+    dwvw_walk_begin(&walk, &setup->medium, &setup->guide, key, setup->max_events, ENTRY_POINT,
+                    entry_direction(setup, key), ENTRY_NORMAL);
     int needs_closest = dwvw_guide_needs_closest(&setup->guide);
     while (walk.status == DWVW_RUNNING) {
         if (needs_closest) {
@@ -91,11 +87,428 @@ static void run_walk(const dwvw_estimate_setup *setup, uint64_t index, block_tot
         double hit = dwvw_shape_exit(&setup->shape, walk.position, walk.direction, &hit_normal);
         dwvw_walk_complete(&walk, hit, hit_normal);
     }
-    out->events += walk.events;
-    double score = walk.status == DWVW_EXITED ? exit_score(setup, walk.exit_normal) : 0.0;
+    end->status = walk.status;
+    end->events = walk.events;
+    for (int c = 0; c < DWVW_MAX_CHANNELS; ++c) end->weight[c] = walk.weight[c];
+    end->exit_normal = walk.exit_normal;
+}
+
+/* ---- the fast paths -------------------------------------------------------------------------
+ * They draw the same random numbers as dwvw_walk_sample / dwvw_walk_complete (same dimensions,
+ * same kernels, same arithmetic for directions and distances), so they make the same walks; only
+ * the weight is formed differently. Grey medium, one component, weight 1 in its one channel.
+ *
+ * Classical alone: f / p = alpha sigma p_phase e^(-sigma t) / (p_phase sigma e^(-sigma t)) = alpha
+ * per scattering event and 1 for the exit, so the weight is alpha^events: no pdf, no exponential.
+ *
+ * One guided component about a fixed unit axis n, isotropic phase 1/(4 pi), at a scattering event
+ * after a sampled direction w (mu = w.n, stretch s = 1 - kappa mu, a = 2 kappa / L):
+ *   f = alpha (1/(4 pi)) sigma e^(-sigma t)
+ *   p = (a / (4 pi s)) sigma s e^(-sigma s t)               (direction pdf x stretched flight)
+ *   f / p = (alpha / a) e^(-sigma (1 - s) t) = (alpha / a) e^(-sigma kappa (t w).n):
+ * the stretch cancels, and t w is the event's displacement. The first step keeps the entry
+ * direction (pdf 1 for every technique, phase 1): f / p = (alpha / s0) e^(-sigma kappa (t w).n).
+ * The exit step has no albedo and no sigma: (s / a) e^(-sigma kappa (t w).n), or for an exit on
+ * the first step e^(-sigma kappa (t w).n). Summed over the steps, the displacements add up to the
+ * position less the entry point, so
+ *   log weight = sum of the log constants - sigma kappa (x - x_entry).n,
+ * one multiply-add per event for the Russian roulette test (weight < threshold, in logs), and one
+ * exponential per walk (or per roulette below the threshold). */
+
+/* What a run's fast path needs, worked out once per run. */
+typedef struct fast_plan {
+    dwvw_walker walker;
+    dwvw_vec3 axis;          /* guided: the fixed axis */
+    dwvw_frame turned[4];    /* its frame and the frame's quarter turns */
+    /* Where the turned frames are signed permutations (an axis along x, y or z: every axis of the
+     * analytic shapes), component i of a direction is sign[q][i] x (c, d, mu)[index[q][i]], and
+     * the cosine to the axis is axis_sign x direction[axis_index]: the same values as the full
+     * products, whose other terms are exact zeros. */
+    int aligned;
+    int index[4][3];
+    double sign[4][3];
+    int axis_index;
+    double axis_sign;
+    double log_per_event;    /* log(alpha / a) */
+    double inv_albedo_eff;   /* 1 / a */
+    int first_known;         /* the entry direction is the same for every walk: */
+    double log_first;        /*   log(alpha / s0), s0 its stretch */
+    double q_guided;         /* mixture: the guided component's weight (the rest is classical) */
+} fast_plan;
+
+static void add_flight(dwvw_vec3 *position, dwvw_vec3 direction, double t)
+{
+    *position = dwvw_madd(*position, direction, t);
+}
+
+static double component(dwvw_vec3 v, int i)
+{
+    return i == 0 ? v.x : i == 1 ? v.y : v.z;
+}
+
+/* Fills plan->aligned and its tables if the turned frames are signed permutations. */
+static void plan_alignment(fast_plan *plan)
+{
+    plan->aligned = 0;
+    for (int q = 0; q < 4; ++q) {
+        const dwvw_frame *f = &plan->turned[q];
+        for (int i = 0; i < 3; ++i) {
+            double parts[3] = {component(f->t, i), component(f->s, i), component(f->n, i)};
+            int nonzero = 0;
+            for (int j = 0; j < 3; ++j) {
+                if (parts[j] == 0.0) continue;
+                if (parts[j] != 1.0 && parts[j] != -1.0) return;
+                ++nonzero;
+                plan->index[q][i] = j;
+                plan->sign[q][i] = parts[j];
+            }
+            if (nonzero != 1) return;
+        }
+    }
+    int nonzero = 0;
+    for (int i = 0; i < 3; ++i) {
+        double a = component(plan->axis, i);
+        if (a == 0.0) continue;
+        if (a != 1.0 && a != -1.0) return;
+        ++nonzero;
+        plan->axis_index = i;
+        plan->axis_sign = a;
+    }
+    plan->aligned = nonzero == 1;
+}
+
+/* dwvw_guided_direction_turned for an aligned plan: the same values (dwvw_frame_direction's
+ * products with the frame's zeros and ones left out). */
+static inline dwvw_vec3 aligned_guided_direction(const fast_plan *plan, const dwvk_dwivedi_event_f *d,
+                                                 dwvk_uniform_pair_f u)
+{
+    dwvk_dwivedi_event_cosine_f s = dwvk_dwivedi_event_sample_f(d, u.a);
+    int32_t q;
+    dwvk_unit2_f azimuth = dwvk_azimuth_quadrant_f(u.b, &q);
+    double sin_theta = s.sin_theta;
+    double values[3] = {(double)azimuth.c * sin_theta, (double)azimuth.s * sin_theta, (double)s.cos_theta};
+    dwvw_vec3 w = dwvw_v(plan->sign[q][0] * values[plan->index[q][0]], plan->sign[q][1] * values[plan->index[q][1]],
+                         plan->sign[q][2] * values[plan->index[q][2]]);
+    return dwvw_scale(w, 1.5 - 0.5 * dwvw_dot(w, w));
+}
+
+/* dwvw_cosine(direction, plan->axis) for an aligned plan. */
+static inline double aligned_cosine(const fast_plan *plan, dwvw_vec3 direction)
+{
+    double mu = plan->axis_sign * component(direction, plan->axis_index);
+    return mu < -1.0 ? -1.0 : mu > 1.0 ? 1.0 : mu;
+}
+
+/* The Russian roulette of dwvw_walk_complete on a weight exp(log_weight) after `events` events:
+ * 0 if the walk ends (absorbed), 1 if it goes on unchanged, 2 if it goes on with its weight raised
+ * to the threshold (*log_weight = its log). */
+#define DWVW_LOG_ROULETTE_THRESHOLD -2.9957322735539909 /* log(DWVW_ROULETTE_THRESHOLD) */
+static int roulette(uint64_t key, uint32_t events, double *log_weight)
+{
+    const double log_threshold = DWVW_LOG_ROULETTE_THRESHOLD;
+    if (!(*log_weight < log_threshold)) return 1;
+    double weight = exp(*log_weight);
+    if (!(weight > 0.0)) return 0;
+    double survive = weight / DWVW_ROULETTE_THRESHOLD;
+    if (dwvk_rng_uniform_d(key, dwvw_event_dim(events - 1u) + DWVW_DIM_ROULETTE) >= survive) return 0;
+    *log_weight = log_threshold; /* weight / survive */
+    return 2;
+}
+
+/* Inline with a constant `kind`: each shape gets its own loop with its exit test inlined. */
+static inline void classical_walk_in(const dwvw_estimate_setup *setup, dwvw_shape_kind kind, uint64_t key,
+                                     dwvw_walk_end *end)
+{
+    const dwvw_medium *m = &setup->medium;
+    const double sigma = m->sigma_t[0], albedo = m->albedo[0];
+    const float g = (float)m->g;
+    dwvw_vec3 position = ENTRY_POINT, direction = entry_direction(setup, key), normal;
+    double weight = 1.0;
+    uint32_t events = 0;
+    for (;;) {
+        uint32_t dim = dwvw_event_dim(events);
+        if (events > 0)
+            direction = dwvw_classical_direction(direction, g, dwvk_rng_uniform_pair_f(key, dim + DWVW_DIM_DIRECTION));
+        double t = dwvw_flight(sigma, dwvk_rng_uniform_f(key, dim + DWVW_DIM_DISTANCE));
+        double hit = dwvw_shape_exit_inline(&setup->shape, kind, position, direction, &normal);
+        if (hit <= t) {
+            end->status = DWVW_EXITED;
+            break;
+        }
+        add_flight(&position, direction, t);
+        ++events;
+        weight *= albedo;
+        if (!(weight > 0.0)) {
+            end->status = DWVW_ABSORBED;
+            break;
+        }
+        if (weight < DWVW_ROULETTE_THRESHOLD) {
+            double survive = weight / DWVW_ROULETTE_THRESHOLD;
+            if (dwvk_rng_uniform_d(key, dwvw_event_dim(events - 1u) + DWVW_DIM_ROULETTE) >= survive) {
+                end->status = DWVW_ABSORBED;
+                break;
+            }
+            weight /= survive;
+        }
+        if (events >= setup->max_events) {
+            end->status = DWVW_TRUNCATED;
+            break;
+        }
+    }
+    end->events = events;
+    end->weight[0] = end->status == DWVW_ABSORBED ? 0.0 : weight;
+    end->weight[1] = end->weight[2] = 0.0;
+    end->exit_normal = normal;
+}
+
+static void classical_walk(const dwvw_estimate_setup *setup, uint64_t key, dwvw_walk_end *end)
+{
+    switch (setup->shape.kind) {
+    case DWVW_HALFSPACE: classical_walk_in(setup, DWVW_HALFSPACE, key, end); return;
+    case DWVW_SLAB: classical_walk_in(setup, DWVW_SLAB, key, end); return;
+    case DWVW_SPHERE: classical_walk_in(setup, DWVW_SPHERE, key, end); return;
+    }
+}
+
+/* The guided part of a setup when it is one component about an axis fixed for the whole walk:
+ * its weight q (the rest is classical) and axis; 0 if the guided part is anything else. */
+static double fixed_guide(const dwvw_estimate_setup *setup, dwvw_vec3 *axis)
+{
+    const dwvw_guide *guide = &setup->guide;
+    int halfspace = setup->shape.kind == DWVW_HALFSPACE;
+    int parts = (guide->q_poe > 0.0) + (guide->q_closest > 0.0) + (guide->q_incident > 0.0) + (guide->q_backward > 0.0);
+    if (parts != 1) return 0.0;
+    if (guide->q_poe > 0.0) {
+        *axis = ENTRY_NORMAL;
+        return guide->q_poe;
+    }
+    /* The half-space's closest point is always on its one plane, and the first step's probe into it
+     * finds no opposite interface, so there closest and backward guide about the entry normal. */
+    if (halfspace && guide->q_closest > 0.0) {
+        *axis = ENTRY_NORMAL;
+        return guide->q_closest;
+    }
+    if (halfspace && guide->q_backward > 0.0) {
+        *axis = ENTRY_NORMAL;
+        return guide->q_backward;
+    }
+    if (guide->q_incident > 0.0 && guide->patch_count == 1) {
+        *axis = guide->patches[0].normal;
+        return guide->q_incident;
+    }
+    return 0.0;
+}
+
+static inline void guided_walk_in(const dwvw_estimate_setup *setup, const fast_plan *plan, dwvw_shape_kind kind,
+                                  uint64_t key, dwvw_walk_end *end)
+{
+    const dwvw_medium *m = &setup->medium;
+    const double sigma = m->sigma_t[0], log_per_event = plan->log_per_event;
+    const uint32_t max_events = setup->max_events;
+    dwvw_vec3 position = ENTRY_POINT, direction = entry_direction(setup, key), normal;
+    uint32_t events = 0;
+    /* log weight = log_constants - sigma x exponent, exponent = sum over steps of (1 - s) t. */
+    double log_constants = 0.0, exponent = 0.0, log_weight = 0.0, last_factor = 1.0;
+    /* The RNG counter of this event's direction dimension, stepped by additions (dwvk_rng_counter). */
+    const uint64_t event_step = (uint64_t)DWVW_DIMS_PER_EVENT * DWVK_GOLDEN_GAMMA;
+    const uint64_t to_distance = (uint64_t)(DWVW_DIM_DISTANCE - DWVW_DIM_DIRECTION) * DWVK_GOLDEN_GAMMA;
+    uint64_t counter = dwvk_rng_counter(key, dwvw_event_dim(0) + DWVW_DIM_DIRECTION);
+    for (;; counter += event_step) {
+        /* The first step (events = 0) keeps the entry direction: its constant is log(alpha / s0). */
+        if (events > 0) {
+            dwvk_uniform_pair_f u = dwvk_uniform_pair_f_from_bits(dwvk_mix64(counter));
+            direction = plan->aligned ? aligned_guided_direction(plan, &m->dwivedi_event, u)
+                                      : dwvw_guided_direction_turned(plan->turned, &m->dwivedi_event, u);
+        }
+        double mu = plan->aligned ? aligned_cosine(plan, direction) : dwvw_cosine(direction, plan->axis);
+        double stretch = dwvk_dwivedi_stretch_d(&m->dwivedi, mu);
+        double t = dwvw_flight(sigma * stretch, dwvk_uniform_f_from_bits(dwvk_mix64(counter + to_distance)));
+        double hit = dwvw_shape_exit_inline(&setup->shape, kind, position, direction, &normal);
+        if (hit <= t) {
+            add_flight(&position, direction, hit);
+            exponent += (1.0 - stretch) * hit;
+            log_weight = log_constants - sigma * exponent;
+            if (events > 0) last_factor = stretch * plan->inv_albedo_eff; /* s / a */
+            end->status = DWVW_EXITED;
+            break;
+        }
+        add_flight(&position, direction, t);
+        exponent += (1.0 - stretch) * t;
+        if (events > 0) log_constants += log_per_event;
+        else log_constants = plan->first_known ? plan->log_first : log(m->albedo[0] / stretch);
+        ++events;
+        log_weight = log_constants - sigma * exponent;
+        if (log_weight < DWVW_LOG_ROULETTE_THRESHOLD) {
+            int fate = roulette(key, events, &log_weight);
+            if (fate == 0) {
+                end->status = DWVW_ABSORBED;
+                break;
+            }
+            if (fate == 2) log_constants = log_weight + sigma * exponent;
+        }
+        if (events >= max_events) {
+            end->status = DWVW_TRUNCATED;
+            break;
+        }
+    }
+    double weight = end->status == DWVW_ABSORBED ? 0.0 : exp(log_weight) * last_factor;
+    end->events = events;
+    end->weight[0] = isfinite(weight) ? weight : 0.0;
+    end->weight[1] = end->weight[2] = 0.0;
+    end->exit_normal = normal;
+}
+
+static void guided_walk(const dwvw_estimate_setup *setup, const fast_plan *plan, uint64_t key, dwvw_walk_end *end)
+{
+    switch (setup->shape.kind) {
+    case DWVW_HALFSPACE: guided_walk_in(setup, plan, DWVW_HALFSPACE, key, end); return;
+    case DWVW_SLAB: guided_walk_in(setup, plan, DWVW_SLAB, key, end); return;
+    case DWVW_SPHERE: guided_walk_in(setup, plan, DWVW_SPHERE, key, end); return;
+    }
+}
+
+/* Classical (weight q0) and one guided component about a fixed axis (weight q1): `auto` wherever
+ * it has one lit patch (or none, on the half-space), `cycles` on the half-space. Each step's
+ * weight is the general path's f / (q0 p_classical + q1 p_guided), formed with the same
+ * arithmetic as dwvw_walk_complete (one exponential per step), for any anisotropy; what the fast
+ * path saves is the per-event mixture bookkeeping. */
+static inline void mixture_walk_in(const dwvw_estimate_setup *setup, const fast_plan *plan, dwvw_shape_kind kind,
+                                   uint64_t key, dwvw_walk_end *end)
+{
+    const dwvw_medium *m = &setup->medium;
+    const double sigma = m->sigma_t[0], albedo = m->albedo[0];
+    const double q0 = setup->guide.q_classical, q1 = plan->q_guided, total = q0 + q1;
+    const float g = (float)m->g;
+    dwvw_vec3 position = ENTRY_POINT, direction = entry_direction(setup, key), normal;
+    double weight = 1.0;
+    uint32_t events = 0;
+    for (;;) {
+        uint32_t dim = dwvw_event_dim(events);
+        /* pick() of walk.c over {q0, q1}. */
+        int guided = !(dwvk_rng_uniform_d(key, dim + DWVW_DIM_COMPONENT) * total < q0);
+        double phase = 1.0, pdf_guided = 1.0;
+        if (events > 0) {
+            dwvk_uniform_pair_f u = dwvk_rng_uniform_pair_f(key, dim + DWVW_DIM_DIRECTION);
+            dwvw_vec3 previous = direction;
+            direction = !guided       ? dwvw_classical_direction(previous, g, u)
+                        : plan->aligned ? aligned_guided_direction(plan, &m->dwivedi_event, u)
+                                        : dwvw_guided_direction_turned(plan->turned, &m->dwivedi_event, u);
+            phase = g == 0.0f ? DWVK_INV_FOUR_PI : dwvk_hg_pdf_f(g, (float)dwvw_cosine(previous, direction));
+        }
+        double stretch = dwvk_dwivedi_stretch_d(&m->dwivedi, plan->aligned ? aligned_cosine(plan, direction)
+                                                                           : dwvw_cosine(direction, plan->axis));
+        if (events > 0) pdf_guided = m->guided_pdf_scale / stretch;
+        double t = dwvw_flight(sigma * (guided ? stretch : 1.0), dwvk_rng_uniform_f(key, dim + DWVW_DIM_DISTANCE));
+        double hit = dwvw_shape_exit_inline(&setup->shape, kind, position, direction, &normal);
+        int exited = hit <= t;
+        if (exited) t = hit;
+        /* dwvw_walk_complete's grey branch, term by term. */
+        double qp0 = q0 * phase, qp1 = q1 * pdf_guided, denominator = 0.0;
+        if (qp0 > 0.0) denominator += qp0 * 1.0 * 1.0;
+        if (qp1 > 0.0) {
+            double decay = stretch == 1.0 ? 1.0 : dwvk_exp_fast(sigma * (1.0 - stretch) * t);
+            denominator += qp1 * (exited ? 1.0 : stretch) * decay;
+        }
+        double ratio = phase * (exited ? 1.0 : albedo) / denominator;
+        weight *= isfinite(ratio) ? ratio : 0.0;
+        add_flight(&position, direction, t);
+        if (exited) {
+            end->status = DWVW_EXITED;
+            break;
+        }
+        ++events;
+        if (!(weight > 0.0)) {
+            end->status = DWVW_ABSORBED;
+            break;
+        }
+        if (weight < DWVW_ROULETTE_THRESHOLD) {
+            double survive = weight / DWVW_ROULETTE_THRESHOLD;
+            if (dwvk_rng_uniform_d(key, dwvw_event_dim(events - 1u) + DWVW_DIM_ROULETTE) >= survive) {
+                end->status = DWVW_ABSORBED;
+                break;
+            }
+            weight /= survive;
+        }
+        if (events >= setup->max_events) {
+            end->status = DWVW_TRUNCATED;
+            break;
+        }
+    }
+    end->events = events;
+    end->weight[0] = end->status == DWVW_ABSORBED ? 0.0 : weight;
+    end->weight[1] = end->weight[2] = 0.0;
+    end->exit_normal = normal;
+}
+
+static void mixture_walk(const dwvw_estimate_setup *setup, const fast_plan *plan, uint64_t key, dwvw_walk_end *end)
+{
+    switch (setup->shape.kind) {
+    case DWVW_HALFSPACE: mixture_walk_in(setup, plan, DWVW_HALFSPACE, key, end); return;
+    case DWVW_SLAB: mixture_walk_in(setup, plan, DWVW_SLAB, key, end); return;
+    case DWVW_SPHERE: mixture_walk_in(setup, plan, DWVW_SPHERE, key, end); return;
+    }
+}
+
+dwvw_walker dwvw_estimate_walker(const dwvw_estimate_setup *setup)
+{
+    dwvw_vec3 axis;
+    if (setup->general_path || setup->medium.channels != 1) return DWVW_WALKER_GENERAL;
+    const dwvw_guide *g = &setup->guide;
+    if (g->q_classical == 1.0 && g->q_poe == 0.0 && g->q_closest == 0.0 && g->q_incident == 0.0 && g->q_backward == 0.0)
+        return DWVW_WALKER_CLASSICAL;
+    double q_guided = fixed_guide(setup, &axis);
+    if (!(q_guided > 0.0)) return DWVW_WALKER_GENERAL;
+    if (g->q_classical == 0.0 && q_guided == 1.0 && setup->medium.g == 0.0) return DWVW_WALKER_GUIDED;
+    return DWVW_WALKER_MIXTURE; /* a classical share, or anisotropic scattering */
+}
+
+static void make_plan(const dwvw_estimate_setup *setup, dwvw_walker walker, fast_plan *plan)
+{
+    const dwvw_medium *m = &setup->medium;
+    memset(plan, 0, sizeof *plan);
+    plan->walker = walker;
+    if (walker != DWVW_WALKER_GUIDED && walker != DWVW_WALKER_MIXTURE) return;
+    plan->axis = ENTRY_NORMAL;
+    plan->q_guided = fixed_guide(setup, &plan->axis);
+    dwvw_frame frame = dwvw_frame_about(plan->axis);
+    for (int q = 0; q < 4; ++q) plan->turned[q] = dwvw_frame_turned(&frame, q);
+    plan_alignment(plan);
+    plan->log_per_event = log(m->albedo[0] / m->dwivedi.albedo_eff);
+    plan->inv_albedo_eff = 1.0 / m->dwivedi.albedo_eff;
+    plan->first_known = !setup->incidence_diffuse;
+    if (plan->first_known) {
+        double s0 = dwvk_dwivedi_stretch_d(&m->dwivedi, dwvw_cosine(entry_direction(setup, 0u), plan->axis));
+        plan->log_first = log(m->albedo[0] / s0);
+    }
+}
+
+static void walk_with_plan(const dwvw_estimate_setup *setup, const fast_plan *plan, uint64_t index,
+                           dwvw_walk_end *end)
+{
+    uint64_t key = dwvk_rng_key(setup->seed, index, 0);
+    switch (plan->walker) {
+    case DWVW_WALKER_CLASSICAL: classical_walk(setup, key, end); return;
+    case DWVW_WALKER_GUIDED: guided_walk(setup, plan, key, end); return;
+    case DWVW_WALKER_MIXTURE: mixture_walk(setup, plan, key, end); return;
+    case DWVW_WALKER_GENERAL: break;
+    }
+    general_walk(setup, key, end);
+}
+
+void dwvw_estimate_walk(const dwvw_estimate_setup *setup, dwvw_walker walker, uint64_t index, dwvw_walk_end *end)
+{
+    fast_plan plan;
+    make_plan(setup, walker, &plan);
+    walk_with_plan(setup, &plan, index, end);
+}
+
+static void add_walk(const dwvw_estimate_setup *setup, const dwvw_walk_end *end, block_totals *out)
+{
+    out->events += end->events;
+    double score = end->status == DWVW_EXITED ? exit_score(setup, end->exit_normal) : 0.0;
     for (int c = 0; c < setup->medium.channels; ++c) {
-        if (walk.status == DWVW_TRUNCATED) out->truncated_weight[c] += walk.weight[c];
-        double x = walk.weight[c] * score;
+        if (end->status == DWVW_TRUNCATED) out->truncated_weight[c] += end->weight[c];
+        double x = end->weight[c] * score;
         /* Welford (Knuth TAOCP 2, 4.2.2): m2 += k/(k+1) (x - mean of the k before)^2. The variance
          * as sum_squares - n mean^2 cancels when scores agree to 8 digits (all near 1 in a thin
          * slab at albedo ~1): it came out 0 where it was ~1e-18 and the standard error was 0. */
@@ -107,8 +520,17 @@ static void run_walk(const dwvw_estimate_setup *setup, uint64_t index, block_tot
         out->sum_squares[c] += x * x;
     }
     ++out->walks;
-    if (walk.status == DWVW_TRUNCATED) ++out->truncated_walks;
+    if (end->status == DWVW_TRUNCATED) ++out->truncated_walks;
 }
+
+typedef struct run_state {
+    const dwvw_estimate_setup *setup;
+    uint64_t block_size;
+    uint32_t block_count;
+    fast_plan plan;
+    atomic_uint next_block;
+    block_totals *blocks;
+} run_state;
 
 static void *worker(void *arg)
 {
@@ -120,7 +542,11 @@ static void *worker(void *arg)
         uint64_t end = first + state->block_size;
         if (end > state->setup->walks) end = state->setup->walks;
         block_totals *out = &state->blocks[block];
-        for (uint64_t i = first; i < end; ++i) run_walk(state->setup, i, out);
+        for (uint64_t i = first; i < end; ++i) {
+            dwvw_walk_end walk;
+            walk_with_plan(state->setup, &state->plan, i, &walk);
+            add_walk(state->setup, &walk, out);
+        }
     }
     return NULL;
 }
@@ -131,6 +557,7 @@ int dwvw_estimate_run(const dwvw_estimate_setup *setup, dwvw_estimate_totals *to
     clock_gettime(CLOCK_MONOTONIC, &start);
     run_state state;
     state.setup = setup;
+    make_plan(setup, dwvw_estimate_walker(setup), &state.plan);
     /* Blocks depend on the walk count only, never on the threads: fixed summation order. */
     state.block_size = (setup->walks + MAX_BLOCKS - 1) / MAX_BLOCKS;
     if (state.block_size < 256) state.block_size = 256;

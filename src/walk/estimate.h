@@ -18,6 +18,7 @@ typedef struct dwvw_estimate_setup {
     int light;               /* DWVW_LIGHT_* bits: which exits score */
     uint64_t walks, seed;
     uint32_t threads, max_events;
+    int general_path;        /* 1: every walk through dwvw_walk_*, never the fast path (for tests) */
 } dwvw_estimate_setup;
 
 typedef struct dwvw_estimate_totals {
@@ -30,6 +31,33 @@ typedef struct dwvw_estimate_totals {
 
 /* The lit patches the incident technique aims at, for a shape and its lighting; returns the count. */
 int dwvw_estimate_light_patches(const dwvw_shape *shape, int light, dwvw_light_patch *patches);
+/* How one walk ended: its status, scattering events, weight (0 unless exited or truncated) and
+ * exit normal. */
+typedef struct dwvw_walk_end {
+    dwvw_status status;
+    uint32_t events;
+    double weight[DWVW_MAX_CHANNELS];
+    dwvw_vec3 exit_normal;
+} dwvw_walk_end;
+
+/* Which walker dwvw_estimate_run uses for a setup. The fast paths are for grey media whose guided
+ * part is one component about an axis fixed for the whole walk (poe; incident with one patch;
+ * closest and backward on the half-space, where the closest normal is the entry normal and no
+ * opposite interface exists): GUIDED for that component alone in an isotropic medium, MIXTURE for
+ * it with a classical share (auto, cycles), CLASSICAL for classical alone. They make the same walks
+ * as the general path from the same random numbers; GUIDED and CLASSICAL cancel the weight's
+ * terms (see estimate.c), MIXTURE forms it as the general path does. */
+typedef enum dwvw_walker {
+    DWVW_WALKER_GENERAL = 0,
+    DWVW_WALKER_CLASSICAL = 1,
+    DWVW_WALKER_GUIDED = 2,
+    DWVW_WALKER_MIXTURE = 3
+} dwvw_walker;
+dwvw_walker dwvw_estimate_walker(const dwvw_estimate_setup *setup);
+/* Walk number `index` of a setup, by the given walker (one that dwvw_estimate_walker allows, or
+ * the general one). */
+void dwvw_estimate_walk(const dwvw_estimate_setup *setup, dwvw_walker walker, uint64_t index, dwvw_walk_end *end);
+
 /* Runs setup->walks walks; 0 on success, -1 if threads could not be started. */
 int dwvw_estimate_run(const dwvw_estimate_setup *setup, dwvw_estimate_totals *totals);
 

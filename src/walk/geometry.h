@@ -18,6 +18,48 @@ typedef struct dwvw_shape {
 /* The distance along unit d from p (inside) to the surface, +INFINITY if none, and the outward
  * normal there. */
 double dwvw_shape_exit(const dwvw_shape *shape, dwvw_vec3 p, dwvw_vec3 d, dwvw_vec3 *normal);
+static const dwvw_vec3 DWVW_FRONT_NORMAL = {0.0, 0.0, -1.0};
+static const dwvw_vec3 DWVW_BACK_NORMAL = {0.0, 0.0, 1.0};
+
+/* max(x, 0) inline (libm's fmax is an out-of-line call, and this is on the per-event path). */
+static inline double dwvw_positive_part(double x)
+{
+    return x > 0.0 ? x : 0.0;
+}
+
+/* dwvw_shape_exit inline, with the kind given apart so that a caller that knows it at compile
+ * time gets one case (the estimator's fast path, per event). */
+static inline double dwvw_shape_exit_inline(const dwvw_shape *shape, dwvw_shape_kind kind, dwvw_vec3 p, dwvw_vec3 d,
+                                            dwvw_vec3 *normal)
+{
+    switch (kind) {
+    case DWVW_HALFSPACE:
+        *normal = DWVW_FRONT_NORMAL;
+        return d.z < 0.0 ? dwvw_positive_part(p.z) / -d.z : INFINITY;
+    case DWVW_SLAB:
+        if (d.z < 0.0) {
+            *normal = DWVW_FRONT_NORMAL;
+            return dwvw_positive_part(p.z) / -d.z;
+        }
+        *normal = DWVW_BACK_NORMAL;
+        return d.z > 0.0 ? dwvw_positive_part(shape->thickness - p.z) / d.z : INFINITY;
+    case DWVW_SPHERE: {
+        /* |q + t d|^2 = R^2 with q = p - centre: t = -b + sqrt(b^2 - c), c = |q|^2 - R^2 <= 0; for
+         * b > 0 the equivalent -c / (b + sqrt(b^2 - c)) avoids cancellation. */
+        double R = shape->radius;
+        dwvw_vec3 q = dwvw_v(p.x, p.y, p.z - R);
+        double b = dwvw_dot(q, d);
+        double c = (dwvw_length(q) - R) * (dwvw_length(q) + R);
+        c = c < 0.0 ? c : 0.0;
+        double root = sqrt(b * b - c);
+        double t = b > 0.0 ? -c / (b + root) : root - b;
+        *normal = dwvw_normalize(dwvw_madd(q, d, t));
+        return t;
+    }
+    }
+    return INFINITY;
+}
+
 /* The outward normal at the surface point closest to p, and the distance to it. */
 double dwvw_shape_closest(const dwvw_shape *shape, dwvw_vec3 p, dwvw_vec3 *normal);
 

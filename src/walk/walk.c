@@ -2,12 +2,6 @@
 
 #include <float.h>
 
-#include "kernel/classical.h"
-#include "kernel/rng.h"
-
-#define INV_TWO_PI 0.15915494309189533577
-#define DWVW_ROULETTE_THRESHOLD 0.05
-
 void dwvw_medium_init(dwvw_medium *medium, int channels, const double *sigma_t, const double *albedo, double g)
 {
     medium->channels = channels;
@@ -21,6 +15,8 @@ void dwvw_medium_init(dwvw_medium *medium, int channels, const double *sigma_t, 
     medium->g = g;
     medium->dwivedi = dwvk_dwivedi_from_kappa(dwvk_kappa_exact(albedo[medium->guide_channel]));
     medium->dwivedi_f = dwvk_dwivedi_to_float(medium->dwivedi);
+    medium->dwivedi_event = dwvk_dwivedi_event_from(medium->dwivedi);
+    medium->guided_pdf_scale = medium->dwivedi.albedo_eff * DWVK_INV_FOUR_PI;
 }
 
 /* The auto heuristic. Guiding pays where walks are long (high albedo) and the Dwivedi
@@ -104,6 +100,7 @@ void dwvw_walk_begin(dwvw_walk *walk, const dwvw_medium *medium, const dwvw_guid
     walk->closest_normal = normal;
     walk->step_distance = 0.0;
     walk->component_count = 0;
+    walk->single_component = -1;
 }
 
 void dwvw_walk_set_closest(dwvw_walk *walk, dwvw_vec3 normal)
@@ -162,8 +159,8 @@ static void build_components(dwvw_walk *walk)
     walk->component_count = 1;
     double backward_fraction = 0.0;
     if (guide->q_backward > 0.0 && walk->have_opposite) {
-        double depth = fmin(fmax(dwvw_dot(dwvw_sub(walk->position, walk->entry_point), walk->entry_normal) * -1.0, 0.0),
-                            walk->opposite_depth);
+        double depth = -dwvw_dot(dwvw_sub(walk->position, walk->entry_point), walk->entry_normal);
+        depth = depth > 0.0 ? depth < walk->opposite_depth ? depth : walk->opposite_depth : 0.0;
         double x = m->sigma_t[m->guide_channel] * (walk->opposite_depth - 2.0 * depth) * m->dwivedi.kappa;
         backward_fraction = 1.0 / (1.0 + exp(x));
     }
@@ -171,11 +168,16 @@ static void build_components(dwvw_walk *walk)
     add_component(walk, guide->q_backward * backward_fraction, dwvw_scale(walk->entry_normal, -1.0));
     if (guide->q_closest > 0.0) add_component(walk, guide->q_closest, walk->closest_normal);
     if (guide->q_incident > 0.0) add_incident_components(walk, guide->q_incident);
-}
-
-static inline float clamp_cosine(double mu)
-{
-    return mu < -1.0 ? -1.0f : mu > 1.0 ? 1.0f : (float)mu;
+    /* With one component of weight > 0 there is nothing to draw: pick() would return it for any u. */
+    walk->single_component = -1;
+    for (int k = 0; k < walk->component_count; ++k) {
+        if (!(walk->component_q[k] > 0.0)) continue;
+        if (walk->single_component >= 0) {
+            walk->single_component = -1;
+            break;
+        }
+        walk->single_component = k;
+    }
 }
 
 static int pick(const double *p, int n, double u)
@@ -196,54 +198,55 @@ static int pick(const double *p, int n, double u)
 double dwvw_walk_sample(dwvw_walk *walk)
 {
     const dwvw_medium *m = walk->medium;
-    uint32_t dim = 2u + DWVW_DIMS_PER_EVENT * walk->events;
-    double u_channel = dwvk_rng_uniform_d(walk->key, dim);
-    double u_component = dwvk_rng_uniform_d(walk->key, dim + 1);
-    float u_cos = dwvk_rng_uniform_f(walk->key, dim + 2);
-    float u_phi = dwvk_rng_uniform_f(walk->key, dim + 3);
-    float u_distance = dwvk_rng_uniform_f(walk->key, dim + 4);
+    const uint32_t dim = dwvw_event_dim(walk->events);
 
     /* Channel: proportional to throughput x albedo (Cycles), to throughput where all albedos are 0. */
-    double total = 0.0;
-    for (int c = 0; c < m->channels; ++c) total += (walk->channel_p[c] = walk->weight[c] * m->albedo[c]);
-    if (!(total > 0.0))
-        for (int c = 0; c < m->channels; ++c) total += (walk->channel_p[c] = walk->weight[c]);
-    for (int c = 0; c < m->channels; ++c) walk->channel_p[c] /= total;
-    int channel = m->channels > 1 ? pick(walk->channel_p, m->channels, u_channel) : 0;
+    int channel = 0;
+    if (m->channels > 1) {
+        double total = 0.0;
+        for (int c = 0; c < m->channels; ++c) total += (walk->channel_p[c] = walk->weight[c] * m->albedo[c]);
+        if (!(total > 0.0))
+            for (int c = 0; c < m->channels; ++c) total += (walk->channel_p[c] = walk->weight[c]);
+        for (int c = 0; c < m->channels; ++c) walk->channel_p[c] /= total;
+        channel = pick(walk->channel_p, m->channels, dwvk_rng_uniform_d(walk->key, dim + DWVW_DIM_CHANNEL));
+    } else {
+        walk->channel_p[0] = 1.0;
+    }
 
     build_components(walk);
-    int chosen = pick(walk->component_q, walk->component_count, u_component);
-    /* Per-event sampling and pdfs run in single precision (src/kernel's float path); positions,
-     * weights and their exponentials stay in double. */
+    int chosen = walk->single_component >= 0
+                     ? walk->single_component
+                     : pick(walk->component_q, walk->component_count,
+                            dwvk_rng_uniform_d(walk->key, dim + DWVW_DIM_COMPONENT));
+    /* Per-event sampling runs in single precision (src/kernel/fastmath.h); positions, directions,
+     * pdfs, weights and their exponentials stay in double. */
     dwvw_vec3 previous = walk->direction;
     float g = (float)m->g;
     if (walk->events > 0) {
         /* The first step keeps the entry direction: only its distance is sampled. */
+        dwvk_uniform_pair_f u = dwvk_rng_uniform_pair_f(walk->key, dim + DWVW_DIM_DIRECTION);
         if (chosen == 0) {
-            float mu = g == 0.0f ? dwvk_isotropic_sample_f(u_cos) : dwvk_hg_sample_f(g, u_cos);
-            walk->direction = dwvw_direction_about(previous, mu, 1.0f - mu, 1.0f + mu, u_phi);
+            walk->direction = dwvw_classical_direction(previous, g, u);
         } else {
-            dwvk_dwivedi_sample_f s = dwvk_dwivedi_sample_pdf_f(&m->dwivedi_f, u_cos);
-            walk->direction = dwvw_direction_about(walk->component_axis[chosen], s.cos_theta, s.one_minus_cos,
-                                                   s.one_plus_cos, u_phi);
+            dwvw_frame frame = dwvw_frame_about(walk->component_axis[chosen]);
+            walk->direction = dwvw_guided_direction(&frame, &m->dwivedi_event, u);
         }
         /* HG at g = 0 is the isotropic 1/(4 pi): skip its square root and division. */
-        walk->phase = g == 0.0f ? (float)DWVK_INV_FOUR_PI
-                                : dwvk_hg_pdf_f(g, clamp_cosine(dwvw_dot(previous, walk->direction)));
+        walk->phase = g == 0.0f ? DWVK_INV_FOUR_PI : dwvk_hg_pdf_f(g, (float)dwvw_cosine(previous, walk->direction));
     } else {
         walk->phase = 1.0;
     }
     /* Every component's direction pdf and stretch at the sampled direction (the pdf is 1 for all
-     * on the first step, whose direction was not sampled). */
+     * on the first step, whose direction was not sampled): p(mu) / (2 pi) = a / (4 pi stretch). */
     walk->component_pdf[0] = walk->phase;
     walk->component_stretch[0] = 1.0;
     for (int k = 1; k < walk->component_count; ++k) {
-        float mu = clamp_cosine(dwvw_dot(walk->direction, walk->component_axis[k]));
-        walk->component_pdf[k] = walk->events > 0 ? dwvk_dwivedi_pdf_f(&m->dwivedi_f, mu) * (float)INV_TWO_PI : 1.0;
-        walk->component_stretch[k] = dwvk_dwivedi_stretch_f(&m->dwivedi_f, mu);
+        double stretch = dwvk_dwivedi_stretch_d(&m->dwivedi, dwvw_cosine(walk->direction, walk->component_axis[k]));
+        walk->component_stretch[k] = stretch;
+        walk->component_pdf[k] = walk->events > 0 ? m->guided_pdf_scale / stretch : 1.0;
     }
-    float sigma = (float)(m->sigma_t[channel] * walk->component_stretch[chosen]);
-    walk->step_distance = dwvk_exponential_sample_f(sigma, u_distance);
+    float u_distance = dwvk_rng_uniform_f(walk->key, dim + DWVW_DIM_DISTANCE);
+    walk->step_distance = dwvw_flight(m->sigma_t[channel] * walk->component_stretch[chosen], u_distance);
     return walk->step_distance;
 }
 
@@ -275,7 +278,9 @@ dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 h
         for (int k = 0; k < components; ++k) {
             if (!(qp[k] > 0.0)) continue;
             double stretch = walk->component_stretch[k];
-            denominator += qp[k] * (exited ? 1.0 : stretch) * exp(sigma_t * (1.0 - stretch) * t);
+            /* The classical component (stretch 1) has exp(0) = 1: skip the call. */
+            double decay = stretch == 1.0 ? 1.0 : dwvk_exp_fast(sigma_t * (1.0 - stretch) * t);
+            denominator += qp[k] * (exited ? 1.0 : stretch) * decay;
         }
         double ratio = walk->phase * (exited ? 1.0 : m->albedo[0]) / denominator;
         walk->weight[0] *= isfinite(ratio) ? ratio : 0.0;
@@ -289,7 +294,7 @@ dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 h
                     if (!(walk->channel_p[c] > 0.0)) continue;
                     double sigma = m->sigma_t[c] * walk->component_stretch[k];
                     double density = exited ? 1.0 : sigma;
-                    denominator += qp[k] * walk->channel_p[c] * density * exp((m->sigma_t[cw] - sigma) * t);
+                    denominator += qp[k] * walk->channel_p[c] * density * dwvk_exp_fast((m->sigma_t[cw] - sigma) * t);
                 }
             }
             double f = walk->phase * (exited ? 1.0 : m->sigma_t[cw] * m->albedo[cw]);
@@ -306,14 +311,14 @@ dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 h
     walk->closest_known = 0;
 
     double largest = 0.0;
-    for (int c = 0; c < m->channels; ++c) largest = fmax(largest, walk->weight[c]);
+    for (int c = 0; c < m->channels; ++c) largest = walk->weight[c] > largest ? walk->weight[c] : largest;
     if (!(largest > 0.0)) return walk->status = DWVW_ABSORBED;
     if (largest < DWVW_ROULETTE_THRESHOLD) {
         /* Russian roulette on small throughput only: survive with probability largest/threshold.
          * Guided walks carry weights near alpha exp(sigma kappa z)/(1 + kappa), just below 1 near
          * the surface; a threshold of 1 would kill them there for nothing but variance. */
         double survive = largest / DWVW_ROULETTE_THRESHOLD;
-        double u = dwvk_rng_uniform_d(walk->key, 2u + DWVW_DIMS_PER_EVENT * walk->events - 1u);
+        double u = dwvk_rng_uniform_d(walk->key, dwvw_event_dim(walk->events - 1u) + DWVW_DIM_ROULETTE);
         if (u >= survive) {
             for (int c = 0; c < m->channels; ++c) walk->weight[c] = 0.0;
             return walk->status = DWVW_ABSORBED;

@@ -23,13 +23,25 @@
 
 #include <stdint.h>
 
+#include "kernel/classical.h"
 #include "kernel/dwivedi.h"
+#include "kernel/rng.h"
 #include "vec3.h"
 
 #define DWVW_MAX_CHANNELS 3
 #define DWVW_MAX_PATCHES 16
 #define DWVW_MAX_COMPONENTS (4 + DWVW_MAX_PATCHES)
+/* Random-number dimensions of event e start at 2 + 6e (0 and 1 are the entry's): +0 the channel,
+ * +1 the component (each drawn only where there is a choice), +2 the cosine and the azimuth (one
+ * 64-bit draw, two 24-bit uniforms), +4 the distance, +5 the Russian roulette after the event;
+ * +3 is unused. */
 #define DWVW_DIMS_PER_EVENT 6
+#define DWVW_DIM_CHANNEL 0u
+#define DWVW_DIM_COMPONENT 1u
+#define DWVW_DIM_DIRECTION 2u
+#define DWVW_DIM_DISTANCE 4u
+#define DWVW_DIM_ROULETTE 5u
+#define DWVW_ROULETTE_THRESHOLD 0.05
 
 typedef enum dwvw_technique {
     DWVW_AUTO = 0,
@@ -49,7 +61,9 @@ typedef struct dwvw_medium {
     double g;                            /* Henyey-Greenstein anisotropy in (-1, 1) */
     int guide_channel;                   /* the channel with the largest albedo */
     dwvk_dwivedi_d dwivedi;              /* the direction distribution, from that albedo */
-    dwvk_dwivedi_f dwivedi_f;            /* the same in single precision, for the per-event path */
+    dwvk_dwivedi_f dwivedi_f;            /* the same in single precision */
+    dwvk_dwivedi_event_f dwivedi_event;  /* the per-event sampler's constants */
+    double guided_pdf_scale;             /* a / (4 pi): a guided direction pdf is this / stretch */
 } dwvw_medium;
 
 /* A lit part of the surface: an infinite plane (distance measured to the plane) or a patch
@@ -93,6 +107,7 @@ typedef struct dwvw_walk {
     int closest_known;
     double step_distance;
     int component_count;
+    int single_component;                           /* the only component with q > 0, else -1 */
     double component_q[DWVW_MAX_COMPONENTS];
     dwvw_vec3 component_axis[DWVW_MAX_COMPONENTS]; /* unused for component 0 (classical) */
     double component_pdf[DWVW_MAX_COMPONENTS];     /* direction pdf per steradian */
@@ -122,6 +137,56 @@ double dwvw_walk_sample(dwvw_walk *walk);
  * answer (not cut at the sampled distance), which locates the opposite interface. Returns the
  * new status. */
 dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 hit_normal);
+
+/* ---- the per-event pieces, shared by dwvw_walk_sample and the estimator's fast path ----------- */
+
+static inline uint32_t dwvw_event_dim(uint32_t events)
+{
+    return 2u + DWVW_DIMS_PER_EVENT * events;
+}
+
+/* A classical direction: the cosine to `previous` from the phase function (isotropic at g = 0),
+ * the azimuth uniform. u.a drives the cosine, u.b the azimuth. */
+static inline dwvw_vec3 dwvw_classical_direction(dwvw_vec3 previous, float g, dwvk_uniform_pair_f u)
+{
+    float mu = g == 0.0f ? dwvk_isotropic_sample_f(u.a) : dwvk_hg_sample_f(g, u.a);
+    float sin2 = (1.0f - mu) * (1.0f + mu);
+    dwvw_frame frame = dwvw_frame_about(previous);
+    return dwvw_frame_direction(&frame, mu, sqrtf(sin2 > 0.0f ? sin2 : 0.0f), dwvk_azimuth_f(u.b));
+}
+
+/* A guided direction about frame->n (Dwivedi's cosine distribution). */
+static inline dwvw_vec3 dwvw_guided_direction(const dwvw_frame *frame, const dwvk_dwivedi_event_f *d,
+                                              dwvk_uniform_pair_f u)
+{
+    dwvk_dwivedi_event_cosine_f s = dwvk_dwivedi_event_sample_f(d, u.a);
+    return dwvw_frame_direction(frame, s.cos_theta, s.sin_theta, dwvk_azimuth_f(u.b));
+}
+
+/* The same about a fixed axis, with its frame's four quarter turns made in advance
+ * (turned[q] = dwvw_frame_turned(frame, q)): bit for bit dwvw_guided_direction, without turning
+ * the azimuth per event. */
+static inline dwvw_vec3 dwvw_guided_direction_turned(const dwvw_frame turned[4], const dwvk_dwivedi_event_f *d,
+                                                     dwvk_uniform_pair_f u)
+{
+    dwvk_dwivedi_event_cosine_f s = dwvk_dwivedi_event_sample_f(d, u.a);
+    int32_t q;
+    dwvk_unit2_f azimuth = dwvk_azimuth_quadrant_f(u.b, &q);
+    return dwvw_frame_direction(&turned[q], s.cos_theta, s.sin_theta, azimuth);
+}
+
+/* The cosine of unit `direction` to unit `axis`, held in [-1, 1]. */
+static inline double dwvw_cosine(dwvw_vec3 direction, dwvw_vec3 axis)
+{
+    double mu = dwvw_dot(direction, axis);
+    return mu < -1.0 ? -1.0 : mu > 1.0 ? 1.0 : mu;
+}
+
+/* A free flight of extinction sigma (> 0) from a 24-bit uniform. */
+static inline double dwvw_flight(double sigma, float u)
+{
+    return dwvk_free_flight(u) / sigma;
+}
 
 /* The mixture weights `auto` uses for a medium: see the definition for the heuristic. */
 void dwvw_auto_weights(const dwvw_medium *medium, int patch_count, double *q_classical, double *q_closest,
