@@ -163,7 +163,7 @@ def sphere_scene(resolution=32, samples=256):
     sphere.name = "Sphere"
     bpy.ops.object.shade_smooth()
     sphere.data.materials.append(material)
-    _camera(scene, (0.0, -5.0, 0.0), (math.pi / 2, 0.0, 0.0), lens=50.0)
+    _camera(scene, (0.0, -3.5, 0.0), (math.pi / 2, 0.0, 0.0), lens=50.0)
     _sun(scene, (math.radians(45.0), 0.0, math.radians(-30.0)), 2.0)
     return scene
 

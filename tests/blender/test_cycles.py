@@ -1,0 +1,154 @@
+"""Compatibility with Cycles, headless: for the same scene, the add-on's camera bake and a Cycles
+render (Principled BSDF, subsurface "Random Walk (Fixed Radius)", specular 0) agree, and the
+add-on's display PNG is Blender's own view transform of the same linear pixels.
+
+Scenes (tests/blender/scenes.py, built by script): a back-lit slab 1.3 / 2.5 / 5 mean free paths
+thick in R / G / B, and a front-lit thick wax sphere. Each is rendered by Cycles and baked by the
+add-on twice with different seeds at 32 x 32 (nothing is cached between runs), then:
+
+- mean radiance per channel within 3% (on channels bright enough to measure);
+- per-pixel differences consistent with noise: with each side's per-pixel variance of its
+  two-seed mean estimated from the two seeds, (a1 - a2)^2 / 4, the ratio
+  R = sum (ours - cycles)^2 / sum (var_ours + var_cycles) is 1 in expectation when both estimate
+  the same image; it must stay below 1.6 (a 3% bias on these images makes it several times that);
+- the display PNG (Filmic, a look, exposure and gamma) equals Image.save_render of our EXR with
+  the scene's view settings within 1/255 per channel.
+
+The figures are printed, and written to DWIVEDI_TEST_HOME/cycles_figures.json.
+"""
+import json
+import math
+import sys
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import bpy  # noqa: E402
+
+import harness  # noqa: E402
+import scenes  # noqa: E402
+
+WORK = harness.install_addon()
+RESOLUTION = 32
+CYCLES_SAMPLES = 512       # per seed; two seeds
+DWIVEDI_SAMPLES = 256      # per seed; two seeds
+MEAN_TOLERANCE = 0.03
+NOISE_RATIO_LIMIT = 1.6
+FIGURES = {}
+
+
+def cycles_render(scene, seed, name):
+    scene.cycles.seed = seed
+    scene.cycles.samples = CYCLES_SAMPLES
+    scene.render.image_settings.file_format = 'OPEN_EXR'
+    scene.render.image_settings.color_depth = '32'
+    scene.render.filepath = str(WORK / f"{name}_cycles_{seed}.exr")
+    start = time.monotonic()
+    bpy.ops.render.render(write_still=True)
+    seconds = time.monotonic() - start
+    _, _, pixels = harness.read_pixels(WORK / f"{name}_cycles_{seed}.exr")
+    return pixels, seconds
+
+
+def dwivedi_bake(scene, seed, name):
+    props = scene.dwivedi_bake
+    props.samples = DWIVEDI_SAMPLES
+    props.threads = 2
+    props.seed = seed
+    props.technique = 'AUTO'
+    props.output_dir = str(WORK / f"{name}_dwivedi_{seed}")
+    start = time.monotonic()
+    result, error = harness.call_operator()
+    seconds = time.monotonic() - start
+    if result != {'FINISHED'}:
+        raise AssertionError(f"the bake failed: {error}")
+    _, _, pixels = harness.read_pixels(WORK / f"{name}_dwivedi_{seed}" / f"{scene.name}_camera.exr")
+    return pixels, seconds
+
+
+def channel_means(pixels):
+    n = len(pixels) // 4
+    return [sum(pixels[c::4]) / n for c in range(3)]
+
+
+def compare(name, build):
+    scene = build(RESOLUTION, CYCLES_SAMPLES)
+    c1, tc1 = cycles_render(scene, 1, name)
+    c2, tc2 = cycles_render(scene, 2, name)
+    o1, to1 = dwivedi_bake(scene, 1, name)
+    o2, to2 = dwivedi_bake(scene, 2, name)
+    cycles = [(a + b) / 2 for a, b in zip(c1, c2)]
+    ours = [(a + b) / 2 for a, b in zip(o1, o2)]
+    cm, om = channel_means(cycles), channel_means(ours)
+    ratios = []
+    for c in range(3):
+        num = sum((ours[i] - cycles[i]) ** 2 for i in range(c, len(ours), 4))
+        den = sum(((o1[i] - o2[i]) ** 2 + (c1[i] - c2[i]) ** 2) / 4 for i in range(c, len(ours), 4))
+        ratios.append(num / den if den > 0 else (0.0 if num == 0 else math.inf))
+    figures = {
+        "cycles_mean_rgb": cm, "dwivedi_mean_rgb": om,
+        "relative_difference_rgb": [(o - c) / c if c > 0 else None for o, c in zip(om, cm)],
+        "noise_ratio_rgb": ratios,
+        "cycles_seconds": tc1 + tc2, "cycles_samples": 2 * CYCLES_SAMPLES,
+        "dwivedi_seconds": to1 + to2, "dwivedi_samples": 2 * DWIVEDI_SAMPLES,
+        "resolution": RESOLUTION,
+    }
+    FIGURES[name] = figures
+    print(f"\n{name}: " + json.dumps(figures, indent=1), flush=True)
+    (harness.HOME / "cycles_figures.json").write_text(json.dumps(FIGURES, indent=2))
+    return figures
+
+
+class CyclesTest(harness.unittest.TestCase):
+    def check(self, figures, channels):
+        for c in channels:
+            cm = figures["cycles_mean_rgb"][c]
+            om = figures["dwivedi_mean_rgb"][c]
+            self.assertGreater(cm, 1e-3, f"channel {c} has signal in Cycles")
+            self.assertLess(abs(om / cm - 1.0), MEAN_TOLERANCE,
+                            f"channel {'RGB'[c]}: dwivedi {om:.5f} vs Cycles {cm:.5f}")
+            self.assertLess(figures["noise_ratio_rgb"][c], NOISE_RATIO_LIMIT,
+                            f"channel {'RGB'[c]}: per-pixel differences exceed the noise")
+
+    def test_back_lit_slab(self):
+        self.check(compare("slab", scenes.slab_scene), (0, 1, 2))
+
+    def test_front_lit_sphere(self):
+        self.check(compare("sphere", scenes.sphere_scene), (0, 1, 2))
+
+    def test_display_png_is_blenders_view_transform(self):
+        scene = scenes.sphere_scene(16, 4)
+        view = scene.view_settings
+        view.view_transform = 'Filmic'
+        view.look = 'Filmic - Medium High Contrast'
+        view.exposure = 1.5
+        view.gamma = 1.3
+        scene.display_settings.display_device = 'sRGB'
+        scene.render.dither_intensity = 0.0
+        scene.render.image_settings.file_format = 'PNG'
+        scene.render.image_settings.color_mode = 'RGBA'
+        scene.render.image_settings.color_depth = '8'
+        props = scene.dwivedi_bake
+        props.samples = 16
+        props.output_dir = str(WORK / "display")
+        result, error = harness.call_operator()
+        self.assertEqual(result, {'FINISHED'}, error)
+        exr = WORK / "display" / f"{scene.name}_camera.exr"
+        ours_png = WORK / "display" / f"{scene.name}_camera.png"
+        image = bpy.data.images.load(str(exr), check_existing=False)
+        blender_png = WORK / "display" / "blender_save_render.png"
+        image.save_render(str(blender_png), scene=scene)
+        bpy.data.images.remove(image)
+        w1, h1, ours = harness.read_pixels(ours_png)
+        w2, h2, theirs = harness.read_pixels(blender_png)
+        self.assertEqual((w1, h1), (w2, h2))
+        worst = max(abs(a - b) for i, (a, b) in enumerate(zip(ours, theirs)) if i % 4 != 3)
+        lit = sum(1 for v in theirs[0::4] if v > 0.05)
+        FIGURES["display_png_max_difference_255"] = worst * 255
+        print(f"display PNG: largest difference {worst * 255:.2f}/255 over {w1}x{h1}, {lit} lit pixels", flush=True)
+        self.assertGreater(lit, 10, "the comparison sees lit pixels")
+        self.assertLessEqual(worst, 1.0 / 255 + 1e-6)
+
+
+harness.run(CyclesTest)
