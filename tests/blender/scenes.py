@@ -131,7 +131,8 @@ def _box(scene, name, size, location, material):
     return obj
 
 
-def slab_scene(resolution=32, samples=256, thickness=0.1, color=(0.8, 0.8, 0.8), radius=(1.0, 0.5, 0.25)):
+def slab_scene(resolution=32, samples=256, thickness=0.1, color=(0.8, 0.8, 0.8), radius=(1.0, 0.5, 0.25),
+               width=4.0):
     """A wide slab `thickness` m thick (4 x 4 m), lit from below by a sun travelling straight
     up, seen from above by an orthographic camera over its centre: only light transmitted
     through the slab reaches the camera. Radius (1.0, 0.5, 0.25) m, colour 0.8: Cycles' fixed
@@ -142,7 +143,7 @@ def slab_scene(resolution=32, samples=256, thickness=0.1, color=(0.8, 0.8, 0.8),
     scene.render.resolution_y = resolution
     scene.cycles.samples = samples
     material = principled_material("Slab", color, radius)
-    _box(scene, "Slab", (4.0, 4.0, thickness), (0.0, 0.0, 0.0), material)
+    _box(scene, "Slab", (width, width, thickness), (0.0, 0.0, 0.0), material)
     _camera(scene, (0.0, 0.0, 3.0), (0.0, 0.0, 0.0), ortho_scale=1.0)
     # A sun's light travels along its local -z: rotated by pi about x it travels +z (upwards).
     _sun(scene, (math.pi, 0.0, 0.0), 3.0)
