@@ -39,6 +39,9 @@ TECHNIQUES = [
 ]
 
 
+_custom_library = False  # the preferences' library is in use (not the bundled one)
+
+
 def shim():
     """The dwivedi Python shim: the copy bundled in the add-on, else one on sys.path; with the
     library from the add-on preferences when one is set."""
@@ -48,15 +51,15 @@ def shim():
         import dwivedi  # a development checkout with python_shim on sys.path
     prefs = preferences()
     wanted = prefs.library_path.strip() if prefs is not None else ""
+    global _custom_library
     if wanted:
-        wanted = bpy.path.abspath(wanted)
-        current = None
-        try:
-            current = dwivedi._library._loaded[1] if dwivedi._library._loaded else None
-        except (AttributeError, TypeError):
-            current = None
-        if current != os.path.abspath(wanted):
+        wanted = os.path.abspath(bpy.path.abspath(wanted))
+        if dwivedi._library.loaded_path() != wanted:
             dwivedi.use_library(wanted)
+            _custom_library = True
+    elif _custom_library:
+        dwivedi.use_library(None)  # back to the bundled library
+        _custom_library = False
     return dwivedi
 
 

@@ -475,11 +475,22 @@ def library() -> ctypes.CDLL:
     return _loaded_library()[0]
 
 
-def use_library(path: str) -> str:
+def loaded_path() -> Optional[str]:
+    """Where the library in use came from, or None if none was loaded yet (never loads one)."""
+    with _lock:
+        return None if _loaded is None else _loaded[1]
+
+
+def use_library(path: Optional[str]) -> Optional[str]:
     """Loads the library from `path` (a file) in place of the one found by the search, for every
     later call; returns the absolute path. Objects made with the previous library keep using it.
-    Error if the file is missing or is not libdwivedi (the previous choice then stays)."""
+    Error if the file is missing or is not libdwivedi (the previous choice then stays).
+    use_library(None) forgets the choice: the next call searches again (see library_path)."""
     global _loaded
+    if path is None:
+        with _lock:
+            _loaded = None
+        return None
     absolute = os.path.abspath(os.fspath(path))
     if not Path(absolute).is_file():
         raise Error(f"the library {absolute} is not a file")
