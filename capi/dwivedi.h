@@ -653,8 +653,8 @@ typedef struct dwv_display_options_t {
     const char *display;
     const char *view;
     const char *look;
-    double exposure;      /* finite */
-    double gamma;         /* > 0, finite */
+    double exposure;      /* stops, in [-100, 100] */
+    double gamma;         /* in [0.001, 1000] */
 } dwv_display_options_t;
 #define DWV_DISPLAY_OPTIONS_INIT {sizeof(dwv_display_options_t), 0u, NULL, NULL, NULL, NULL, 0.0, 1.0}
 /* Writes an 8-bit sRGB-encoded (as the display says) RGBA PNG of the image through the view. */

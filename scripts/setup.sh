@@ -4,7 +4,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-packages=(build-essential cmake pkg-config binutils python3 python3-mpmath python3-numpy python3-matplotlib)
+packages=(build-essential cmake pkg-config binutils python3 python3-mpmath python3-numpy python3-matplotlib
+          libopenexr-dev openexr libopencolorio-dev opencolorio-tools libpng-dev)
 
 missing=()
 for p in "${packages[@]}"; do

@@ -1,0 +1,111 @@
+#define _POSIX_C_SOURCE 200809L /* strnlen */
+
+/* capi entry points that write images out: OpenEXR and colour-managed display images (PNG or
+ * bytes in memory). They validate every argument, then hand over to src/io. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "bake/image.h"
+#include "dwivedi.h"
+#include "error.h"
+#include "image_handle.h"
+#include "io/atomic_file.h"
+#include "io/display.h"
+#include "io/exr.h"
+#include "io/png_writer.h"
+
+/* The message of an io call, prefixed with the entry point's name. */
+static dwv_result_t io_result(const char *fn, dwv_result_t result, const char *message)
+{
+    if (result == DWV_SUCCESS) return result;
+    return dwv_fail(result, "%s: %s", fn, message);
+}
+
+static dwv_result_t check_path(const char *fn, const char *path)
+{
+    DWV_TRY(dwv_check_pointer(fn, "path", path));
+    char message[512];
+    return io_result(fn, dwvio_check_output_path(path, message, sizeof message), message);
+}
+
+static dwv_result_t check_name(const char *fn, const char *what, const char *name)
+{
+    if (!name) return DWV_SUCCESS;
+    size_t length = strnlen(name, 1025u);
+    if (length > 1024u) return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: display->%s is longer than 1024 bytes", fn, what);
+    return DWV_SUCCESS;
+}
+
+static dwv_result_t check_display(const char *fn, const dwv_display_options_t *display)
+{
+    DWV_TRY(dwv_check_struct(fn, "display", display, (uint32_t)sizeof(dwv_display_options_t)));
+    DWV_TRY(dwv_check_finite(fn, "display->exposure", display->exposure));
+    /* 2^exposure must stay a finite, non-zero float gain. */
+    DWV_TRY(dwv_check_range(fn, "display->exposure", display->exposure, -100.0, 100.0));
+    DWV_TRY(dwv_check_finite(fn, "display->gamma", display->gamma));
+    if (!(display->gamma > 0.0))
+        return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: display->gamma = %.17g must be > 0", fn, display->gamma);
+    if (display->gamma < 1e-3 || display->gamma > 1e3)
+        return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: display->gamma = %.17g is outside [0.001, 1000]", fn,
+                        display->gamma);
+    if (display->config_path && strnlen(display->config_path, 4096u) >= 4096u)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: display->config_path is longer than 4095 bytes", fn);
+    DWV_TRY(check_name(fn, "display", display->display));
+    DWV_TRY(check_name(fn, "view", display->view));
+    DWV_TRY(check_name(fn, "look", display->look));
+    return DWV_SUCCESS;
+}
+
+dwv_result_t dwv_image_write_exr(const dwv_image_t *image, const char *path)
+{
+    static const char fn[] = "dwv_image_write_exr";
+    DWV_TRY(dwv_check_pointer(fn, "image", image));
+    DWV_TRY(check_path(fn, path));
+    char message[512];
+    return io_result(fn, dwvio_write_exr(dwv_image_object(image), path, message, sizeof message), message);
+}
+
+/* The display bytes of `img` into `out` (4 x width x height). */
+static dwv_result_t render_display(const char *fn, const dwvb_image *img, const dwv_display_options_t *display,
+                                   uint8_t *out)
+{
+    char message[512];
+    dwv_result_t result = dwvio_to_display(img->rgba, img->width, img->height, display, out, message, sizeof message);
+    return io_result(fn, result, message);
+}
+
+dwv_result_t dwv_image_write_display_png(const dwv_image_t *image, const char *path,
+                                         const dwv_display_options_t *display)
+{
+    static const char fn[] = "dwv_image_write_display_png";
+    DWV_TRY(dwv_check_pointer(fn, "image", image));
+    DWV_TRY(check_path(fn, path));
+    DWV_TRY(check_display(fn, display));
+    const dwvb_image *img = dwv_image_object(image);
+    size_t bytes = (size_t)img->width * img->height * 4u;
+    uint8_t *pixels = malloc(bytes);
+    if (!pixels) return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "%s: no memory for %zu bytes of display pixels", fn, bytes);
+    dwv_result_t result = render_display(fn, img, display, pixels);
+    if (result == DWV_SUCCESS) {
+        char message[512];
+        result = io_result(fn, dwvio_write_png_rgba8(pixels, img->width, img->height, path, message, sizeof message),
+                           message);
+    }
+    free(pixels);
+    return result;
+}
+
+dwv_result_t dwv_image_to_display(const dwv_image_t *image, const dwv_display_options_t *display, uint8_t *rgba8,
+                                  uint64_t size)
+{
+    static const char fn[] = "dwv_image_to_display";
+    DWV_TRY(dwv_check_pointer(fn, "image", image));
+    DWV_TRY(check_display(fn, display));
+    DWV_TRY(dwv_check_pointer(fn, "rgba8", rgba8));
+    const dwvb_image *img = dwv_image_object(image);
+    uint64_t needed = (uint64_t)img->width * img->height * 4u;
+    if (size < needed)
+        return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: size is %llu bytes; %u x %u RGBA pixels need %llu", fn,
+                        (unsigned long long)size, img->width, img->height, (unsigned long long)needed);
+    return render_display(fn, img, display, rgba8);
+}

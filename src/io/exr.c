@@ -1,0 +1,261 @@
+/* OpenEXR output through the OpenEXR core C API (OpenEXR 3.1, openexr.h).
+ *
+ * One scanline part, ZIP compression (lossless, 16 lines per chunk), channels
+ *   R, G, B, A          FLOAT  scene-linear Rec.709 (the chromaticities attribute says which)
+ *   variance.R, .G, .B  FLOAT  the estimated variance of each pixel's mean
+ *   samples.Y           UINT   samples that went into each pixel
+ * and metadata (string unless said):
+ *   dwivedi:version                  library version "major.minor.patch"
+ *   dwivedi:technique                walk technique name ("none" for caller-made pixels)
+ *   dwivedi:samples                  int, samples per pixel (the largest per-pixel count)
+ *   dwivedi:total_samples, dwivedi:events   decimal uint64 (too large for an int attribute)
+ *   dwivedi:seconds                  double, bake time
+ *   dwivedi:estimated_relative_error double (inf when nothing was estimated)
+ *   dwivedi:features                 comma-separated feature names ("" for none)
+ *   dwivedi:feature_bits             int, the DWV_FEATURE_* bits
+ *   dwivedi:error_vs_time            one line per completed pass: "seconds relative_error spp",
+ *                                    %.17g so that the doubles read back exactly
+ * The bytes go through the atomic file helper (a custom write function on its temporary file),
+ * so OpenEXR never opens the target itself. */
+#include "exr.h"
+
+#include <inttypes.h>
+#include <math.h>
+#include <openexr.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "atomic_file.h"
+
+/* What the error handler and the write function share for one file. */
+typedef struct exr_sink {
+    dwvio_atomic_file file;
+} exr_sink;
+
+/* OpenEXR's first message on this thread. OpenEXR delivers messages on the thread that caused
+ * them, while it holds the context's lock (so the handler must not call back into the context). */
+static _Thread_local char exr_message[256];
+
+/* OpenEXR reports through this instead of printing to stderr (the library never prints). */
+static void on_exr_error(exr_const_context_t ctxt, exr_result_t code, const char *msg)
+{
+    (void)ctxt;
+    if (exr_message[0] == '\0')
+        snprintf(exr_message, sizeof exr_message, "%s (%s)", msg ? msg : "", exr_get_error_code_as_string(code));
+}
+
+static int64_t write_to_sink(exr_const_context_t ctxt, void *userdata, const void *buffer, uint64_t sz,
+                             uint64_t offset, exr_stream_error_func_ptr_t error_cb)
+{
+    exr_sink *sink = userdata;
+    if (sz > (uint64_t)INT64_MAX || dwvio_atomic_pwrite(&sink->file, buffer, (size_t)sz, offset) != 0) {
+        if (error_cb) error_cb(ctxt, EXR_ERR_WRITE_IO, "%s", sink->file.message);
+        return -1;
+    }
+    return (int64_t)sz;
+}
+
+/* The names of DWV_FEATURE_* bits, as capi/dwivedi.h lists them. */
+static const char *const feature_names[] = {"embree",        "subsurface",    "closest_point",
+                                            "incident_patches", "rgb_walks", "guided",
+                                            "world_light",   "direct_lights", "diffuse_surfaces"};
+
+static void features_string(uint32_t bits, char *out, size_t size)
+{
+    size_t used = 0u;
+    out[0] = '\0';
+    for (size_t i = 0; i < 32u; ++i) {
+        if (!(bits & (1u << i))) continue;
+        char unknown[24];
+        const char *name = feature_names[0];
+        if (i < sizeof feature_names / sizeof *feature_names) {
+            name = feature_names[i];
+        } else {
+            snprintf(unknown, sizeof unknown, "bit%zu", i);
+            name = unknown;
+        }
+        int n = snprintf(out + used, size - used, "%s%s", used ? "," : "", name);
+        if (n < 0 || (size_t)n >= size - used) return;
+        used += (size_t)n;
+    }
+}
+
+/* "seconds relative_error spp\n" per point; NULL when out of memory. */
+static char *error_series_string(const dwvb_image *image)
+{
+    uint32_t count = image->stats.error_vs_time_count;
+    size_t size = (size_t)count * 72u + 1u;
+    char *text = malloc(size);
+    if (!text) return NULL;
+    size_t used = 0u;
+    text[0] = '\0';
+    for (uint32_t i = 0; i < count; ++i) {
+        const dwv_error_point_t *p = &image->error_vs_time[i];
+        int n = snprintf(text + used, size - used, "%.17g %.17g %" PRIu64 "\n", p->seconds,
+                         p->estimated_relative_error, p->samples_per_pixel);
+        if (n < 0 || (size_t)n >= size - used) break;
+        used += (size_t)n;
+    }
+    return text;
+}
+
+/* Runs one OpenEXR call; on failure formats the message and jumps to the cleanup. */
+#define EXR_CHECK(call, what)                                                                         \
+    do {                                                                                              \
+        exr_result_t exr_check_rv_ = (call);                                                          \
+        if (exr_check_rv_ != EXR_ERR_SUCCESS) {                                                       \
+            snprintf(message, size, "cannot write '%s': %s: %s", path, what,                          \
+                     sink->file.failed        ? sink->file.message                                    \
+                     : exr_message[0]          ? exr_message                                         \
+                                              : exr_get_default_error_message(exr_check_rv_));        \
+            result = DWV_ERROR_IO;                                                                    \
+            goto done;                                                                                \
+        }                                                                                             \
+    } while (0)
+
+static dwv_result_t set_metadata(exr_context_t ctxt, int part, const dwvb_image *image, exr_sink *sink,
+                                 const char *path, char *message, size_t size)
+{
+    dwv_result_t result = DWV_SUCCESS;
+    const dwv_bake_stats_t *stats = &image->stats;
+    /* Rec.709 / sRGB primaries and the D65 white point (ITU-R BT.709-6, Table 1 items 1.3, 1.4). */
+    const exr_attr_chromaticities_t rec709 = {0.640f, 0.330f, 0.300f, 0.600f, 0.150f, 0.060f, 0.3127f, 0.3290f};
+    char features[512], number[32];
+    char *series = NULL;
+    const char *technique = dwv_technique_name(stats->technique);
+    if (stats->samples_per_pixel == 0u) technique = "none"; /* caller-made pixels, not a bake */
+    EXR_CHECK(exr_attr_set_chromaticities(ctxt, part, "chromaticities", &rec709), "chromaticities");
+    EXR_CHECK(exr_attr_set_string(ctxt, part, "dwivedi:version", dwv_version_string()), "metadata");
+    EXR_CHECK(exr_attr_set_string(ctxt, part, "dwivedi:technique", technique ? technique : "unknown"), "metadata");
+    int32_t spp = stats->samples_per_pixel > (uint64_t)INT32_MAX ? INT32_MAX : (int32_t)stats->samples_per_pixel;
+    EXR_CHECK(exr_attr_set_int(ctxt, part, "dwivedi:samples", spp), "metadata");
+    snprintf(number, sizeof number, "%" PRIu64, stats->samples);
+    EXR_CHECK(exr_attr_set_string(ctxt, part, "dwivedi:total_samples", number), "metadata");
+    snprintf(number, sizeof number, "%" PRIu64, stats->events);
+    EXR_CHECK(exr_attr_set_string(ctxt, part, "dwivedi:events", number), "metadata");
+    EXR_CHECK(exr_attr_set_double(ctxt, part, "dwivedi:seconds", stats->seconds), "metadata");
+    double error = stats->samples_per_pixel == 0u ? INFINITY : stats->estimated_relative_error;
+    EXR_CHECK(exr_attr_set_double(ctxt, part, "dwivedi:estimated_relative_error", error), "metadata");
+    features_string(stats->features, features, sizeof features);
+    EXR_CHECK(exr_attr_set_string(ctxt, part, "dwivedi:features", features), "metadata");
+    EXR_CHECK(exr_attr_set_int(ctxt, part, "dwivedi:feature_bits", (int32_t)stats->features), "metadata");
+    series = error_series_string(image);
+    if (!series) {
+        snprintf(message, size, "cannot write '%s': no memory for the error series", path);
+        return DWV_ERROR_OUT_OF_MEMORY;
+    }
+    EXR_CHECK(exr_attr_set_string(ctxt, part, "dwivedi:error_vs_time", series), "metadata");
+done:
+    free(series);
+    return result;
+}
+
+/* One channel's source: interleaved `stride` values per pixel starting at `first`. */
+typedef struct channel_source {
+    const char *name;
+    exr_pixel_type_t type;
+    exr_perceptual_treatment_t percept;
+    const uint8_t *first;
+    int32_t stride; /* bytes from one pixel to the next */
+} channel_source;
+
+dwv_result_t dwvio_write_exr(const dwvb_image *image, const char *path, char *message, size_t size)
+{
+    exr_sink *sink = calloc(1, sizeof *sink);
+    if (!sink) {
+        snprintf(message, size, "cannot write '%s': out of memory", path);
+        return DWV_ERROR_OUT_OF_MEMORY;
+    }
+    exr_message[0] = '\0';
+    dwv_result_t result = dwvio_atomic_open(&sink->file, path, message, size);
+    if (result != DWV_SUCCESS) {
+        free(sink);
+        return result;
+    }
+    const int32_t width = (int32_t)image->width, height = (int32_t)image->height;
+    const channel_source sources[] = {
+        /* The perceptual flag only steers lossy codecs; colour is "logarithmic" by convention. */
+        {"R", EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LOGARITHMIC, (const uint8_t *)(image->rgba + 0), 16},
+        {"G", EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LOGARITHMIC, (const uint8_t *)(image->rgba + 1), 16},
+        {"B", EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LOGARITHMIC, (const uint8_t *)(image->rgba + 2), 16},
+        {"A", EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR, (const uint8_t *)(image->rgba + 3), 16},
+        {"variance.R", EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR, (const uint8_t *)(image->variance + 0), 12},
+        {"variance.G", EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR, (const uint8_t *)(image->variance + 1), 12},
+        {"variance.B", EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR, (const uint8_t *)(image->variance + 2), 12},
+        {"samples.Y", EXR_PIXEL_UINT, EXR_PERCEPTUALLY_LINEAR, (const uint8_t *)image->samples, 4},
+    };
+    const size_t source_count = sizeof sources / sizeof *sources;
+
+    exr_context_t ctxt = NULL;
+    exr_encode_pipeline_t encoder;
+    int encoder_ready = 0;
+    memset(&encoder, 0, sizeof encoder);
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    init.error_handler_fn = on_exr_error;
+    init.user_data = sink;
+    init.write_fn = write_to_sink;
+    int part = 0;
+    EXR_CHECK(exr_start_write(&ctxt, path, EXR_WRITE_FILE_DIRECTLY, &init), "starting");
+    /* "dwivedi:estimated_relative_error" has 32 characters: the long-name flag (OpenEXR >= 1.7
+     * readers) allows up to 255. */
+    EXR_CHECK(exr_set_longname_support(ctxt, 1), "long names");
+    EXR_CHECK(exr_add_part(ctxt, "rgba", EXR_STORAGE_SCANLINE, &part), "adding the part");
+    EXR_CHECK(exr_initialize_required_attr_simple(ctxt, part, width, height, EXR_COMPRESSION_ZIP), "header");
+    for (size_t c = 0; c < source_count; ++c)
+        EXR_CHECK(exr_add_channel(ctxt, part, sources[c].name, sources[c].type, sources[c].percept, 1, 1), "channels");
+    result = set_metadata(ctxt, part, image, sink, path, message, size);
+    if (result != DWV_SUCCESS) goto done;
+    EXR_CHECK(exr_write_header(ctxt), "header");
+
+    int32_t lines_per_chunk = 1;
+    EXR_CHECK(exr_get_scanlines_per_chunk(ctxt, part, &lines_per_chunk), "chunk layout");
+    for (int32_t y = 0; y < height; y += lines_per_chunk) {
+        exr_chunk_info_t chunk;
+        EXR_CHECK(exr_write_scanline_chunk_info(ctxt, part, y, &chunk), "chunk");
+        if (!encoder_ready) {
+            EXR_CHECK(exr_encoding_initialize(ctxt, part, &chunk, &encoder), "encoder");
+            encoder_ready = 1;
+        } else {
+            EXR_CHECK(exr_encoding_update(ctxt, part, &chunk, &encoder), "encoder");
+        }
+        /* The encoder lists channels sorted by name; find each one's source by name. */
+        for (int16_t c = 0; c < encoder.channel_count; ++c) {
+            exr_coding_channel_info_t *channel = &encoder.channels[c];
+            const channel_source *source = NULL;
+            for (size_t s = 0; s < source_count; ++s)
+                if (strcmp(channel->channel_name, sources[s].name) == 0) source = &sources[s];
+            if (!source) {
+                snprintf(message, size, "cannot write '%s': OpenEXR listed an unknown channel '%s'", path,
+                         channel->channel_name);
+                result = DWV_ERROR_INTERNAL;
+                goto done;
+            }
+            channel->user_pixel_stride = source->stride;
+            channel->user_line_stride = source->stride * width;
+            channel->user_bytes_per_element = 4;
+            channel->user_data_type = (uint16_t)source->type;
+            channel->encode_from_ptr = source->first + (size_t)chunk.start_y * (size_t)width * (size_t)source->stride;
+        }
+        if (y == 0) EXR_CHECK(exr_encoding_choose_default_routines(ctxt, part, &encoder), "encoder");
+        EXR_CHECK(exr_encoding_run(ctxt, part, &encoder), "encoding pixels");
+    }
+
+done:
+    if (encoder_ready) exr_encoding_destroy(ctxt, &encoder);
+    if (ctxt) {
+        /* exr_finish writes the chunk offset table: its failure is a failed file too. */
+        exr_result_t finished = exr_finish(&ctxt);
+        if (result == DWV_SUCCESS && finished != EXR_ERR_SUCCESS) {
+            snprintf(message, size, "cannot write '%s': finishing: %s", path,
+                     sink->file.failed ? sink->file.message : exr_get_default_error_message(finished));
+            result = DWV_ERROR_IO;
+        }
+    }
+    if (result == DWV_SUCCESS)
+        result = dwvio_atomic_commit(&sink->file, message, size);
+    else
+        dwvio_atomic_abort(&sink->file);
+    free(sink);
+    return result;
+}
