@@ -410,9 +410,10 @@ typedef struct dwv_material_t {
     double base_color[3];         /* in [0, 1] */
     double subsurface_weight;     /* in [0, 1] */
     double subsurface_color[3];   /* in [0, 1] */
-    double subsurface_radius[3];  /* >= 0, finite; a channel of radius 0 does not scatter */
+    double subsurface_radius[3];  /* >= 0, finite; a channel whose radius x scale is below 1e-8 is
+                                     Lambertian diffuse of subsurface_color instead (as Cycles) */
     double subsurface_scale;      /* >= 0, finite */
-    double subsurface_anisotropy; /* Henyey-Greenstein g in (-1, 1); Cycles clamps to [-0.9, 0.9] */
+    double subsurface_anisotropy; /* Henyey-Greenstein g in (-1, 1); used clamped to [0, 0.9], as Cycles */
     double subsurface_ior;        /* in [1, 4]; kept for compatibility (Cycles' walk ignores it) */
 } dwv_material_t;
 #define DWV_MATERIAL_INIT                                                                           \

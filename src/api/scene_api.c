@@ -267,6 +267,24 @@ dwv_result_t dwv_scene_commit(dwv_scene_t *scene)
     static const char fn[] = "dwv_scene_commit";
     dwvb_scene *s;
     DWV_TRY(open_scene(fn, scene, &s));
-    s->committed = 1;
+    char message[256];
+    dwv_result_t result = dwvb_scene_commit(s, message, sizeof message);
+    if (result != DWV_SUCCESS) return dwv_fail(result, "%s: %s", fn, message);
     return DWV_SUCCESS;
+}
+
+const char *dwv_feature_name(uint32_t feature)
+{
+    switch (feature) {
+    case DWV_FEATURE_EMBREE: return "embree";
+    case DWV_FEATURE_SUBSURFACE: return "subsurface";
+    case DWV_FEATURE_CLOSEST_POINT: return "closest_point";
+    case DWV_FEATURE_INCIDENT_PATCHES: return "incident_patches";
+    case DWV_FEATURE_RGB_WALKS: return "rgb_walks";
+    case DWV_FEATURE_GUIDED: return "guided";
+    case DWV_FEATURE_WORLD_LIGHT: return "world_light";
+    case DWV_FEATURE_DIRECT_LIGHTS: return "direct_lights";
+    case DWV_FEATURE_DIFFUSE_SURFACES: return "diffuse_surfaces";
+    default: return NULL;
+    }
 }

@@ -1,7 +1,14 @@
 #include "scene.h"
 
+#include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "kernel/rng.h"
+#include "light/direct.h"
+
+static dwv_result_t uncommit(dwvb_scene *scene, dwv_result_t result);
 
 dwvb_scene *dwvb_scene_new(void)
 {
@@ -14,6 +21,7 @@ dwvb_scene *dwvb_scene_new(void)
 void dwvb_scene_free(dwvb_scene *scene)
 {
     if (!scene) return;
+    uncommit(scene, DWV_SUCCESS);
     for (uint32_t i = 0; i < scene->mesh_count; ++i) dwvg_mesh_free(&scene->meshes[i]);
     free(scene->meshes);
     free(scene->materials);
@@ -57,4 +65,147 @@ int dwvb_scene_push_light(dwvb_scene *scene, const dwv_light_desc_t *light)
     scene->lights = grown;
     scene->lights[scene->light_count++] = *light;
     return 0;
+}
+
+int dwvb_scene_world_lit(const dwvb_scene *scene)
+{
+    return scene->world[0] > 0.0 || scene->world[1] > 0.0 || scene->world[2] > 0.0;
+}
+
+/* Surface points per subsurface mesh whose irradiance makes its lit patches. */
+#define PATCH_POINTS 1024u
+#define PATCH_SEED 0x6c69745f70617463ull
+
+static double luminance(const double rgb[3])
+{
+    return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
+}
+
+/* The lit patches of a mesh for the incident technique (Meng et al. 2016, Sec. 4.3): PATCH_POINTS
+ * area-uniform surface points, each with its irradiance from the lights and the world (shadow
+ * rays included), grouped by the dominant axis of their normal into at most six patches: power =
+ * sum of irradiance x area per point, point and normal = their irradiance-weighted means. Returns
+ * the count, or -1 out of memory. */
+static int make_patches(const dwvb_scene *scene, const dwvl_environment *env, uint32_t mesh_id,
+                        dwvw_light_patch *patches)
+{
+    const dwvg_mesh *mesh = &scene->meshes[mesh_id];
+    double *cdf = malloc((size_t)mesh->triangle_count * sizeof *cdf);
+    if (!cdf) return -1;
+    double total = 0.0;
+    for (uint32_t t = 0; t < mesh->triangle_count; ++t) {
+        total += dwvg_triangle_area(mesh, t);
+        cdf[t] = total;
+    }
+    double power[6] = {0}, weight_sum[6] = {0};
+    dwvw_vec3 point[6], normal[6];
+    for (int b = 0; b < 6; ++b) point[b] = normal[b] = dwvw_v(0.0, 0.0, 0.0);
+    if (total > 0.0 && isfinite(total)) {
+        double area_per_point = total / PATCH_POINTS;
+        for (uint32_t i = 0; i < PATCH_POINTS; ++i) {
+            uint64_t key = dwvk_rng_key(PATCH_SEED, mesh_id, i);
+            double target = dwvk_rng_uniform_d(key, 0) * total;
+            uint32_t lo = 0, hi = mesh->triangle_count - 1u;
+            while (lo < hi) {
+                uint32_t mid = lo + (hi - lo) / 2u;
+                if (cdf[mid] > target) hi = mid;
+                else lo = mid + 1u;
+            }
+            double su = sqrt(dwvk_rng_uniform_d(key, 1)), v = dwvk_rng_uniform_d(key, 2);
+            double b1 = su * (1.0 - v), b2 = su * v; /* uniform on the triangle */
+            dwvw_vec3 ng = dwvg_geometric_normal(mesh, lo);
+            if (ng.x == 0.0 && ng.y == 0.0 && ng.z == 0.0) continue;
+            dwvw_vec3 x = dwvg_point(mesh, lo, b1, b2);
+            double radiance[3];
+            dwvl_direct(env, x, ng, ng, key, 3u, radiance);
+            /* The Lambertian estimate is irradiance / pi. */
+            double e = 3.14159265358979323846 * luminance(radiance);
+            if (!(e > 0.0)) continue;
+            double ax = fabs(ng.x), ay = fabs(ng.y), az = fabs(ng.z);
+            int bin = ax >= ay && ax >= az ? (ng.x > 0.0 ? 0 : 1) : ay >= az ? (ng.y > 0.0 ? 2 : 3) : (ng.z > 0.0 ? 4 : 5);
+            power[bin] += e * area_per_point;
+            weight_sum[bin] += e;
+            point[bin] = dwvw_madd(point[bin], x, e);
+            normal[bin] = dwvw_madd(normal[bin], ng, e);
+        }
+    }
+    free(cdf);
+    double largest = 0.0;
+    for (int b = 0; b < 6; ++b) largest = fmax(largest, power[b]);
+    int count = 0;
+    for (int b = 0; b < 6; ++b) {
+        double length = dwvw_length(normal[b]);
+        if (!(power[b] > 1e-6 * largest) || !(length > 0.0)) continue;
+        dwvw_light_patch p = {.point = dwvw_scale(point[b], 1.0 / weight_sum[b]),
+                              .normal = dwvw_scale(normal[b], 1.0 / length), .power = power[b], .is_plane = 0};
+        patches[count++] = p;
+    }
+    return count;
+}
+
+/* Drops what a failed commit made, so that the scene is as before and may be committed again. */
+static dwv_result_t uncommit(dwvb_scene *scene, dwv_result_t result)
+{
+    if (scene->geometry.device) dwvg_world_free(&scene->geometry);
+    free(scene->shading);
+    free(scene->emitters);
+    free(scene->patches);
+    free(scene->patch_count);
+    scene->shading = NULL;
+    scene->emitters = NULL;
+    scene->patches = NULL;
+    scene->patch_count = NULL;
+    return result;
+}
+
+dwv_result_t dwvb_scene_commit(dwvb_scene *scene, char *message, size_t size)
+{
+    uint32_t nm = scene->material_count, nl = scene->light_count, nmesh = scene->mesh_count;
+    scene->shading = calloc(nm ? nm : 1u, sizeof *scene->shading);
+    scene->emitters = calloc(nl ? nl : 1u, sizeof *scene->emitters);
+    scene->patches = calloc(nmesh ? nmesh : 1u, sizeof *scene->patches);
+    scene->patch_count = calloc(nmesh ? nmesh : 1u, sizeof *scene->patch_count);
+    if (!scene->shading || !scene->emitters || !scene->patches || !scene->patch_count) {
+        snprintf(message, size, "out of memory");
+        return uncommit(scene, DWV_ERROR_OUT_OF_MEMORY);
+    }
+    for (uint32_t i = 0; i < nm; ++i) dwvb_material_init(&scene->shading[i], &scene->materials[i]);
+    for (uint32_t i = 0; i < nl; ++i) dwvl_light_init(&scene->emitters[i], &scene->lights[i]);
+    uint32_t features = 0;
+    if (nmesh > 0) {
+        if (dwvg_world_build(&scene->geometry, scene->meshes, nmesh, message, size)) {
+            /* dwvg_world_build freed its own part and says whether Embree or memory failed. */
+            return uncommit(scene, strstr(message, "Embree") ? DWV_ERROR_INTERNAL : DWV_ERROR_OUT_OF_MEMORY);
+        }
+        scene->warnings = scene->geometry.warnings;
+        features |= DWV_FEATURE_EMBREE;
+    }
+    int world_lit = dwvb_scene_world_lit(scene);
+    if (world_lit) features |= DWV_FEATURE_WORLD_LIGHT;
+    int lights_lit = 0;
+    for (uint32_t i = 0; i < nl; ++i)
+        for (int c = 0; c < 3; ++c) lights_lit |= scene->emitters[i].emission[c] > 0.0;
+    if (lights_lit) features |= DWV_FEATURE_DIRECT_LIGHTS;
+    dwvl_environment env = {.lights = scene->emitters, .light_count = nl, .world_lit = world_lit,
+                            .geometry = nmesh > 0 ? &scene->geometry : NULL};
+    for (int c = 0; c < 3; ++c) env.world[c] = scene->world[c];
+    for (uint32_t m = 0; m < nmesh; ++m) {
+        const dwvb_material *material = &scene->shading[scene->meshes[m].material_id];
+        if (material->diffuse_albedo[0] > 0.0 || material->diffuse_albedo[1] > 0.0 || material->diffuse_albedo[2] > 0.0)
+            features |= DWV_FEATURE_DIFFUSE_SURFACES;
+        if (!material->subsurface) continue;
+        features |= DWV_FEATURE_SUBSURFACE;
+        if (!material->grey) features |= DWV_FEATURE_RGB_WALKS;
+        if (!lights_lit && !world_lit) continue;
+        int count = make_patches(scene, &env, m, scene->patches[m]);
+        if (count < 0) {
+            snprintf(message, size, "out of memory while finding the lit patches of mesh %u", m);
+            return uncommit(scene, DWV_ERROR_OUT_OF_MEMORY);
+        }
+        scene->patch_count[m] = count;
+        if (count > 0) features |= DWV_FEATURE_INCIDENT_PATCHES;
+    }
+    scene->features = features;
+    scene->committed = 1;
+    return DWV_SUCCESS;
 }

@@ -4,10 +4,15 @@
 #define DWV_BAKE_SCENE_H
 
 #include <stdatomic.h>
+#include <stddef.h>
 #include <stdint.h>
 
+#include "bake/material.h"
 #include "dwivedi.h"
+#include "geom/embree.h"
 #include "geom/mesh.h"
+#include "light/light.h"
+#include "walk/walk.h"
 
 /* Absurd counts are refused before anything is allocated. */
 #define DWVB_MAX_MATERIALS (1u << 16)
@@ -26,6 +31,15 @@ typedef struct dwvb_scene {
     double world[3];     /* constant world radiance: colour x strength */
     int have_camera;
     dwv_camera_t camera; /* validated; rotation columns orthonormal */
+
+    /* Made by dwvb_scene_commit, read-only afterwards (bakes share them across threads). */
+    dwvg_world geometry;       /* built when there is a mesh */
+    dwvb_material *shading;    /* per material */
+    dwvl_light *emitters;      /* per light */
+    dwvw_light_patch (*patches)[DWVW_MAX_PATCHES]; /* per mesh: lit patches of subsurface meshes */
+    int *patch_count;          /* per mesh */
+    uint32_t features;         /* DWV_FEATURE_* the scene can use (bakes narrow it by technique) */
+    uint64_t warnings;         /* degenerate or non-finite triangles */
 } dwvb_scene;
 
 dwvb_scene *dwvb_scene_new(void);
@@ -34,5 +48,13 @@ void dwvb_scene_free(dwvb_scene *scene);
 int dwvb_scene_push_material(dwvb_scene *scene, const dwv_material_t *material);
 int dwvb_scene_push_mesh(dwvb_scene *scene, const dwvg_mesh *mesh);
 int dwvb_scene_push_light(dwvb_scene *scene, const dwv_light_desc_t *light);
+
+/* Freezes the scene: builds the Embree world, the materials' media, the lights, the lit patches
+ * of each subsurface mesh (for the incident technique) and the feature analysis. On failure
+ * returns the code with a message in `message` and leaves the scene uncommitted. */
+dwv_result_t dwvb_scene_commit(dwvb_scene *scene, char *message, size_t size);
+
+/* Whether the world (constant environment) gives light. */
+int dwvb_scene_world_lit(const dwvb_scene *scene);
 
 #endif

@@ -1,0 +1,149 @@
+/* capi entry points of bakes: options checked against the committed scene, the bake handle
+ * holding a reference to its scene while it lives. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdlib.h>
+#include <unistd.h>
+
+#include "bake/bake.h"
+#include "dwivedi.h"
+#include "error.h"
+#include "image_handle.h"
+#include "scene_handle.h"
+
+#define MAX_SIDE 16384u
+#define MAX_PIXELS (1u << 26)
+#define MAX_SAMPLES (1ull << 24)
+#define MAX_THREADS 1024u
+#define MAX_MARGIN 64u
+#define DEFAULT_TILE 32u
+#define DEFAULT_MAX_EVENTS 1000000u
+
+struct dwv_bake_s {
+    dwvb_bake *bake;
+    dwv_scene_t *scene;
+};
+
+static dwv_result_t check_options(const char *fn, const dwvb_scene *s, const dwv_bake_options_t *o)
+{
+    if (o->target != DWV_BAKE_CAMERA && o->target != DWV_BAKE_UV)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: target %d is neither camera (0) nor UV (1)", fn, (int)o->target);
+    if (o->width < 1u || o->height < 1u || o->width > MAX_SIDE || o->height > MAX_SIDE ||
+        (uint64_t)o->width * o->height > MAX_PIXELS)
+        return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: %u x %u pixels: each side must be 1 to %u and at most %u pixels",
+                        fn, o->width, o->height, MAX_SIDE, MAX_PIXELS);
+    if (o->technique < DWV_TECHNIQUE_AUTO || o->technique > DWV_TECHNIQUE_CYCLES)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: technique %d is not known", fn, (int)o->technique);
+    if (o->samples < 1u || o->samples > MAX_SAMPLES)
+        return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: samples = %llu is outside [1, %llu]", fn,
+                        (unsigned long long)o->samples, MAX_SAMPLES);
+    DWV_TRY(dwv_check_range(fn, "time_limit", o->time_limit, 0.0, HUGE_VAL));
+    DWV_TRY(dwv_check_range(fn, "target_error", o->target_error, 0.0, HUGE_VAL));
+    if (o->threads > MAX_THREADS)
+        return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: threads = %u is above %u", fn, o->threads, MAX_THREADS);
+    if (o->target == DWV_BAKE_CAMERA) {
+        if (!s->have_camera)
+            return dwv_fail(DWV_ERROR_INVALID_STATE, "%s: a camera bake needs a camera (dwv_scene_set_camera)", fn);
+    } else {
+        if (o->uv_mesh >= s->mesh_count)
+            return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: uv_mesh = %u but the scene has %u mesh(es)", fn, o->uv_mesh,
+                            s->mesh_count);
+        if (!s->meshes[o->uv_mesh].uvs)
+            return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: uv_mesh %u has no UVs", fn, o->uv_mesh);
+        if (o->uv_margin > MAX_MARGIN)
+            return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: uv_margin = %u is above %u", fn, o->uv_margin, MAX_MARGIN);
+    }
+    return DWV_SUCCESS;
+}
+
+dwv_result_t dwv_bake_start(dwv_scene_t *scene, const dwv_bake_options_t *options, dwv_bake_t **bake)
+{
+    static const char fn[] = "dwv_bake_start";
+    DWV_TRY(dwv_check_pointer(fn, "bake", bake));
+    *bake = NULL;
+    DWV_TRY(dwv_check_pointer(fn, "scene", scene));
+    DWV_TRY(dwv_check_struct(fn, "options", options, (uint32_t)sizeof(dwv_bake_options_t)));
+    dwvb_scene *s = dwv_scene_object(scene);
+    if (!s->committed) return dwv_fail(DWV_ERROR_INVALID_STATE, "%s: the scene is not committed (dwv_scene_commit)", fn);
+    DWV_TRY(check_options(fn, s, options));
+    dwv_bake_options_t resolved = *options;
+    resolved.struct_size = (uint32_t)sizeof resolved;
+    if (resolved.threads == 0u) {
+        long cores = sysconf(_SC_NPROCESSORS_ONLN);
+        resolved.threads = cores < 1 ? 1u : cores > (long)MAX_THREADS ? MAX_THREADS : (uint32_t)cores;
+    }
+    if (resolved.tile_size == 0u) resolved.tile_size = DEFAULT_TILE;
+    if (resolved.max_events == 0u) resolved.max_events = DEFAULT_MAX_EVENTS;
+    dwv_bake_t *handle = calloc(1, sizeof *handle);
+    if (!handle) return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "%s: out of memory", fn);
+    char message[256];
+    dwv_result_t result = dwvb_bake_start(s, &resolved, &handle->bake, message, sizeof message);
+    if (result != DWV_SUCCESS) {
+        free(handle);
+        return dwv_fail(result, "%s: %s", fn, message);
+    }
+    atomic_fetch_add(&s->references, 1u);
+    handle->scene = scene;
+    *bake = handle;
+    return DWV_SUCCESS;
+}
+
+dwv_result_t dwv_bake_wait(dwv_bake_t *bake, double timeout_seconds, int32_t *done)
+{
+    static const char fn[] = "dwv_bake_wait";
+    DWV_TRY(dwv_check_pointer(fn, "bake", bake));
+    DWV_TRY(dwv_check_pointer(fn, "done", done));
+    if (isnan(timeout_seconds)) return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: timeout_seconds is NaN", fn);
+    *done = dwvb_bake_wait(bake->bake, timeout_seconds);
+    return DWV_SUCCESS;
+}
+
+dwv_result_t dwv_bake_progress(dwv_bake_t *bake, dwv_bake_progress_t *progress)
+{
+    static const char fn[] = "dwv_bake_progress";
+    DWV_TRY(dwv_check_pointer(fn, "bake", bake));
+    DWV_TRY(dwv_check_struct(fn, "progress", progress, (uint32_t)sizeof(dwv_bake_progress_t)));
+    dwvb_bake_progress(bake->bake, progress);
+    return DWV_SUCCESS;
+}
+
+dwv_result_t dwv_bake_cancel(dwv_bake_t *bake)
+{
+    DWV_TRY(dwv_check_pointer("dwv_bake_cancel", "bake", bake));
+    dwvb_bake_cancel(bake->bake);
+    return DWV_SUCCESS;
+}
+
+dwv_result_t dwv_bake_finish(dwv_bake_t *bake, dwv_image_t **image)
+{
+    static const char fn[] = "dwv_bake_finish";
+    DWV_TRY(dwv_check_pointer(fn, "bake", bake));
+    DWV_TRY(dwv_check_pointer(fn, "image", image));
+    *image = NULL;
+    dwvb_image *made = NULL;
+    char message[256];
+    dwv_result_t result = dwvb_bake_finish(bake->bake, &made, message, sizeof message);
+    if (result != DWV_SUCCESS) return dwv_fail(result, "%s: %s", fn, message);
+    *image = dwv_image_handle(made);
+    return DWV_SUCCESS;
+}
+
+void dwv_bake_release(dwv_bake_t *bake)
+{
+    if (!bake) return;
+    dwvb_bake_free(bake->bake);
+    dwv_scene_release(bake->scene);
+    free(bake);
+}
+
+dwv_result_t dwv_bake(dwv_scene_t *scene, const dwv_bake_options_t *options, dwv_image_t **image)
+{
+    static const char fn[] = "dwv_bake";
+    DWV_TRY(dwv_check_pointer(fn, "image", image));
+    *image = NULL;
+    dwv_bake_t *bake;
+    DWV_TRY(dwv_bake_start(scene, options, &bake));
+    dwv_result_t result = dwv_bake_finish(bake, image);
+    dwv_bake_release(bake);
+    return result;
+}

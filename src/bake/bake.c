@@ -1,0 +1,605 @@
+#define _POSIX_C_SOURCE 200809L
+#include "bake.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "bake/shade.h"
+#include "bake/uv_raster.h"
+#include "kernel/rng.h"
+
+/* The walk's random numbers come from a stream of their own: bit 63 of the stream marks it. */
+#define WALK_STREAM 0x8000000000000000ull
+#define PROGRESS_PERIOD 0.1 /* seconds between progress callbacks */
+
+typedef struct pixel_sums {
+    double sum[3], sum_squares[3];
+    double sum_alpha, sum_luminance_squares;
+} pixel_sums;
+
+struct dwvb_bake {
+    const dwvb_scene *scene;
+    dwv_bake_options_t options;
+    uint32_t width, height, threads;
+    dwvb_shader shader;
+    dwvw_guide *guides;
+    int *needs_closest;
+    uint32_t features;
+    /* camera */
+    dwvw_vec3 eye, right, up, forward; /* right/up scaled to the image's half extents */
+    /* UV */
+    dwvb_uv_raster raster;
+    /* accumulation */
+    pixel_sums *sums;
+    uint32_t *counts;
+    uint32_t tiles_x, tile_count;
+    dwvb_tally *tile_tallies;
+    uint64_t pass_first, pass_end; /* sample indices of the running pass */
+    atomic_uint next_tile;
+    atomic_uint tiles_done;
+    atomic_int time_up;
+    atomic_int cancelled;
+    atomic_uint_fast64_t events;
+    struct timespec start;
+    uint64_t spp_done;
+    double error;
+    /* control */
+    pthread_t control;
+    int control_started, joined;
+    pthread_mutex_t lock;
+    pthread_cond_t changed; /* workers finished, or the bake ended */
+    uint32_t workers_running;
+    int done;
+    dwv_result_t result;
+    char message[256];
+    dwvb_image *image;
+    dwv_bake_progress_t progress;
+};
+
+static double elapsed(const dwvb_bake *bake)
+{
+    struct timespec now;
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    return (double)(now.tv_sec - bake->start.tv_sec) + 1e-9 * (double)(now.tv_nsec - bake->start.tv_nsec);
+}
+
+static double luminance(const double rgb[3])
+{
+    return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
+}
+
+/* One camera sample through pixel (x, row). Blender's camera: local -z forward, +y up, the
+ * sensor (or ortho_scale) across the larger image side; a box filter over the pixel. */
+static void camera_sample(const dwvb_bake *bake, uint32_t x, uint32_t row, uint64_t key, dwvw_vec3 *origin,
+                          dwvw_vec3 *direction)
+{
+    double sx = 2.0 * ((double)x + dwvk_rng_uniform_d(key, 0)) / bake->width - 1.0;
+    double sy = 1.0 - 2.0 * ((double)row + dwvk_rng_uniform_d(key, 1)) / bake->height;
+    dwvw_vec3 offset = dwvw_add(dwvw_scale(bake->right, sx), dwvw_scale(bake->up, sy));
+    if (bake->scene->camera.kind == DWV_CAMERA_PERSPECTIVE) {
+        *origin = bake->eye;
+        *direction = dwvw_normalize(dwvw_add(bake->forward, offset));
+    } else {
+        *origin = dwvw_add(bake->eye, offset);
+        *direction = bake->forward;
+    }
+}
+
+/* The dimensions of the shading key used before shading: camera jitter. */
+#define PIXEL_DIMS 2u
+
+static void sample_pixel(dwvb_bake *bake, uint32_t index, uint64_t s, double rgb[3], double *alpha, dwvb_tally *tally)
+{
+    uint64_t key = dwvk_rng_key(bake->options.seed, index, s);
+    uint64_t key_walk = dwvk_rng_key(bake->options.seed, WALK_STREAM | index, s);
+    uint32_t x = index % bake->width, row = index / bake->width;
+    dwvg_hit hit;
+    dwvw_vec3 view;
+    if (bake->options.target == DWV_BAKE_CAMERA) {
+        dwvw_vec3 origin;
+        camera_sample(bake, x, row, key, &origin, &view);
+        if (!(bake->scene->mesh_count > 0 && dwvg_intersect(&bake->scene->geometry, origin, view, 0.0, INFINITY, &hit))) {
+            for (int c = 0; c < 3; ++c) rgb[c] = bake->scene->world[c];
+            *alpha = 0.0;
+            return;
+        }
+    } else {
+        /* The texel centre's surface point, seen along its normal: the radiance leaving along n. */
+        const dwvb_uv_texel *texel = &bake->raster.texels[index];
+        hit.mesh = bake->options.uv_mesh;
+        hit.prim = (uint32_t)texel->triangle;
+        hit.u = texel->b1;
+        hit.v = texel->b2;
+        hit.t = 0.0;
+        const dwvg_mesh *mesh = &bake->scene->meshes[hit.mesh];
+        view = dwvw_scale(dwvg_geometric_normal(mesh, hit.prim), -1.0);
+    }
+    dwvb_shade(&bake->shader, &hit, view, key, PIXEL_DIMS, key_walk, rgb, tally);
+    *alpha = 1.0;
+    if (!(isfinite(rgb[0]) && isfinite(rgb[1]) && isfinite(rgb[2]))) {
+        ++tally->warnings;
+        rgb[0] = rgb[1] = rgb[2] = 0.0;
+    }
+}
+
+static int pixel_active(const dwvb_bake *bake, uint32_t index)
+{
+    return bake->options.target == DWV_BAKE_CAMERA || bake->raster.texels[index].triangle >= 0;
+}
+
+static void *worker(void *arg)
+{
+    dwvb_bake *bake = arg;
+    uint32_t tile_size = bake->options.tile_size;
+    for (;;) {
+        if (atomic_load(&bake->cancelled)) break;
+        if (bake->options.time_limit > 0.0 && elapsed(bake) >= bake->options.time_limit) {
+            atomic_store(&bake->time_up, 1);
+            break;
+        }
+        uint32_t tile = atomic_fetch_add(&bake->next_tile, 1u);
+        if (tile >= bake->tile_count) break;
+        uint32_t x0 = (tile % bake->tiles_x) * tile_size, y0 = (tile / bake->tiles_x) * tile_size;
+        uint32_t x1 = x0 + tile_size < bake->width ? x0 + tile_size : bake->width;
+        uint32_t y1 = y0 + tile_size < bake->height ? y0 + tile_size : bake->height;
+        dwvb_tally *tally = &bake->tile_tallies[tile];
+        uint64_t events_before = tally->events;
+        for (uint32_t y = y0; y < y1; ++y) {
+            for (uint32_t x = x0; x < x1; ++x) {
+                uint32_t index = y * bake->width + x;
+                if (!pixel_active(bake, index)) continue;
+                pixel_sums *p = &bake->sums[index];
+                for (uint64_t s = bake->pass_first; s < bake->pass_end; ++s) {
+                    /* Checked per sample: a sample ends within max_events, so cancel is quick. */
+                    if (atomic_load_explicit(&bake->cancelled, memory_order_relaxed)) goto out;
+                    double rgb[3], alpha;
+                    sample_pixel(bake, index, s, rgb, &alpha, tally);
+                    for (int c = 0; c < 3; ++c) {
+                        p->sum[c] += rgb[c];
+                        p->sum_squares[c] += rgb[c] * rgb[c];
+                    }
+                    double l = luminance(rgb);
+                    p->sum_luminance_squares += l * l;
+                    p->sum_alpha += alpha;
+                    ++bake->counts[index];
+                }
+            }
+        }
+        atomic_fetch_add(&bake->events, tally->events - events_before);
+        atomic_fetch_add(&bake->tiles_done, 1u);
+    }
+out:
+    pthread_mutex_lock(&bake->lock);
+    --bake->workers_running;
+    pthread_cond_broadcast(&bake->changed);
+    pthread_mutex_unlock(&bake->lock);
+    return NULL;
+}
+
+/* Whether pixel `index` counts in the image's error and mean: UV texels of the islands; camera
+ * pixels that saw a surface (all pixels when none did). */
+static int covered(const dwvb_bake *bake, uint32_t index, int any_surface)
+{
+    if (bake->options.target == DWV_BAKE_UV) return bake->raster.texels[index].triangle >= 0;
+    return !any_surface || bake->sums[index].sum_alpha > 0.0;
+}
+
+static int any_surface_seen(const dwvb_bake *bake)
+{
+    if (bake->options.target != DWV_BAKE_CAMERA) return 1;
+    size_t pixels = (size_t)bake->width * bake->height;
+    for (size_t i = 0; i < pixels; ++i)
+        if (bake->sums[i].sum_alpha > 0.0) return 1;
+    return 0;
+}
+
+/* The variance of a pixel's mean from its sums: (sum x^2 - (sum x)^2 / n) / (n (n - 1)); 0 below
+ * two samples (unknown, see dwvb_estimate_error). */
+static double mean_variance(double sum, double sum_squares, uint32_t n)
+{
+    if (n < 2u) return 0.0;
+    double v = (sum_squares - sum * sum / n) / ((double)n * (n - 1u));
+    return v > 0.0 ? v : 0.0;
+}
+
+/* sqrt(sum of pixel-mean luminance variances) / sum of pixel-mean luminances over the covered
+ * pixels: the relative standard error of the image's mean. +inf while a covered pixel has fewer
+ * than two samples, 0 for an image that is black with no variance. */
+static double estimate_error(const dwvb_bake *bake)
+{
+    int any = any_surface_seen(bake);
+    size_t pixels = (size_t)bake->width * bake->height;
+    double variance = 0.0, total = 0.0;
+    for (size_t i = 0; i < pixels; ++i) {
+        if (!covered(bake, (uint32_t)i, any)) continue;
+        uint32_t n = bake->counts[i];
+        if (n < 2u) return INFINITY;
+        const pixel_sums *p = &bake->sums[i];
+        double l = luminance(p->sum);
+        total += l / n;
+        variance += mean_variance(l, p->sum_luminance_squares, n);
+    }
+    if (variance == 0.0) return 0.0;
+    return total > 0.0 ? sqrt(variance) / total : INFINITY;
+}
+
+static double fraction_done(dwvb_bake *bake)
+{
+    double pass_share = bake->tile_count ? (double)atomic_load(&bake->tiles_done) / bake->tile_count : 0.0;
+    double spp = (double)bake->spp_done + pass_share * (double)(bake->pass_end - bake->pass_first);
+    double f = spp / (double)bake->options.samples;
+    if (bake->options.time_limit > 0.0) f = fmax(f, elapsed(bake) / bake->options.time_limit);
+    /* The error falls as 1/sqrt(samples): (target / error)^2 is the share of samples done. */
+    if (bake->options.target_error > 0.0 && isfinite(bake->error) && bake->error > 0.0)
+        f = fmax(f, (bake->options.target_error / bake->error) * (bake->options.target_error / bake->error));
+    return fmin(fmax(f, 0.0), 1.0);
+}
+
+/* Refreshes the shared progress and calls the callback (outside the lock). */
+static void report(dwvb_bake *bake, int done)
+{
+    dwv_bake_progress_t p = DWV_BAKE_PROGRESS_INIT;
+    p.done = (uint32_t)done;
+    p.fraction = done && bake->result == DWV_SUCCESS ? 1.0 : fraction_done(bake);
+    p.seconds = elapsed(bake);
+    p.estimated_relative_error = bake->error;
+    p.samples_per_pixel = bake->spp_done;
+    p.events = (uint64_t)atomic_load(&bake->events);
+    pthread_mutex_lock(&bake->lock);
+    bake->progress = p;
+    pthread_mutex_unlock(&bake->lock);
+    if (bake->options.progress && bake->options.progress(bake->options.progress_user, &p) != 0)
+        atomic_store(&bake->cancelled, 1);
+}
+
+static void timed_wait(dwvb_bake *bake, double seconds)
+{
+    struct timespec until;
+    clock_gettime(CLOCK_MONOTONIC, &until);
+    double whole = floor(seconds);
+    until.tv_sec += (time_t)whole;
+    until.tv_nsec += (long)((seconds - whole) * 1e9);
+    if (until.tv_nsec >= 1000000000L) {
+        until.tv_sec += 1;
+        until.tv_nsec -= 1000000000L;
+    }
+    pthread_cond_timedwait(&bake->changed, &bake->lock, &until);
+}
+
+/* Runs one pass on `threads` workers while reporting progress; 0, or -1 if threads could not start. */
+static int run_pass(dwvb_bake *bake)
+{
+    atomic_store(&bake->next_tile, 0u);
+    atomic_store(&bake->tiles_done, 0u);
+    pthread_t ids[1024];
+    uint32_t started = 0;
+    pthread_mutex_lock(&bake->lock);
+    bake->workers_running = bake->threads;
+    pthread_mutex_unlock(&bake->lock);
+    for (; started < bake->threads; ++started)
+        if (pthread_create(&ids[started], NULL, worker, bake) != 0) break;
+    pthread_mutex_lock(&bake->lock);
+    bake->workers_running -= bake->threads - started;
+    while (bake->workers_running > 0) {
+        timed_wait(bake, PROGRESS_PERIOD);
+        pthread_mutex_unlock(&bake->lock);
+        report(bake, 0);
+        pthread_mutex_lock(&bake->lock);
+    }
+    pthread_mutex_unlock(&bake->lock);
+    for (uint32_t i = 0; i < started; ++i) pthread_join(ids[i], NULL);
+    return started == 0 ? -1 : 0;
+}
+
+static dwv_result_t fail(dwvb_bake *bake, dwv_result_t result, const char *message)
+{
+    snprintf(bake->message, sizeof bake->message, "%s", message);
+    return result;
+}
+
+/* Turns the sums into the image and its stats. */
+static dwv_result_t make_image(dwvb_bake *bake, double seconds)
+{
+    dwvb_image *image = bake->image;
+    size_t pixels = (size_t)bake->width * bake->height;
+    int any = any_surface_seen(bake);
+    dwv_bake_stats_t *st = &image->stats;
+    double mean[3] = {0.0, 0.0, 0.0};
+    uint64_t covered_count = 0, samples = 0, largest = 0;
+    for (size_t i = 0; i < pixels; ++i) {
+        uint32_t n = bake->counts[i];
+        const pixel_sums *p = &bake->sums[i];
+        samples += n;
+        if (n > largest) largest = n;
+        if (n == 0u) continue;
+        for (int c = 0; c < 3; ++c) {
+            image->rgba[4 * i + c] = (float)(p->sum[c] / n);
+            image->variance[3 * i + c] = (float)mean_variance(p->sum[c], p->sum_squares[c], n);
+        }
+        image->rgba[4 * i + 3] = (float)(p->sum_alpha / n);
+        image->samples[i] = n;
+        if (covered(bake, (uint32_t)i, any)) {
+            ++covered_count;
+            for (int c = 0; c < 3; ++c) mean[c] += p->sum[c] / n;
+        }
+    }
+    dwvb_tally total = {0};
+    for (uint32_t t = 0; t < bake->tile_count; ++t) {
+        total.events += bake->tile_tallies[t].events;
+        total.walks += bake->tile_tallies[t].walks;
+        total.warnings += bake->tile_tallies[t].warnings;
+        for (int c = 0; c < 3; ++c) total.truncated[c] += bake->tile_tallies[t].truncated[c];
+    }
+    st->technique = bake->options.technique;
+    st->samples_per_pixel = largest;
+    st->samples = samples;
+    st->events = total.events;
+    st->walks = total.walks;
+    st->seconds = seconds;
+    st->estimated_relative_error = bake->error;
+    for (int c = 0; c < 3; ++c) {
+        st->mean_rgb[c] = covered_count ? mean[c] / (double)covered_count : 0.0;
+        st->truncated_weight[c] = samples ? total.truncated[c] / (double)samples : 0.0;
+    }
+    st->features = bake->features;
+    st->threads = bake->threads;
+    st->warnings = bake->scene->warnings + total.warnings;
+    if (bake->options.target == DWV_BAKE_UV) {
+        dwv_result_t r = dwvb_uv_dilate_image(&bake->raster, bake->options.uv_margin, image);
+        if (r != DWV_SUCCESS) return fail(bake, r, "no memory for the UV margin");
+    }
+    return DWV_SUCCESS;
+}
+
+static dwv_result_t run(dwvb_bake *bake)
+{
+    uint64_t samples = bake->options.samples;
+    while (bake->spp_done < samples) {
+        uint64_t pass = bake->spp_done == 0 ? 2u : bake->spp_done;
+        if (pass > samples - bake->spp_done) pass = samples - bake->spp_done;
+        bake->pass_first = bake->spp_done;
+        bake->pass_end = bake->spp_done + pass;
+        if (run_pass(bake)) return fail(bake, DWV_ERROR_INTERNAL, "could not start a worker thread");
+        if (atomic_load(&bake->cancelled)) return fail(bake, DWV_ERROR_CANCELLED, "the bake was cancelled");
+        int cut = atomic_load(&bake->time_up);
+        if (!cut) bake->spp_done = bake->pass_end;
+        bake->error = estimate_error(bake);
+        dwv_error_point_t point = {elapsed(bake), bake->error, bake->spp_done};
+        if (!cut && dwvb_image_add_error_point(bake->image, point))
+            return fail(bake, DWV_ERROR_OUT_OF_MEMORY, "no memory for the error series");
+        if (cut) break;
+        if (bake->options.target_error > 0.0 && bake->error <= bake->options.target_error) break;
+    }
+    return make_image(bake, elapsed(bake));
+}
+
+static void *control(void *arg)
+{
+    dwvb_bake *bake = arg;
+    dwv_result_t result = run(bake);
+    if (result != DWV_SUCCESS && bake->image) {
+        dwvb_image_free(bake->image);
+        bake->image = NULL;
+    }
+    bake->result = result;
+    report(bake, 1);
+    pthread_mutex_lock(&bake->lock);
+    bake->done = 1;
+    pthread_cond_broadcast(&bake->changed);
+    pthread_mutex_unlock(&bake->lock);
+    return NULL;
+}
+
+static void release_parts(dwvb_bake *bake)
+{
+    free(bake->guides);
+    free(bake->needs_closest);
+    free(bake->sums);
+    free(bake->counts);
+    free(bake->tile_tallies);
+    dwvb_uv_raster_free(&bake->raster);
+    if (bake->image) dwvb_image_free(bake->image);
+    pthread_mutex_destroy(&bake->lock);
+    pthread_cond_destroy(&bake->changed);
+    free(bake);
+}
+
+/* The camera's frame: right and up span the image's half extents at unit distance (perspective)
+ * or in scene units (orthographic). */
+static void setup_camera(dwvb_bake *bake)
+{
+    const dwv_camera_t *cam = &bake->scene->camera;
+    const double *m = cam->transform;
+    bake->eye = dwvw_v(m[3], m[7], m[11]);
+    dwvw_vec3 x = dwvw_v(m[0], m[4], m[8]), y = dwvw_v(m[1], m[5], m[9]), z = dwvw_v(m[2], m[6], m[10]);
+    double half = cam->kind == DWV_CAMERA_PERSPECTIVE ? 0.5 * cam->sensor_width / cam->focal_length
+                                                      : 0.5 * cam->ortho_scale;
+    double aspect = (double)bake->width / bake->height;
+    double half_x = aspect >= 1.0 ? half : half * aspect, half_y = aspect >= 1.0 ? half / aspect : half;
+    bake->right = dwvw_scale(x, half_x);
+    bake->up = dwvw_scale(y, half_y);
+    bake->forward = dwvw_scale(z, -1.0);
+}
+
+/* Which meshes' walks the bake can reach: all for a camera, the one mesh for a UV bake. */
+static int mesh_used(const dwvb_bake *bake, uint32_t m)
+{
+    return bake->options.target == DWV_BAKE_CAMERA || m == bake->options.uv_mesh;
+}
+
+static void setup_guides(dwvb_bake *bake)
+{
+    const dwvb_scene *scene = bake->scene;
+    uint32_t features = scene->features & ~(uint32_t)(DWV_FEATURE_INCIDENT_PATCHES | DWV_FEATURE_CLOSEST_POINT);
+    for (uint32_t m = 0; m < scene->mesh_count; ++m) {
+        const dwvb_material *material = &scene->shading[scene->meshes[m].material_id];
+        if (!material->subsurface) continue;
+        dwvw_technique technique = (dwvw_technique)bake->options.technique;
+        /* Incident guiding needs lit patches; where a mesh has none (no light reaches it) it
+         * aims at the closest surface point instead, as auto does. */
+        if (technique == DWVW_INCIDENT && scene->patch_count[m] == 0) technique = DWVW_CLOSEST;
+        dwvw_guide_init(&bake->guides[m], technique, &material->medium, scene->patches[m], scene->patch_count[m]);
+        bake->needs_closest[m] = dwvw_guide_needs_closest(&bake->guides[m]);
+        if (!mesh_used(bake, m)) continue;
+        if (bake->needs_closest[m]) features |= DWV_FEATURE_CLOSEST_POINT;
+        if (bake->guides[m].q_incident > 0.0 && bake->guides[m].patch_count > 0) features |= DWV_FEATURE_INCIDENT_PATCHES;
+        if (bake->guides[m].q_classical < 1.0) features |= DWV_FEATURE_GUIDED;
+    }
+    bake->features = features;
+}
+
+dwv_result_t dwvb_bake_start(dwvb_scene *scene, const dwv_bake_options_t *options, dwvb_bake **out,
+                             char *message, size_t size)
+{
+    dwvb_bake *bake = calloc(1, sizeof *bake);
+    if (!bake) {
+        snprintf(message, size, "out of memory");
+        return DWV_ERROR_OUT_OF_MEMORY;
+    }
+    bake->scene = scene;
+    bake->options = *options;
+    bake->width = options->width;
+    bake->height = options->height;
+    bake->threads = options->threads;
+    bake->error = INFINITY;
+    pthread_mutex_init(&bake->lock, NULL);
+    pthread_condattr_t attributes;
+    pthread_condattr_init(&attributes);
+    pthread_condattr_setclock(&attributes, CLOCK_MONOTONIC);
+    pthread_cond_init(&bake->changed, &attributes);
+    pthread_condattr_destroy(&attributes);
+    atomic_init(&bake->next_tile, 0u);
+    atomic_init(&bake->tiles_done, 0u);
+    atomic_init(&bake->time_up, 0);
+    atomic_init(&bake->cancelled, 0);
+    atomic_init(&bake->events, 0u);
+    bake->progress = (dwv_bake_progress_t)DWV_BAKE_PROGRESS_INIT;
+    bake->progress.estimated_relative_error = INFINITY;
+
+    size_t pixels = (size_t)bake->width * bake->height;
+    uint32_t tile = options->tile_size;
+    bake->tiles_x = (bake->width + tile - 1u) / tile;
+    bake->tile_count = bake->tiles_x * ((bake->height + tile - 1u) / tile);
+    uint32_t meshes = scene->mesh_count ? scene->mesh_count : 1u;
+    bake->guides = calloc(meshes, sizeof *bake->guides);
+    bake->needs_closest = calloc(meshes, sizeof *bake->needs_closest);
+    bake->sums = calloc(pixels, sizeof *bake->sums);
+    bake->counts = calloc(pixels, sizeof *bake->counts);
+    bake->tile_tallies = calloc(bake->tile_count, sizeof *bake->tile_tallies);
+    bake->image = dwvb_image_new(bake->width, bake->height);
+    if (!bake->guides || !bake->needs_closest || !bake->sums || !bake->counts || !bake->tile_tallies || !bake->image) {
+        release_parts(bake);
+        snprintf(message, size, "out of memory for a %u x %u bake", options->width, options->height);
+        return DWV_ERROR_OUT_OF_MEMORY;
+    }
+    if (options->target == DWV_BAKE_UV) {
+        const dwvg_mesh *mesh = &scene->meshes[options->uv_mesh];
+        dwv_result_t r = dwvb_uv_rasterize(mesh->uvs, mesh->triangle_count, bake->width, bake->height, &bake->raster);
+        if (r != DWV_SUCCESS) {
+            release_parts(bake);
+            snprintf(message, size, "could not lay out the UVs of mesh %u (%s)", options->uv_mesh, dwv_result_string(r));
+            return r;
+        }
+    } else {
+        setup_camera(bake);
+    }
+    setup_guides(bake);
+    bake->shader.scene = scene;
+    bake->shader.env.lights = scene->emitters;
+    bake->shader.env.light_count = scene->light_count;
+    for (int c = 0; c < 3; ++c) bake->shader.env.world[c] = scene->world[c];
+    bake->shader.env.world_lit = dwvb_scene_world_lit(scene);
+    bake->shader.env.geometry = scene->mesh_count ? &scene->geometry : NULL;
+    bake->shader.guides = bake->guides;
+    bake->shader.needs_closest = bake->needs_closest;
+    bake->shader.max_events = options->max_events;
+    clock_gettime(CLOCK_MONOTONIC, &bake->start);
+    if (pthread_create(&bake->control, NULL, control, bake) != 0) {
+        release_parts(bake);
+        snprintf(message, size, "could not start the bake's control thread");
+        return DWV_ERROR_INTERNAL;
+    }
+    bake->control_started = 1;
+    *out = bake;
+    return DWV_SUCCESS;
+}
+
+int dwvb_bake_wait(dwvb_bake *bake, double seconds)
+{
+    pthread_mutex_lock(&bake->lock);
+    if (seconds < 0.0) {
+        while (!bake->done) pthread_cond_wait(&bake->changed, &bake->lock);
+    } else if (!bake->done && seconds > 0.0) {
+        struct timespec start;
+        clock_gettime(CLOCK_MONOTONIC, &start);
+        for (;;) {
+            struct timespec now;
+            clock_gettime(CLOCK_MONOTONIC, &now);
+            double left = seconds - ((double)(now.tv_sec - start.tv_sec) + 1e-9 * (double)(now.tv_nsec - start.tv_nsec));
+            if (bake->done || left <= 0.0) break;
+            timed_wait(bake, left);
+        }
+    }
+    int done = bake->done;
+    pthread_mutex_unlock(&bake->lock);
+    return done;
+}
+
+void dwvb_bake_progress(dwvb_bake *bake, dwv_bake_progress_t *progress)
+{
+    pthread_mutex_lock(&bake->lock);
+    uint32_t size = progress->struct_size;
+    *progress = bake->progress;
+    progress->struct_size = size;
+    progress->done = (uint32_t)bake->done;
+    pthread_mutex_unlock(&bake->lock);
+}
+
+void dwvb_bake_cancel(dwvb_bake *bake)
+{
+    atomic_store(&bake->cancelled, 1);
+}
+
+static void join(dwvb_bake *bake)
+{
+    dwvb_bake_wait(bake, -1.0);
+    pthread_mutex_lock(&bake->lock);
+    int join_now = bake->control_started && !bake->joined;
+    bake->joined = 1;
+    pthread_mutex_unlock(&bake->lock);
+    if (join_now) pthread_join(bake->control, NULL);
+}
+
+dwv_result_t dwvb_bake_finish(dwvb_bake *bake, dwvb_image **image, char *message, size_t size)
+{
+    join(bake);
+    if (bake->result != DWV_SUCCESS) {
+        snprintf(message, size, "%s", bake->message);
+        return bake->result;
+    }
+    if (!bake->image) {
+        snprintf(message, size, "the image was already handed over");
+        return DWV_ERROR_INVALID_STATE;
+    }
+    *image = bake->image;
+    bake->image = NULL;
+    return DWV_SUCCESS;
+}
+
+void dwvb_bake_free(dwvb_bake *bake)
+{
+    if (!bake) return;
+    dwvb_bake_cancel(bake);
+    join(bake);
+    release_parts(bake);
+}
+
+long long dwvb_scene_geometry_bytes(const dwvb_scene *scene)
+{
+    return scene->mesh_count ? (long long)atomic_load(&((dwvb_scene *)scene)->geometry.embree_bytes) : 0;
+}

@@ -1,0 +1,45 @@
+/* A scene material turned into what shading needs, by Cycles' conventions for the Principled
+ * BSDF with subsurface method "Random Walk (Fixed Radius)" (Blender 3.4, intern/cycles):
+ *
+ *   kernel/svm/closure.h     g = clamp(subsurface_anisotropy, 0, 0.9)
+ *   kernel/closure/bssrdf.h  a channel with radius < BSSRDF_MIN_RADIUS = 1e-8 becomes Lambertian
+ *                            diffuse (weight: that channel of the subsurface colour); otherwise
+ *                            bssrdf_setup_radius: d = radius / (4 pi) for the fixed-radius method
+ *   kernel/integrator/subsurface_random_walk.h, subsurface_random_walk_remap:
+ *                            sigma_t = 1 / (max(d, 1e-16) (1 - g))   (1/d is the reduced extinction)
+ *                            alpha = (1 - A^(1/4)) P(g) atan(Q(g) A)^R(g)
+ *                                    + A^(1/4) S(g) atan(T(g) A)^U(g), clamped to [0, 0.999999],
+ *                            A the subsurface colour (multiple-scattering albedo), P..U fitted
+ *                            polynomials (and exponentials) in g (the coefficients of Cycles' fit)
+ *   subsurface_random_walk_coefficients: the closure weight (which holds the colour A) is divided
+ *                            by A, and where alpha < 0.2 the walk runs with alpha = 0.2 and its
+ *                            throughput is scaled by alpha / 0.2.
+ *   entry: cosine-weighted diffuse transmission about -N (rejected where it would not enter below
+ *          the geometric normal); exit: a Lambertian (diffuse) BSDF at the exit point.
+ * The issue's "mean free path = radius x scale / (4 pi)" holds for g = 0 only: Cycles' 1/(4 pi)
+ * scaling gives the reduced mean free path d, and the walk's mean free path is d (1 - g). */
+#ifndef DWV_BAKE_MATERIAL_H
+#define DWV_BAKE_MATERIAL_H
+
+#include "dwivedi.h"
+#include "walk/walk.h"
+
+#define DWVB_MIN_RADIUS 1e-8
+#define DWVB_MIN_ALPHA 0.2
+
+typedef struct dwvb_material {
+    int subsurface;            /* walks run: some channel scatters with a non-zero weight */
+    double diffuse_albedo[3];  /* the Lambertian lobe: (1 - w) base colour, plus w x subsurface
+                                  colour in channels whose radius is below DWVB_MIN_RADIUS */
+    double walk_scale[3];      /* w x Cycles' low-albedo compensation; 0 where a channel does not walk */
+    int grey;                  /* all three channels walk alike: one-channel walks */
+    dwvw_medium medium;
+} dwvb_material;
+
+/* Cycles' albedo inversion: the single-scattering albedo for multiple-scattering albedo A in
+ * [0, 1] and anisotropy g in [0, 0.9] (before the clamps). */
+double dwvb_albedo_inversion(double A, double g);
+/* Derives the shading of a validated material. */
+void dwvb_material_init(dwvb_material *out, const dwv_material_t *in);
+
+#endif

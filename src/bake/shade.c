@@ -1,0 +1,106 @@
+#include "shade.h"
+
+#include <math.h>
+
+#include "kernel/rng.h"
+
+/* Runs one walk from entry point x (on triangle entry_prim of mesh `mesh`) along unit `direction`
+ * into the medium; on exit fills the exit hit and returns 1. */
+static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvb_material *material, uint32_t entry_prim, dwvw_vec3 x, dwvw_vec3 direction, dwvw_vec3 entry_normal, uint64_t key,
+                    dwvw_walk *walk, dwvg_hit *exit, dwvb_tally *tally)
+{
+    const dwvg_world *world = &shader->scene->geometry;
+    const dwvg_mesh *m = &shader->scene->meshes[mesh];
+    dwvw_walk_begin(walk, &material->medium, &shader->guides[mesh], key, shader->max_events, x, direction,
+                    entry_normal);
+    int needs_closest = shader->needs_closest[mesh];
+    int first = 1;
+    while (walk->status == DWVW_RUNNING) {
+        if (needs_closest) {
+            dwvg_hit closest;
+            if (dwvg_closest_mesh(world, mesh, walk->position, &closest))
+                dwvw_walk_set_closest(walk, dwvg_geometric_normal(m, closest.prim));
+        }
+        double distance = dwvw_walk_sample(walk);
+        /* The first step is the probe: its full distance to the surface locates an opposite
+         * interface. A ray leaving a flat triangle inward cannot meet that triangle again, so a
+         * hit on the entry triangle is rounding and the ray goes on past it. */
+        double tnear = 0.0, tfar = first ? INFINITY : distance;
+        dwvg_hit hit;
+        int found;
+        for (;;) {
+            found = dwvg_intersect_mesh(world, mesh, walk->position, walk->direction, tnear, tfar, &hit);
+            if (!(found && first && hit.prim == entry_prim)) break;
+            tnear = nextafterf((float)hit.t, INFINITY);
+        }
+        first = 0;
+        dwvw_vec3 normal = dwvw_v(0.0, 0.0, 0.0);
+        if (found) {
+            normal = dwvg_geometric_normal(m, hit.prim);
+            if (normal.x == 0.0 && normal.y == 0.0 && normal.z == 0.0) {
+                ++tally->warnings;
+                return 0;
+            }
+            *exit = hit;
+        }
+        dwvw_walk_complete(walk, found ? hit.t : INFINITY, normal);
+    }
+    tally->events += walk->events;
+    ++tally->walks;
+    if (walk->status == DWVW_TRUNCATED) {
+        int channels = material->medium.channels;
+        for (int c = 0; c < 3; ++c) tally->truncated[c] += walk->weight[channels == 1 ? 0 : c] * material->walk_scale[c];
+    }
+    return walk->status == DWVW_EXITED;
+}
+
+void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, uint64_t key_shade,
+                uint32_t dimension, uint64_t key_walk, double rgb[3], dwvb_tally *tally)
+{
+    const dwvb_scene *scene = shader->scene;
+    const dwvg_mesh *mesh = &scene->meshes[hit->mesh];
+    uint32_t material_id = mesh->material_id;
+    const dwvb_material *material = &scene->shading[material_id];
+    rgb[0] = rgb[1] = rgb[2] = 0.0;
+    dwvw_vec3 ng = dwvg_geometric_normal(mesh, hit->prim);
+    if (ng.x == 0.0 && ng.y == 0.0 && ng.z == 0.0) {
+        ++tally->warnings;
+        return;
+    }
+    if (dwvw_dot(view, ng) > 0.0) {
+        /* The back of a face. A diffuse surface is two-sided; a subsurface one is seen from inside
+         * its medium (an open or inside-out mesh): no walk is defined there. */
+        if (material->subsurface) {
+            ++tally->warnings;
+            return;
+        }
+        ng = dwvw_scale(ng, -1.0);
+    }
+    dwvw_vec3 x = dwvg_point(mesh, hit->prim, hit->u, hit->v);
+    dwvw_vec3 n = dwvg_shading_normal(mesh, hit->prim, hit->u, hit->v, ng);
+    uint32_t light_dims = dwvl_direct_dimensions(&shader->env);
+    if (material->diffuse_albedo[0] > 0.0 || material->diffuse_albedo[1] > 0.0 || material->diffuse_albedo[2] > 0.0) {
+        double direct[3];
+        dwvl_direct(&shader->env, x, n, ng, key_shade, dimension + DWVB_SHADE_DIMS, direct);
+        for (int c = 0; c < 3; ++c) rgb[c] += material->diffuse_albedo[c] * direct[c];
+    }
+    if (!material->subsurface) return;
+    /* Entry: cosine-weighted about -n, rejected (no contribution, as Cycles) where it would not
+     * go below the geometric surface. The pdf cos/pi cancels the diffuse transmission f = 1/pi. */
+    double u = dwvk_rng_uniform_d(key_shade, dimension), mu = sqrt(u);
+    dwvw_vec3 inward = dwvw_direction_about(dwvw_scale(n, -1.0), mu, 1.0 - mu, 1.0 + mu,
+                                            dwvk_rng_uniform_d(key_shade, dimension + 1u));
+    if (!(dwvw_dot(inward, ng) < 0.0)) return;
+    dwvw_walk walk;
+    dwvg_hit exit = {0};
+    if (!run_walk(shader, hit->mesh, material, hit->prim, x, inward, n, key_walk, &walk, &exit,
+                  tally))
+        return;
+    dwvw_vec3 exit_ng = walk.exit_normal;
+    dwvw_vec3 exit_n = dwvg_shading_normal(mesh, exit.prim, exit.u, exit.v, exit_ng);
+    double direct[3];
+    dwvl_direct(&shader->env, walk.position, exit_n, exit_ng, key_shade, dimension + DWVB_SHADE_DIMS + light_dims,
+                direct);
+    int grey = material->medium.channels == 1;
+    for (int c = 0; c < 3; ++c) rgb[c] += walk.weight[grey ? 0 : c] * material->walk_scale[c] * direct[c];
+}

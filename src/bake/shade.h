@@ -1,0 +1,39 @@
+/* One sample of the radiance leaving a surface point of the scene toward a viewer: the Lambertian
+ * lobe by next-event estimation, plus the random-walk subsurface lobe (Cycles-like, Fresnel-free):
+ * enter by cosine-weighted diffuse transmission, walk in the mesh's own Embree scene with the
+ * step machine of src/walk, leave through a Lambertian exit that gathers direct light and the
+ * world. One bounce: surfaces do not light each other. */
+#ifndef DWV_BAKE_SHADE_H
+#define DWV_BAKE_SHADE_H
+
+#include <stdint.h>
+
+#include "bake/scene.h"
+#include "geom/embree.h"
+#include "light/direct.h"
+#include "walk/walk.h"
+
+typedef struct dwvb_shader {
+    const dwvb_scene *scene;
+    dwvl_environment env;
+    const dwvw_guide *guides;     /* per mesh (used where its material scatters) */
+    const int *needs_closest;     /* per mesh */
+    uint32_t max_events;
+} dwvb_shader;
+
+/* What samples met, summed by the caller in a fixed order. */
+typedef struct dwvb_tally {
+    uint64_t events, walks, warnings;
+    double truncated[3];
+} dwvb_tally;
+
+/* Random dimensions of the shading key before direct lighting starts. */
+#define DWVB_SHADE_DIMS 2u
+
+/* The radiance leaving hit point `hit` along -view (view: unit direction of the ray that found
+ * it, from the viewer). key_shade drives entry and light sampling from dimension `dimension`
+ * on; key_walk drives the walk. */
+void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, uint64_t key_shade,
+                uint32_t dimension, uint64_t key_walk, double rgb[3], dwvb_tally *tally);
+
+#endif

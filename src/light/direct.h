@@ -1,0 +1,31 @@
+/* Next-event estimation: the radiance a white Lambertian surface reflects at a point, from every
+ * light (one shadow-tested sample each) and the constant world (one cosine-weighted shadow ray). */
+#ifndef DWV_LIGHT_DIRECT_H
+#define DWV_LIGHT_DIRECT_H
+
+#include <stdint.h>
+
+#include "geom/embree.h"
+#include "light.h"
+
+typedef struct dwvl_environment {
+    const dwvl_light *lights;
+    uint32_t light_count;
+    double world[3];          /* constant world radiance */
+    int world_lit;            /* 0: the world is black and is not sampled */
+    const dwvg_world *geometry;
+} dwvl_environment;
+
+/* Random dimensions one call uses: 2 per light and 2 for the world. */
+static inline uint32_t dwvl_direct_dimensions(const dwvl_environment *env)
+{
+    return 2u * env->light_count + 2u;
+}
+
+/* (1/pi) integral of L_in cos over the hemisphere of the shading normal `n` at x, estimated with
+ * uniform numbers from `key` starting at `dimension`; `ng` is the unit geometric normal on the
+ * same side (shadow rays leave from x + epsilon ng and never below the geometric surface). */
+void dwvl_direct(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng, uint64_t key,
+                 uint32_t dimension, double out[3]);
+
+#endif

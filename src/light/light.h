@@ -1,0 +1,42 @@
+/* Lights in Blender's units, as Cycles 3.4 evaluates them (intern/cycles/kernel/light/,
+ * scene/light.cpp), with emission closures of value 1 x strength (kernel/closure/emissive.h):
+ *   point, power P, colour c: intensity I = P c / (4 pi) W/sr (eval_fac 1/(4 pi) x 1/(pi r^2) on a
+ *       disc of radius r facing the shaded point, radiance P c / (4 pi^2 r^2));
+ *   area, power P: one-sided radiance L = P c / (4 A) along the light's local -z
+ *       (eval_fac 0.25 / A), A the rectangle's or ellipse's area;
+ *   sun, strength S (W/m^2): irradiance S c on a surface facing it, from a cone of the angular
+ *       diameter with constant radiance S c / (pi sin^2(angle/2)) (Cycles' own disc sampling
+ *       gives S cos^2(angle/2) instead, which differs by less than 0.01% below 1 degree);
+ *   world: constant radiance colour x strength.
+ * A sample returns the direction toward the light, the distance, and the radiance divided by the
+ * solid-angle pdf: for a Lambertian surface of albedo rho, rho/pi x value x cos x visibility
+ * estimates the reflected radiance. */
+#ifndef DWV_LIGHT_LIGHT_H
+#define DWV_LIGHT_LIGHT_H
+
+#include "dwivedi.h"
+#include "walk/vec3.h"
+
+typedef struct dwvl_light {
+    dwv_light_kind_t kind;
+    double emission[3];        /* sun: irradiance S c; point: intensity P c / (4 pi); area: radiance */
+    dwvw_vec3 direction;       /* sun: unit, toward the sun; area: unit emission direction (local -z) */
+    double one_minus_cos_half; /* sun: 1 - cos(angle / 2), from 2 sin^2(angle / 4) */
+    dwvw_vec3 position;        /* point: centre; area: centre */
+    double radius;             /* point */
+    dwvw_vec3 axis_x, axis_y;  /* area: full extents in the world (size x the transform's axes) */
+    double area;               /* area: of the rectangle or ellipse */
+} dwvl_light;
+
+typedef struct dwvl_sample {
+    dwvw_vec3 direction; /* unit, from the shaded point toward the light */
+    double distance;     /* to the sampled light point; +INFINITY for the sun */
+    double value[3];     /* radiance / solid-angle pdf; all 0 when the light cannot reach */
+} dwvl_sample;
+
+/* Converts a validated description. */
+void dwvl_light_init(dwvl_light *light, const dwv_light_desc_t *desc);
+/* Samples the light as seen from x with two uniform numbers. */
+void dwvl_light_sample(const dwvl_light *light, dwvw_vec3 x, double u1, double u2, dwvl_sample *sample);
+
+#endif

@@ -1,0 +1,145 @@
+/* The Embree world: closest points (rtcPointQuery + our point-triangle distance) agree with a
+ * brute-force search over all triangles, rays find the surface a sphere formula predicts,
+ * degenerate and overflowing triangles are counted as warnings, and the memory Embree holds per
+ * triangle is reported. */
+#include <math.h>
+#include <stdio.h>
+
+#include "bake/bake.h"
+#include "bake/scene.h"
+#include "bake_scenes.h"
+#include "check.h"
+#include "geom/embree.h"
+#include "kernel/rng.h"
+
+/* Distance from p to triangle abc by brute force: the face's plane where the projection falls
+ * inside, else the nearest of the three edges (segments). */
+static double segment_distance(dwvw_vec3 p, dwvw_vec3 a, dwvw_vec3 b)
+{
+    dwvw_vec3 ab = dwvw_sub(b, a);
+    double t = dwvw_dot(dwvw_sub(p, a), ab) / dwvw_dot(ab, ab);
+    t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
+    return dwvw_length(dwvw_sub(p, dwvw_madd(a, ab, t)));
+}
+
+static double brute_distance(const dwvg_mesh *mesh, uint32_t prim, dwvw_vec3 p)
+{
+    dwvw_vec3 v[3];
+    for (int k = 0; k < 3; ++k) {
+        const float *q = mesh->positions + 3u * mesh->indices[3u * prim + (uint32_t)k];
+        v[k] = dwvw_v(q[0], q[1], q[2]);
+    }
+    dwvw_vec3 n = dwvg_geometric_normal(mesh, prim);
+    double h = dwvw_dot(dwvw_sub(p, v[0]), n);
+    dwvw_vec3 x = dwvw_madd(p, n, -h);
+    int inside = 1;
+    for (int k = 0; k < 3; ++k) {
+        dwvw_vec3 e = dwvw_sub(v[(k + 1) % 3], v[k]), w = dwvw_sub(x, v[k]);
+        dwvw_vec3 c = dwvw_v(e.y * w.z - e.z * w.y, e.z * w.x - e.x * w.z, e.x * w.y - e.y * w.x);
+        if (dwvw_dot(c, n) < 0.0) inside = 0;
+    }
+    if (inside) return fabs(h);
+    double d = segment_distance(p, v[0], v[1]);
+    d = fmin(d, segment_distance(p, v[1], v[2]));
+    return fmin(d, segment_distance(p, v[2], v[0]));
+}
+
+static dwvb_scene *commit_meshes(const test_mesh *meshes, int count, const double *transform)
+{
+    dwvb_scene *scene = dwvb_scene_new();
+    dwv_material_t m = DWV_MATERIAL_INIT;
+    dwvb_scene_push_material(scene, &m);
+    static const double identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+    for (int i = 0; i < count; ++i) {
+        dwvg_mesh mesh;
+        dwvg_mesh_init(&mesh, meshes[i].vertex_count, meshes[i].triangle_count, 0, meshes[i].positions,
+                       meshes[i].indices, NULL, NULL, transform ? transform : identity);
+        dwvb_scene_push_mesh(scene, &mesh);
+    }
+    char message[256];
+    dwv_result_t r = dwvb_scene_commit(scene, message, sizeof message);
+    CHECK(r == DWV_SUCCESS, "commit: %s", message);
+    return scene;
+}
+
+static void test_closest_and_rays(void)
+{
+    test_mesh sphere = test_sphere(0.3, -0.2, 0.1, 1.0, 12, 24);
+    dwvb_scene *scene = commit_meshes(&sphere, 1, NULL);
+    const dwvg_mesh *mesh = &scene->meshes[0];
+    int agree = 0;
+    for (uint32_t i = 0; i < 500; ++i) {
+        uint64_t key = dwvk_rng_key(1, i, 0);
+        dwvw_vec3 p = dwvw_v(0.3 + 2.4 * (dwvk_rng_uniform_d(key, 0) - 0.5), -0.2 + 2.4 * (dwvk_rng_uniform_d(key, 1) - 0.5),
+                             0.1 + 2.4 * (dwvk_rng_uniform_d(key, 2) - 0.5));
+        double best = INFINITY;
+        for (uint32_t t = 0; t < mesh->triangle_count; ++t) best = fmin(best, brute_distance(mesh, t, p));
+        dwvg_hit hit;
+        int found = dwvg_closest_mesh(&scene->geometry, 0, p, &hit);
+        double d = found ? dwvw_length(dwvw_sub(dwvg_point(mesh, hit.prim, hit.u, hit.v), p)) : INFINITY;
+        agree += found && fabs(d - best) <= 1e-6 && fabs(hit.t - best) <= 1e-6;
+    }
+    CHECK(agree == 500, "closest point agrees with brute force at %d of 500 points", agree);
+    /* Rays from inside along random directions meet the surface where the polygonised sphere
+     * is: between the inscribed radius cos(pi/12) cos(pi/24)... and 1 from the centre. */
+    int on_surface = 0;
+    for (uint32_t i = 0; i < 500; ++i) {
+        uint64_t key = dwvk_rng_key(2, i, 0);
+        double mu = 2.0 * dwvk_rng_uniform_d(key, 0) - 1.0;
+        dwvw_vec3 d = dwvw_direction_about(dwvw_v(0, 0, 1), mu, 1.0 - mu, 1.0 + mu, dwvk_rng_uniform_d(key, 1));
+        dwvw_vec3 c = dwvw_v(0.3, -0.2, 0.1);
+        dwvg_hit a, b;
+        int fa = dwvg_intersect_mesh(&scene->geometry, 0, c, d, 0.0, INFINITY, &a);
+        int fb = dwvg_intersect(&scene->geometry, c, d, 0.0, INFINITY, &b);
+        double inner = cos(3.14159265358979 / 12.0) * cos(3.14159265358979 / 24.0);
+        on_surface += fa && fb && a.prim == b.prim && b.mesh == 0 && a.t >= inner - 1e-5 && a.t <= 1.0 + 1e-5 &&
+                      dwvw_dot(dwvg_geometric_normal(mesh, a.prim), d) > 0.0 &&
+                      dwvg_occluded(&scene->geometry, c, d, 0.0, INFINITY) && !dwvg_occluded(&scene->geometry, c, d, 0.0, 0.5 * inner);
+    }
+    CHECK(on_surface == 500, "rays meet the sphere from inside at %d of 500", on_surface);
+    CHECK(scene->warnings == 0, "a clean sphere has no warnings (%llu)", (unsigned long long)scene->warnings);
+    dwvb_scene_free(scene);
+    test_mesh_free(&sphere);
+}
+
+static void test_warnings(void)
+{
+    test_mesh box = test_box(0, 0, 0, 1, 1, 1);
+    box.indices[4] = box.indices[3]; /* triangle 1 degenerate: a repeated corner */
+    dwvb_scene *scene = commit_meshes(&box, 1, NULL);
+    CHECK(scene->warnings == 1, "one degenerate triangle, %llu warnings", (unsigned long long)scene->warnings);
+    dwvb_scene_free(scene);
+    /* Finite input that overflows float in world space: every triangle touching vertex 7 (the
+     * corner 1e30 x 1e10 away) becomes non-finite and is skipped by Embree, counted here. */
+    test_mesh_free(&box);
+    box = test_box(0, 0, 0, 1, 1, 1);
+    box.positions[21] = box.positions[22] = box.positions[23] = 1e10f;
+    static const double huge[12] = {1e30, 0, 0, 0, 0, 1e30, 0, 0, 0, 0, 1e30, 0};
+    scene = commit_meshes(&box, 1, huge);
+    CHECK(scene->warnings == 6, "six triangles touch the overflowing corner, %llu warnings",
+          (unsigned long long)scene->warnings);
+    dwvb_scene_free(scene);
+    test_mesh_free(&box);
+}
+
+static void test_memory(void)
+{
+    test_mesh sphere = test_sphere(0, 0, 0, 1, 256, 512);
+    dwvb_scene *scene = commit_meshes(&sphere, 1, NULL);
+    long long bytes = dwvb_scene_geometry_bytes(scene);
+    double per_triangle = (double)bytes / sphere.triangle_count;
+    /* Our own arrays: 12 bytes per vertex and 12 per triangle (indices), about 18 per triangle. */
+    printf("Embree holds %lld bytes for %u triangles: %.1f bytes per triangle (plus ~18 of our own arrays)\n", bytes,
+           sphere.triangle_count, per_triangle);
+    CHECK(per_triangle > 8.0 && per_triangle < 512.0, "%.1f bytes per triangle", per_triangle);
+    dwvb_scene_free(scene);
+    test_mesh_free(&sphere);
+}
+
+int main(void)
+{
+    test_closest_and_rays();
+    test_warnings();
+    test_memory();
+    return check_report("test_geometry");
+}
