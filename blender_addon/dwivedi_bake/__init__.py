@@ -175,11 +175,11 @@ class _Job:
             image.write_exr(self.exr)
             image.write_png(self.png, self.display)
             stats = image.stats
+            if settings.load_result:
+                blender_image(image, "Dwivedi " + ("Camera" if settings.target == 'CAMERA' else "UV"), self.exr)
         finally:
             image.close()
             self.close()
-        if settings.load_result:
-            load_image(self.exr, "Dwivedi " + ("Camera" if settings.target == 'CAMERA' else "UV"))
         return (f"Dwivedi bake: {self.exported.width} x {self.exported.height}, {stats.samples_per_pixel} spp, "
                 f"{stats.seconds:.2f} s, est. error {stats.estimated_relative_error:.2%} -> {self.exr}")
 
@@ -201,17 +201,35 @@ def display_settings(scene, dwivedi):
                                    exposure=view.exposure, gamma=view.gamma)
 
 
-def load_image(path, name):
-    """Loads (or reloads) the EXR as a Blender image named `name`."""
-    image = bpy.data.images.get(name)
-    if image is not None and bpy.path.abspath(image.filepath) == path:
-        image.reload()
-        return image
-    if image is not None:
-        bpy.data.images.remove(image)
-    image = bpy.data.images.load(path, check_existing=False)
-    image.name = name
-    return image
+def blender_image(image, name, path):
+    """The baked pixels as a float Blender image `name` (made again if its size changed), in
+    scene-linear colour, with `path` as its file for Image > Save. Made from memory rather than by
+    loading the EXR: Blender 3.4 cannot read an EXR whose unlayered RGBA sits beside layered
+    channels (variance.R...), which ours has."""
+    import array
+    width, height = image.width, image.height
+    target = bpy.data.images.get(name)
+    if target is not None and (tuple(target.size) != (width, height) or not target.is_float
+                               or target.source != 'GENERATED'):
+        bpy.data.images.remove(target)
+        target = None
+    if target is None:
+        target = bpy.data.images.new(name, width, height, alpha=True, float_buffer=True)
+    for colorspace in ("Linear Rec.709", "Linear"):  # Blender 4.x, 3.x names of scene linear
+        try:
+            target.colorspace_settings.name = colorspace
+            break
+        except TypeError:
+            continue
+    raw = image.rgba.cast("B")  # rows of 16 x width bytes, row 0 at the top; Blender's is the bottom
+    stride = 16 * width
+    flipped = array.array("f")
+    flipped.frombytes(b"".join(raw[y * stride:(y + 1) * stride] for y in range(height - 1, -1, -1)))
+    target.pixels.foreach_set(flipped)
+    target.filepath_raw = path
+    target.file_format = 'OPEN_EXR'
+    target.update()
+    return target
 
 
 class DWIVEDI_OT_bake(bpy.types.Operator):

@@ -64,6 +64,15 @@ def call_operator(**settings):
         return {'CANCELLED'}, str(error)
 
 
+def image_pixels(name):
+    """The float RGBA pixels of the Blender image `name` (rows from the bottom), with its size."""
+    image = bpy.data.images[name]
+    width, height = image.size
+    pixels = [0.0] * (4 * width * height)
+    image.pixels.foreach_get(pixels)
+    return width, height, pixels
+
+
 def read_pixels(path):
     """The float RGBA pixels of an image file as Blender loads it (rows from the bottom), with
     its size; EXR gives scene-linear floats, PNG the stored bytes / 255."""
