@@ -61,8 +61,12 @@ def _value(node: Any, names: Tuple[str, ...], default: Any, material_name: str, 
         return float(value)
 
 
-def _principled(material: Any) -> Any:
-    """The Principled BSDF that feeds the material's active output (Cycles or All), else any."""
+SHADER_TYPES = ('BSDF_PRINCIPLED', 'SUBSURFACE_SCATTERING')
+
+
+def _surface_shader(material: Any) -> Any:
+    """The Principled BSDF or Subsurface Scattering node that feeds the material's active output
+    (Cycles or All), else the first such node in the tree, else None."""
     if not material.use_nodes or material.node_tree is None:
         return None
     nodes = material.node_tree.nodes
@@ -75,10 +79,10 @@ def _principled(material: Any) -> Any:
         surface = output.inputs.get("Surface")
         if surface is not None and surface.is_linked:
             linked = surface.links[0].from_node
-            if linked.type == 'BSDF_PRINCIPLED':
+            if linked.type in SHADER_TYPES:
                 return linked
     for node in nodes:
-        if node.type == 'BSDF_PRINCIPLED':
+        if node.type in SHADER_TYPES:
             return node
     return None
 
@@ -92,10 +96,25 @@ def material_from_blender(material: Any, dwivedi: Any, warnings: List[str]) -> A
     if material is None:
         return dwivedi.Material.diffuse((0.8, 0.8, 0.8))
     name = material.name
-    node = _principled(material)
+    node = _surface_shader(material)
     if node is None:
-        warnings.append(f"material '{name}' has no Principled BSDF: baked as diffuse in its viewport colour")
+        warnings.append(f"material '{name}' has no Principled BSDF or Subsurface Scattering node: baked as "
+                        "diffuse in its viewport colour")
         return dwivedi.Material.diffuse(tuple(material.diffuse_color)[:3])
+    if node.type == 'SUBSURFACE_SCATTERING':
+        # Color is the walk's albedo, Radius x Scale its radius; exit Lambertian (Cycles gives
+        # this node no roughness: no retro-reflection, no Fresnel-weighted exit).
+        color = _value(node, ("Color",), (0.8, 0.8, 0.8, 1.0), name, warnings)[:3]
+        out = dwivedi.Material(base_color=color, subsurface_weight=1.0, subsurface_color=color,
+                               subsurface_radius=_value(node, ("Radius",), (1.0, 0.2, 0.1), name, warnings)[:3],
+                               subsurface_scale=_value(node, ("Scale",), 0.05, name, warnings),
+                               subsurface_anisotropy=max(-0.9, min(0.9, _value(node, ("Anisotropy",), 0.0, name,
+                                                                                 warnings))),
+                               subsurface_ior=min(max(_value(node, ("IOR",), 1.4, name, warnings), 1.0), 4.0))
+        if getattr(node, "falloff", 'RANDOM_WALK_FIXED_RADIUS') != 'RANDOM_WALK_FIXED_RADIUS':
+            warnings.append(f"material '{name}': subsurface method {node.falloff} is baked as Random Walk "
+                            "(Fixed Radius)")
+        return out
     method = getattr(node, "subsurface_method", 'RANDOM_WALK_FIXED_RADIUS')
     base = _value(node, ("Base Color",), (0.8, 0.8, 0.8, 1.0), name, warnings)[:3]
     radius = _value(node, ("Subsurface Radius",), (1.0, 0.2, 0.1), name, warnings)[:3]
@@ -114,6 +133,14 @@ def material_from_blender(material: Any, dwivedi: Any, warnings: List[str]) -> A
                                subsurface_ior=ior, kind="subsurface" if weight > 0.0 else "diffuse")
     else:  # Blender 3.x
         factor = _value(node, ("Subsurface",), 0.0, name, warnings)
+        roughness = _value(node, ("Roughness",), 0.5, name, warnings)
+        if factor > 0.0:
+            # Cycles 3.x's Principled (v1) adds to the walk a retro-reflection lobe (by Roughness)
+            # and weights the exit by 1 - (1 - cos)^5 / 2 (PRINCIPLED_DIFFUSE_LAMBERT_EXIT): dwivedi
+            # bakes the plain walk, as the Subsurface Scattering node and Blender 4.x do.
+            warnings.append(f"material '{name}': Blender 3.x's Principled adds retro-reflection (roughness "
+                            f"{roughness:.2f}) and a Fresnel-weighted exit to subsurface; dwivedi bakes the "
+                            "Lambertian-exit walk (front-lit results can differ from Cycles by a few %)")
         color = _value(node, ("Subsurface Color",), (0.8, 0.8, 0.8, 1.0), name, warnings)[:3]
         out = dwivedi.Material.from_blender_3x(base, factor, color, radius, anisotropy, ior)
         if factor <= 0.0:

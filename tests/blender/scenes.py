@@ -80,6 +80,23 @@ def principled_material(name, color, radius, scale=1.0, weight=1.0, anisotropy=0
     return material
 
 
+def sss_node_material(name, color, radius, scale=1.0):
+    """The Subsurface Scattering node, Random Walk (Fixed Radius): walks entering by cosine-weighted
+    diffuse transmission and leaving through a Lambertian exit, nothing else (Cycles gives it no
+    roughness, so no Principled retro-reflection and no Fresnel-weighted exit)."""
+    material = bpy.data.materials.new(name)
+    material.use_nodes = True
+    tree = material.node_tree
+    tree.nodes.remove(tree.nodes["Principled BSDF"])
+    node = tree.nodes.new("ShaderNodeSubsurfaceScattering")
+    node.falloff = 'RANDOM_WALK_FIXED_RADIUS'
+    node.inputs["Color"].default_value = (color[0], color[1], color[2], 1.0)
+    node.inputs["Scale"].default_value = scale
+    node.inputs["Radius"].default_value = tuple(radius)
+    tree.links.new(node.outputs[0], tree.nodes["Material Output"].inputs["Surface"])
+    return material
+
+
 def diffuse_material(name, color):
     material = bpy.data.materials.new(name)
     material.use_nodes = True
@@ -150,15 +167,19 @@ def slab_scene(resolution=32, samples=256, thickness=0.1, color=(0.8, 0.8, 0.8),
     return scene
 
 
-def sphere_scene(resolution=32, samples=256):
+def sphere_scene(resolution=32, samples=256, shader='PRINCIPLED'):
     """A sphere of radius 1 m, smooth shaded, lit by a sun from the camera's side (45 degrees
     off the view axis), seen by a perspective camera. Radius (0.5, 0.25, 0.1) m (mean free
-    paths 0.04, 0.02, 0.008 m), colour (0.9, 0.6, 0.4): thick front-lit wax-like."""
+    paths 0.04, 0.02, 0.008 m), colour (0.9, 0.6, 0.4): thick front-lit wax-like. shader:
+    'PRINCIPLED' (Principled BSDF) or 'SSS' (the Subsurface Scattering node)."""
     scene = _reset()
     scene.render.resolution_x = resolution
     scene.render.resolution_y = resolution
     scene.cycles.samples = samples
-    material = principled_material("Wax", (0.9, 0.6, 0.4), (0.5, 0.25, 0.1))
+    if shader == 'PRINCIPLED':
+        material = principled_material("Wax", (0.9, 0.6, 0.4), (0.5, 0.25, 0.1))
+    else:
+        material = sss_node_material("Wax", (0.9, 0.6, 0.4), (0.5, 0.25, 0.1))
     bpy.ops.mesh.primitive_uv_sphere_add(segments=48, ring_count=24, radius=1.0)
     sphere = bpy.context.active_object
     sphere.name = "Sphere"
