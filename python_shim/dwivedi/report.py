@@ -11,7 +11,8 @@ Runs benchmark scenes through the shim and writes DIR/report.md, DIR/report.json
    (rmse_<scene>.png). Scenes: the default scene, a thin back-lit slab and a thick front-lit
    sphere (both built here from triangles, with Cycles-compatible materials).
 3. Cycles (where Blender is installed and the source tree is at hand): the Blender test scenes of
-   tests/blender/scenes.py, rendered by Cycles and baked by dwivedi (through the add-on's export)
+   tests/blender/scenes.py (the slab with a Principled BSDF, the sphere with the Subsurface
+   Scattering node, whose walk is the one dwivedi bakes: see docs/cycles-conventions.md), rendered by Cycles and baked by dwivedi (through the add-on's export)
    at growing sample counts inside one headless Blender; the RMSE of each against a converged
    reference (Cycles at the largest count x 4, another seed) is plotted against seconds, and the
    time each needs to reach the same RMSE is compared (cycles_<scene>.png). Cycles' time is its
@@ -205,7 +206,10 @@ def cycles(scene, spp, seed, path):
 
 out = {}
 for name in args["scenes_list"]:
-    scene = getattr(scenes, name + "_scene")(args["size"], 16)
+    builders = {"slab": scenes.slab_scene,
+                # The Subsurface Scattering node: the plain walk, which Blender 3.x's Principled is not.
+                "sphere": lambda r, s: scenes.sphere_scene(r, s, shader='SSS')}
+    scene = builders[name](args["size"], 16)
     work = args["work"]
     overhead = cycles(scene, 1, 0, f"{work}/{name}_c1.exr")
     ref_spp = 4 * args["cycles_counts"][-1]
