@@ -132,16 +132,23 @@ static int pixel_active(const dwvb_bake *bake, uint32_t index)
     return bake->options.target == DWV_BAKE_CAMERA || bake->raster.texels[index].triangle >= 0;
 }
 
+/* Whether the worker must stop: cancelled, or (with a time limit) out of time. */
+static int must_stop(dwvb_bake *bake)
+{
+    if (atomic_load_explicit(&bake->cancelled, memory_order_relaxed)) return 1;
+    if (bake->options.time_limit > 0.0 && elapsed(bake) >= bake->options.time_limit) {
+        atomic_store(&bake->time_up, 1);
+        return 1;
+    }
+    return 0;
+}
+
 static void *worker(void *arg)
 {
     dwvb_bake *bake = arg;
     uint32_t tile_size = bake->options.tile_size;
-    for (;;) {
-        if (atomic_load(&bake->cancelled)) break;
-        if (bake->options.time_limit > 0.0 && elapsed(bake) >= bake->options.time_limit) {
-            atomic_store(&bake->time_up, 1);
-            break;
-        }
+    int stop = 0;
+    while (!stop && !must_stop(bake)) {
         uint32_t tile = atomic_fetch_add(&bake->next_tile, 1u);
         if (tile >= bake->tile_count) break;
         uint32_t x0 = (tile % bake->tiles_x) * tile_size, y0 = (tile / bake->tiles_x) * tile_size;
@@ -149,14 +156,15 @@ static void *worker(void *arg)
         uint32_t y1 = y0 + tile_size < bake->height ? y0 + tile_size : bake->height;
         dwvb_tally *tally = &bake->tile_tallies[tile];
         uint64_t events_before = tally->events;
-        for (uint32_t y = y0; y < y1; ++y) {
-            for (uint32_t x = x0; x < x1; ++x) {
+        for (uint32_t y = y0; y < y1 && !stop; ++y) {
+            for (uint32_t x = x0; x < x1 && !stop; ++x) {
                 uint32_t index = y * bake->width + x;
                 if (!pixel_active(bake, index)) continue;
                 pixel_sums *p = &bake->sums[index];
                 for (uint64_t s = bake->pass_first; s < bake->pass_end; ++s) {
-                    /* Checked per sample: a sample ends within max_events, so cancel is quick. */
-                    if (atomic_load_explicit(&bake->cancelled, memory_order_relaxed)) goto out;
+                    /* Checked per sample, which ends within max_events: cancel is quick and a
+                     * time limit cuts where the clock says (pixels keep the samples they got). */
+                    if ((stop = must_stop(bake))) break;
                     double rgb[3], alpha;
                     sample_pixel(bake, index, s, rgb, &alpha, tally);
                     for (int c = 0; c < 3; ++c) {
@@ -171,9 +179,8 @@ static void *worker(void *arg)
             }
         }
         atomic_fetch_add(&bake->events, tally->events - events_before);
-        atomic_fetch_add(&bake->tiles_done, 1u);
+        if (!stop) atomic_fetch_add(&bake->tiles_done, 1u);
     }
-out:
     pthread_mutex_lock(&bake->lock);
     --bake->workers_running;
     pthread_cond_broadcast(&bake->changed);
@@ -443,6 +450,11 @@ static void setup_guides(dwvb_bake *bake)
         /* Incident guiding needs lit patches; where a mesh has none (no light reaches it) it
          * aims at the closest surface point instead, as auto does. */
         if (technique == DWVW_INCIDENT && scene->patch_count[m] == 0) technique = DWVW_CLOSEST;
+        /* Auto leaves media to classical sampling below albedo 0.2 (dwvw_auto_weights); Cycles'
+         * floor raises every lower albedo to exactly 0.2, where walks average about 1.25 events
+         * and guiding has nothing to gain, so those stay classical too. */
+        if (technique == DWVW_AUTO && material->medium.albedo[material->medium.guide_channel] <= DWVB_MIN_ALPHA)
+            technique = DWVW_CLASSICAL;
         dwvw_guide_init(&bake->guides[m], technique, &material->medium, scene->patches[m], scene->patch_count[m]);
         bake->needs_closest[m] = dwvw_guide_needs_closest(&bake->guides[m]);
         if (!mesh_used(bake, m)) continue;

@@ -33,6 +33,9 @@ static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvb_materia
             if (!(found && first && hit.prim == entry_prim)) break;
             tnear = nextafterf((float)hit.t, INFINITY);
         }
+        /* A closed mesh surrounds every point inside: a probe that meets nothing means the
+         * mesh is open there (or the ray slipped through), and the walk may wander off. */
+        if (first && !found) ++tally->warnings;
         first = 0;
         dwvw_vec3 normal = dwvw_v(0.0, 0.0, 0.0);
         if (found) {

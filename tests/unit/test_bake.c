@@ -345,6 +345,46 @@ static void test_uv(void)
     dwv_scene_release(scene);
 }
 
+/* Bad geometry is met and counted, never a crash or a non-finite pixel: a box without its top
+ * face (the camera looks into it: it sees the inside of subsurface faces, and walks entering the
+ * sides find no surface above) and a zero-area triangle. */
+static void test_warnings(void)
+{
+    dwv_scene_t *scene;
+    dwv_scene_create(&scene);
+    dwv_material_t m = white_medium(0.3, 0.3, 0.3);
+    test_mesh box = test_box(-1.0, -1.0, -1.0, 1.0, 1.0, 1.0);
+    /* The top (+z) face is triangles 2 and 3: the last two (the +x face) take their place. */
+    for (int k = 0; k < 6; ++k) box.indices[6 + k] = box.indices[30 + k];
+    box.triangle_count = 10;
+    box.indices[0] = box.indices[1]; /* triangle 0: zero area */
+    test_add(scene, &box, &m);
+    test_mesh_free(&box);
+    double white[3] = {1.0, 1.0, 1.0};
+    dwv_camera_t camera = test_ortho_camera(0.0, 0.0, 5.0, 3.0);
+    dwv_scene_set_world(scene, white, 1.0);
+    dwv_scene_set_camera(scene, &camera);
+    CHECK(dwv_scene_commit(scene) == DWV_SUCCESS, "commit: %s", dwv_last_error_message());
+    dwv_bake_options_t o = DWV_BAKE_OPTIONS_INIT;
+    o.width = o.height = 16;
+    o.samples = 4;
+    dwv_image_t *image = NULL;
+    CHECK(dwv_bake(scene, &o, &image) == DWV_SUCCESS, "bake: %s", dwv_last_error_message());
+    if (image) {
+        dwv_bake_stats_t st = DWV_BAKE_STATS_INIT;
+        dwv_image_stats(image, &st);
+        dwv_image_info_t info = DWV_IMAGE_INFO_INIT;
+        dwv_image_info(image, &info);
+        int finite = 1;
+        for (int i = 0; i < 4 * 16 * 16; ++i) finite &= isfinite(info.rgba[i]);
+        CHECK(finite, "finite pixels");
+        CHECK(st.warnings > 1, "warnings %llu", (unsigned long long)st.warnings);
+        printf("open box: %llu warnings\n", (unsigned long long)st.warnings);
+        dwv_image_release(image);
+    }
+    dwv_scene_release(scene);
+}
+
 static void test_refusals(void)
 {
     dwv_scene_t *open_scene, *scene = mixed_scene();
@@ -456,5 +496,6 @@ int main(void)
     test_determinism();
     test_cancel_and_budgets();
     test_uv();
+    test_warnings();
     return check_report("test_bake");
 }
