@@ -473,10 +473,10 @@ static int refusals(void)
 static void test_sizes(void)
 {
     CHECK(refusals() == 0, "refusals");
-    const char *preload = getenv("LD_PRELOAD");
 #ifdef SHADOW_MEMORY
     int limited = 0;
 #else
+    const char *preload = getenv("LD_PRELOAD");
     int limited = !(preload && strstr(preload, "vgpreload"));
 #endif
     if (!limited) {
