@@ -5,7 +5,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(build-essential cmake pkg-config binutils python3 python3-mpmath python3-numpy python3-matplotlib
-          libopenexr-dev openexr libopencolorio-dev opencolorio-tools libpng-dev)
+          libopenexr-dev openexr libopencolorio-dev opencolorio-tools libpng-dev
+          libcjson-dev libassimp-dev)
 # Blender 3.4 for the add-on's headless tests (tests/blender, registered only where it is found).
 packages+=(blender)
 

@@ -18,6 +18,7 @@
 #include <assimp/scene.h>
 
 #include "api/error.h"
+#include "io/ply_check.h"
 
 /* Assimp keeps its last error in one global string, so imports are taken one at a time: the
  * message read after a failed import is then that import's own. */
@@ -64,6 +65,14 @@ static int all_finite(const struct aiScene *scene)
         }
     }
     return 1;
+}
+
+static int has_polygons(const struct aiScene *scene)
+{
+    for (unsigned m = 0; m < scene->mNumMeshes; ++m)
+        for (unsigned f = 0; f < scene->mMeshes[m]->mNumFaces; ++f)
+            if (scene->mMeshes[m]->mFaces[f].mNumIndices > 3u) return 1;
+    return 0;
 }
 
 static dwv_result_t convert(const struct aiScene *scene, const char *path, dwvio_mesh_data *out)
@@ -147,17 +156,21 @@ dwv_result_t dwvio_mesh_file_read(const char *path, dwvio_mesh_data *mesh)
     FILE *probe = fopen(path, "rb");
     if (!probe) return dwv_fail(DWV_ERROR_IO, "mesh file '%s': %s", path, strerror(errno));
     fclose(probe);
+    if (has_extension(path, ".ply")) DWV_TRY(dwvio_ply_check(path));
 
-    /* Triangulate polygons; bake the node hierarchy into the vertices; drop points and lines;
-     * let Assimp check its own output (indices in range and the like). */
-    const unsigned flags = aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType |
-                           aiProcess_ValidateDataStructure;
+    /* Bake the node hierarchy into the vertices; drop points and lines; let Assimp check its own
+     * output (indices in range and the like). */
+    const unsigned flags = aiProcess_PreTransformVertices | aiProcess_SortByPType | aiProcess_ValidateDataStructure;
     struct aiPropertyStore *props = aiCreatePropertyStore();
     if (!props) return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "mesh file '%s': no memory for the importer", path);
     aiSetImportPropertyInteger(props, AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
 
     pthread_mutex_lock(&assimp_lock);
     const struct aiScene *scene = aiImportFileExWithProperties(path, flags, NULL, props);
+    /* Triangulate only when a face has more than 3 corners: Assimp 5.2's triangulation asserts
+     * (and aborts the process) on a mesh flagged as polygons that holds only triangles, which its
+     * PLY reader can produce (found by tests/fuzz/fuzz_mesh_file). */
+    if (scene && has_polygons(scene)) scene = aiApplyPostProcessing(scene, aiProcess_Triangulate);
     /* Then join identical vertices (OBJ corners come one vertex each), so that smooth normals are
      * shared. Not with a NaN or infinity in the file: the join would merge such a vertex into
      * another one and hide it, where the scene's own check should refuse it. */

@@ -61,6 +61,20 @@ static double signed_volume(const dwvio_mesh_data *m)
     return volume;
 }
 
+/* The smallest triangle area (float positions, as the scene keeps them). */
+static double smallest_area(const dwvio_mesh_data *m)
+{
+    double smallest = HUGE_VAL;
+    for (size_t t = 0; t < m->triangle_count; ++t) {
+        const uint32_t *tri = m->indices + 3u * t;
+        const float *a = m->positions + 3u * tri[0], *b = m->positions + 3u * tri[1], *c = m->positions + 3u * tri[2];
+        double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+        smallest = fmin(smallest, 0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]));
+    }
+    return smallest;
+}
+
 /* Vertex normals unit and on the outer side of every face around them. */
 static int normals_outward(const dwvio_mesh_data *m, double *worst)
 {
@@ -102,6 +116,7 @@ static void test_leaf(void)
     double worst;
     CHECK(normals_outward(&leaf, &worst), "leaf normals: worst cosine to a face %.3g", worst);
     CHECK(uvs_in_unit_square(&leaf), "leaf UVs outside [0, 1]");
+    CHECK(smallest_area(&leaf) > 1e-10, "a leaf triangle of area %.3g m^2", smallest_area(&leaf));
     /* Thickness at the middle: the two poles (first and last vertices), along -y. */
     const float *front = leaf.positions, *back = leaf.positions + 3u * (leaf.vertex_count - 1u);
     CHECK(fabs(front[0]) < 1e-12 && fabs(back[0]) < 1e-12 && fabs((double)back[1] - front[1] - DWVIO_LEAF_THICKNESS) < 1e-7,
@@ -146,6 +161,7 @@ static void test_block(void)
     double worst;
     CHECK(normals_outward(&block, &worst), "block normals: worst cosine to a face %.3g", worst);
     CHECK(uvs_in_unit_square(&block), "block UVs outside [0, 1]");
+    CHECK(smallest_area(&block) > 1e-8, "a block triangle of area %.3g m^2", smallest_area(&block));
     CHECK(block.vertex_count == 6u * 24u * 24u + 2u, "welded block has %u vertices (a closed cube grid has 6 n^2 + 2)",
           block.vertex_count);
     dwvio_mesh_data_free(&block);
