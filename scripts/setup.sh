@@ -5,8 +5,10 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(build-essential cmake pkg-config binutils python3 python3-mpmath python3-numpy python3-matplotlib
-          libopenexr-dev openexr libopencolorio-dev opencolorio-tools libpng-dev libcjson-dev libassimp-dev
+          libopenexr-dev openexr libopencolorio-dev opencolorio-tools libpng-dev libcjson-dev libassimp-dev libembree-dev
           abigail-tools valgrind clang-14 libclang-rt-14-dev)
+# Blender 3.4 for the add-on's headless tests (tests/blender, registered only where it is found).
+packages+=(blender)
 
 missing=()
 for p in "${packages[@]}"; do

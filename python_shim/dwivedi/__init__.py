@@ -1,5 +1,10 @@
 """dwivedi: Dwivedi-guided random-walk subsurface scattering, from Python.
 
+Scenes and bakes (see dwivedi.baker): build a Scene of meshes with Materials, lights, a world and
+a Camera (or Scene.load a scene file, or take Scene.default()), commit it, bake(scene, ...) it into
+an Image, and write that as OpenEXR or a colour-managed PNG. The kernel functions (diffusion
+length, Dwivedi sampling) are below.
+
 A thin ctypes shim over libdwivedi's C API (capi/dwivedi.h); standard library only. The library is
 looked for on the first call, in this order (see ``library_path()``):
 
@@ -29,11 +34,32 @@ from dataclasses import dataclass
 from typing import NamedTuple, Tuple
 
 from . import _library
-from ._library import Error, library_path
+from ._library import Error, library_path, use_library
+from .baker import (AreaLight, Bake, BakeSettings, BakeStats, Camera, Cancelled, DisplaySettings, ErrorPoint, Image,
+                    Material, PointLight, Progress, Scene, SunLight, bake, feature_names, start_bake, techniques)
 
 __all__ = [
     "Error",
+    "Cancelled",
     "library_path",
+    "use_library",
+    "Scene",
+    "Material",
+    "SunLight",
+    "PointLight",
+    "AreaLight",
+    "Camera",
+    "BakeSettings",
+    "Bake",
+    "Progress",
+    "bake",
+    "start_bake",
+    "Image",
+    "BakeStats",
+    "ErrorPoint",
+    "DisplaySettings",
+    "techniques",
+    "feature_names",
     "version",
     "methods",
     "diffusion_length",

@@ -11,7 +11,7 @@ import ctypes.util
 import os
 import threading
 from pathlib import Path
-from typing import Dict, Iterator, List, Optional, Sequence, Tuple
+from typing import Callable, Dict, Iterator, List, Optional, Sequence, Tuple
 
 # The environment variable naming the library file to load, bypassing the search.
 ENV_VARIABLE = "DWIVEDI_LIBRARY"
@@ -22,8 +22,17 @@ SOURCE_TREE_MARKER = Path("capi") / "dwivedi.h"
 
 # dwv_result_t values (capi/dwivedi.h).
 DWV_SUCCESS = 0
+DWV_ERROR_NULL_POINTER = 1
+DWV_ERROR_INVALID_ARGUMENT = 2
 DWV_ERROR_OUT_OF_RANGE = 3
+DWV_ERROR_STRUCT_SIZE = 4
 DWV_ERROR_UNKNOWN_NAME = 5
+DWV_ERROR_OUT_OF_MEMORY = 6
+DWV_ERROR_INTERNAL = 7
+DWV_ERROR_INVALID_STATE = 8
+DWV_ERROR_CANCELLED = 9
+DWV_ERROR_IO = 10
+DWV_ERROR_FORMAT = 11
 
 
 class Error(ValueError):
@@ -104,6 +113,191 @@ class DwivediSample(_SizedStructure):
     ]
 
 
+# ---- The baker API (scenes, bakes, images, output, scene files): capi/dwivedi.h's last part. ----
+
+_Vec3 = ctypes.c_double * 3
+_Transform = ctypes.c_double * 12
+
+
+class Material(_SizedStructure):
+    """dwv_material_t."""
+
+    _fields_ = [
+        ("struct_size", ctypes.c_uint32),
+        ("kind", ctypes.c_int32),
+        ("base_color", _Vec3),
+        ("subsurface_weight", ctypes.c_double),
+        ("subsurface_color", _Vec3),
+        ("subsurface_radius", _Vec3),
+        ("subsurface_scale", ctypes.c_double),
+        ("subsurface_anisotropy", ctypes.c_double),
+        ("subsurface_ior", ctypes.c_double),
+    ]
+
+
+class Mesh(_SizedStructure):
+    """dwv_mesh_t (the pointers borrow the caller's buffers for the duration of one call)."""
+
+    _fields_ = [
+        ("struct_size", ctypes.c_uint32),
+        ("vertex_count", ctypes.c_uint32),
+        ("triangle_count", ctypes.c_uint32),
+        ("material_id", ctypes.c_uint32),
+        ("positions", ctypes.c_void_p),
+        ("indices", ctypes.c_void_p),
+        ("normals", ctypes.c_void_p),
+        ("uvs", ctypes.c_void_p),
+        ("transform", _Transform),
+    ]
+
+
+class LightDesc(_SizedStructure):
+    """dwv_light_desc_t."""
+
+    _fields_ = [
+        ("struct_size", ctypes.c_uint32),
+        ("kind", ctypes.c_int32),
+        ("color", _Vec3),
+        ("strength", ctypes.c_double),
+        ("direction", _Vec3),
+        ("angle", ctypes.c_double),
+        ("position", _Vec3),
+        ("radius", ctypes.c_double),
+        ("transform", _Transform),
+        ("size_x", ctypes.c_double),
+        ("size_y", ctypes.c_double),
+    ]
+
+
+class CameraDesc(_SizedStructure):
+    """dwv_camera_t."""
+
+    _fields_ = [
+        ("struct_size", ctypes.c_uint32),
+        ("kind", ctypes.c_int32),
+        ("transform", _Transform),
+        ("focal_length", ctypes.c_double),
+        ("sensor_width", ctypes.c_double),
+        ("ortho_scale", ctypes.c_double),
+    ]
+
+
+class BakeProgress(_SizedStructure):
+    """dwv_bake_progress_t."""
+
+    _fields_ = [
+        ("struct_size", ctypes.c_uint32),
+        ("done", ctypes.c_uint32),
+        ("fraction", ctypes.c_double),
+        ("seconds", ctypes.c_double),
+        ("estimated_relative_error", ctypes.c_double),
+        ("samples_per_pixel", ctypes.c_uint64),
+        ("events", ctypes.c_uint64),
+    ]
+
+
+# dwv_progress_callback_t. The shim polls progress on the caller's thread instead of passing a
+# callback (Python callbacks on the library's threads would run user code, Blender's API among
+# it, off the main thread), so the field stays NULL.
+ProgressCallback = ctypes.CFUNCTYPE(ctypes.c_int32, ctypes.c_void_p, ctypes.POINTER(BakeProgress))
+
+
+class BakeOptions(_SizedStructure):
+    """dwv_bake_options_t, with the defaults of DWV_BAKE_OPTIONS_INIT."""
+
+    _fields_ = [
+        ("struct_size", ctypes.c_uint32),
+        ("target", ctypes.c_int32),
+        ("width", ctypes.c_uint32),
+        ("height", ctypes.c_uint32),
+        ("uv_mesh", ctypes.c_uint32),
+        ("uv_margin", ctypes.c_uint32),
+        ("technique", ctypes.c_int32),
+        ("samples", ctypes.c_uint64),
+        ("time_limit", ctypes.c_double),
+        ("target_error", ctypes.c_double),
+        ("threads", ctypes.c_uint32),
+        ("max_events", ctypes.c_uint32),
+        ("seed", ctypes.c_uint64),
+        ("tile_size", ctypes.c_uint32),
+        ("reserved", ctypes.c_uint32),
+        ("progress", ProgressCallback),
+        ("progress_user", ctypes.c_void_p),
+    ]
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.width = 256
+        self.height = 256
+        self.uv_margin = 16
+        self.samples = 64
+
+
+class ImageInfo(_SizedStructure):
+    """dwv_image_info_t."""
+
+    _fields_ = [
+        ("struct_size", ctypes.c_uint32),
+        ("width", ctypes.c_uint32),
+        ("height", ctypes.c_uint32),
+        ("reserved", ctypes.c_uint32),
+        ("rgba", ctypes.c_void_p),
+        ("variance", ctypes.c_void_p),
+        ("samples", ctypes.c_void_p),
+    ]
+
+
+class BakeStats(_SizedStructure):
+    """dwv_bake_stats_t."""
+
+    _fields_ = [
+        ("struct_size", ctypes.c_uint32),
+        ("technique", ctypes.c_int32),
+        ("samples_per_pixel", ctypes.c_uint64),
+        ("samples", ctypes.c_uint64),
+        ("events", ctypes.c_uint64),
+        ("walks", ctypes.c_uint64),
+        ("seconds", ctypes.c_double),
+        ("estimated_relative_error", ctypes.c_double),
+        ("mean_rgb", _Vec3),
+        ("truncated_weight", _Vec3),
+        ("features", ctypes.c_uint32),
+        ("threads", ctypes.c_uint32),
+        ("warnings", ctypes.c_uint64),
+        ("error_vs_time_count", ctypes.c_uint32),
+        ("reserved", ctypes.c_uint32),
+    ]
+
+
+class ErrorPoint(ctypes.Structure):
+    """dwv_error_point_t (no struct_size: an element of an array)."""
+
+    _fields_ = [
+        ("seconds", ctypes.c_double),
+        ("estimated_relative_error", ctypes.c_double),
+        ("samples_per_pixel", ctypes.c_uint64),
+    ]
+
+
+class DisplayOptions(_SizedStructure):
+    """dwv_display_options_t, with the defaults of DWV_DISPLAY_OPTIONS_INIT."""
+
+    _fields_ = [
+        ("struct_size", ctypes.c_uint32),
+        ("reserved", ctypes.c_uint32),
+        ("config_path", ctypes.c_char_p),
+        ("display", ctypes.c_char_p),
+        ("view", ctypes.c_char_p),
+        ("look", ctypes.c_char_p),
+        ("exposure", ctypes.c_double),
+        ("gamma", ctypes.c_double),
+    ]
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.gamma = 1.0
+
+
 _result_t = ctypes.c_int32
 _method_t = ctypes.c_int32
 _double_p = ctypes.POINTER(ctypes.c_double)
@@ -124,6 +318,47 @@ _PROTOTYPES: Dict[str, Tuple[object, Sequence[object]]] = {
     "dwv_dwivedi_stretch": (_result_t, (_dwivedi_p, ctypes.c_double, _double_p)),
 }
 
+_p = ctypes.POINTER
+_handle_p = ctypes.c_void_p  # dwv_scene_t *, dwv_bake_t *, dwv_image_t * (opaque)
+_handle_pp = ctypes.POINTER(ctypes.c_void_p)
+
+# The baker API: a library built before it lacks these, and the kernel functions must keep working
+# with such a library; a missing one raises Error when called (see function()).
+_BAKER_PROTOTYPES: Dict[str, Tuple[object, Sequence[object]]] = {
+    "dwv_technique_name": (ctypes.c_char_p, (ctypes.c_int32,)),
+    "dwv_technique_from_name": (_result_t, (ctypes.c_char_p, _p(ctypes.c_int32))),
+    "dwv_feature_name": (ctypes.c_char_p, (ctypes.c_uint32,)),
+    "dwv_scene_create": (_result_t, (_handle_pp,)),
+    "dwv_scene_retain": (_result_t, (_handle_p,)),
+    "dwv_scene_release": (None, (_handle_p,)),
+    "dwv_scene_add_material": (_result_t, (_handle_p, _p(Material), _p(ctypes.c_uint32))),
+    "dwv_scene_add_mesh": (_result_t, (_handle_p, _p(Mesh), _p(ctypes.c_uint32))),
+    "dwv_scene_add_light": (_result_t, (_handle_p, _p(LightDesc))),
+    "dwv_scene_set_world": (_result_t, (_handle_p, _p(ctypes.c_double), ctypes.c_double)),
+    "dwv_scene_set_camera": (_result_t, (_handle_p, _p(CameraDesc))),
+    "dwv_scene_commit": (_result_t, (_handle_p,)),
+    "dwv_bake_start": (_result_t, (_handle_p, _p(BakeOptions), _handle_pp)),
+    "dwv_bake_wait": (_result_t, (_handle_p, ctypes.c_double, _p(ctypes.c_int32))),
+    "dwv_bake_progress": (_result_t, (_handle_p, _p(BakeProgress))),
+    "dwv_bake_cancel": (_result_t, (_handle_p,)),
+    "dwv_bake_finish": (_result_t, (_handle_p, _handle_pp)),
+    "dwv_bake_release": (None, (_handle_p,)),
+    "dwv_bake": (_result_t, (_handle_p, _p(BakeOptions), _handle_pp)),
+    "dwv_image_info": (_result_t, (_handle_p, _p(ImageInfo))),
+    "dwv_image_stats": (_result_t, (_handle_p, _p(BakeStats))),
+    "dwv_image_error_vs_time": (_result_t, (_handle_p, _p(ErrorPoint), ctypes.c_uint32, _p(ctypes.c_uint32))),
+    "dwv_image_retain": (_result_t, (_handle_p,)),
+    "dwv_image_release": (None, (_handle_p,)),
+    "dwv_image_create": (_result_t, (ctypes.c_uint32, ctypes.c_uint32, ctypes.c_void_p, _handle_pp)),
+    "dwv_image_write_exr": (_result_t, (_handle_p, ctypes.c_char_p)),
+    "dwv_image_write_display_png": (_result_t, (_handle_p, ctypes.c_char_p, _p(DisplayOptions))),
+    "dwv_image_to_display": (_result_t, (_handle_p, _p(DisplayOptions), ctypes.c_void_p, ctypes.c_uint64)),
+    "dwv_scene_load": (_result_t, (ctypes.c_char_p, _handle_pp, _p(BakeOptions))),
+    "dwv_scene_load_json": (_result_t, (ctypes.c_char_p, ctypes.c_uint64, ctypes.c_char_p, _handle_pp,
+                                        _p(BakeOptions))),
+    "dwv_scene_create_default": (_result_t, (_handle_pp, _p(BakeOptions))),
+}
+
 _lock = threading.Lock()
 _loaded: Optional[Tuple[ctypes.CDLL, str]] = None
 
@@ -135,6 +370,11 @@ def _open(name: str) -> ctypes.CDLL:
         function = getattr(lib, function_name)
         function.restype = restype
         function.argtypes = list(argtypes)
+    for function_name, (restype, argtypes) in _BAKER_PROTOTYPES.items():
+        function = getattr(lib, function_name, None)
+        if function is not None:
+            function.restype = restype
+            function.argtypes = list(argtypes)
     return lib
 
 
@@ -233,6 +473,44 @@ def _loaded_library() -> Tuple[ctypes.CDLL, str]:
 def library() -> ctypes.CDLL:
     """The loaded library; Error if there is none."""
     return _loaded_library()[0]
+
+
+def loaded_path() -> Optional[str]:
+    """Where the library in use came from, or None if none was loaded yet (never loads one)."""
+    with _lock:
+        return None if _loaded is None else _loaded[1]
+
+
+def use_library(path: Optional[str]) -> Optional[str]:
+    """Loads the library from `path` (a file) in place of the one found by the search, for every
+    later call; returns the absolute path. Objects made with the previous library keep using it.
+    Error if the file is missing or is not libdwivedi (the previous choice then stays).
+    use_library(None) forgets the choice: the next call searches again (see library_path)."""
+    global _loaded
+    if path is None:
+        with _lock:
+            _loaded = None
+        return None
+    absolute = os.path.abspath(os.fspath(path))
+    if not Path(absolute).is_file():
+        raise Error(f"the library {absolute} is not a file")
+    try:
+        lib = _open(absolute)
+    except (OSError, AttributeError) as error:
+        raise Error(f"{absolute} cannot be loaded as libdwivedi: {error}") from None
+    with _lock:
+        _loaded = (lib, absolute)
+    return absolute
+
+
+def function(name: str) -> Callable[..., object]:
+    """The library's function `name`, declared; Error if this library predates it."""
+    lib = library()
+    found = getattr(lib, name, None) if name in _BAKER_PROTOTYPES or name in _PROTOTYPES else None
+    if found is None:
+        raise Error(f"{name} is missing from {library_path()}: that libdwivedi was built without this part "
+                    "of the baker API (rebuild it, or point DWIVEDI_LIBRARY at a newer one)", DWV_ERROR_INVALID_STATE)
+    return found
 
 
 def library_path() -> str:

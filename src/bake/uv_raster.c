@@ -238,6 +238,23 @@ void dwvb_uv_raster_free(dwvb_uv_raster *raster)
 static const int neighbour_dx[8] = {-1, 1, 0, 0, -1, 1, -1, 1};
 static const int neighbour_dy[8] = {0, 0, -1, 1, -1, -1, 1, 1};
 
+/* The indices of texel i's neighbours inside the image, in the order above; returns how many.
+ * `offset` holds the index differences of the eight (dx + dy width, modulo 2^32). */
+static inline int neighbours(uint32_t width, uint32_t height, const uint32_t offset[8], uint32_t i, uint32_t out[8])
+{
+    uint32_t x = i % width, y = i / width;
+    int n = 0;
+    if (x - 1u < width - 2u && y - 1u < height - 2u) { /* 0 < x < width - 1, 0 < y < height - 1 */
+        for (int k = 0; k < 8; ++k) out[k] = i + offset[k];
+        return 8;
+    }
+    for (int k = 0; k < 8; ++k) {
+        int64_t nx = (int64_t)x + neighbour_dx[k], ny = (int64_t)y + neighbour_dy[k];
+        if (nx >= 0 && ny >= 0 && nx < width && ny < height) out[n++] = (uint32_t)(ny * width + nx);
+    }
+    return n;
+}
+
 typedef struct index_list {
     uint32_t *items;
     size_t count, capacity;
@@ -266,56 +283,45 @@ dwv_result_t dwvb_uv_margin_build(const dwvb_uv_raster *raster, uint32_t margin,
     DWV_TRY(dwv_check_pointer(fn, "raster", raster));
     DWV_TRY(dwv_check_pointer(fn, "raster->texels", raster->texels));
     const uint32_t width = raster->width, height = raster->height;
-    const size_t count = (size_t)width * height; /* the raster was checked when it was made */
+    const size_t count = (size_t)width * height; /* <= 2^26: checked when the raster was made */
     uint32_t *source = malloc(count * sizeof *source);
     index_list frontier = {NULL, 0, 0}, next = {NULL, 0, 0}, chosen = {NULL, 0, 0};
+    uint32_t near[8], offset[8];
+    for (int k = 0; k < 8; ++k) offset[k] = (uint32_t)neighbour_dx[k] + (uint32_t)neighbour_dy[k] * width;
     if (!source) goto out_of_memory;
     for (size_t i = 0; i < count; ++i) source[i] = raster->texels[i].triangle >= 0 ? (uint32_t)i : DWVB_UV_NO_SOURCE;
 
-    uint32_t passes = margin < (width > height ? width : height) ? margin : (width > height ? width : height);
-    /* Pass 0's frontier: covered texels with an uncovered neighbour. */
-    if (passes > 0u) {
-        for (uint32_t y = 0; y < height; ++y) {
-            for (uint32_t x = 0; x < width; ++x) {
-                size_t i = (size_t)y * width + x;
-                if (source[i] == DWVB_UV_NO_SOURCE) continue;
-                int edge = 0;
-                for (int k = 0; k < 8 && !edge; ++k) {
-                    int64_t nx = (int64_t)x + neighbour_dx[k], ny = (int64_t)y + neighbour_dy[k];
-                    edge = nx >= 0 && ny >= 0 && nx < width && ny < height &&
-                           source[(size_t)ny * width + (size_t)nx] == DWVB_UV_NO_SOURCE;
-                }
-                if (edge && list_push(&frontier, (uint32_t)i, count)) goto out_of_memory;
-            }
-        }
+    const uint32_t side = width > height ? width : height;
+    const uint32_t passes = margin < side ? margin : side; /* no Chebyshev distance reaches side */
+    /* The frontier before pass 1: covered texels with an uncovered neighbour. */
+    for (uint32_t i = 0; passes > 0u && i < count; ++i) {
+        if (source[i] == DWVB_UV_NO_SOURCE) continue;
+        int n = neighbours(width, height, offset, i, near), edge = 0;
+        for (int k = 0; k < n; ++k) edge |= source[near[k]] == DWVB_UV_NO_SOURCE;
+        if (edge && list_push(&frontier, i, count)) goto out_of_memory;
     }
     for (uint32_t pass = 1; pass <= passes && frontier.count > 0; ++pass) {
         /* The texels this pass fills: the unfilled neighbours of the last pass's. */
         next.count = 0;
         for (size_t f = 0; f < frontier.count; ++f) {
-            uint32_t x = frontier.items[f] % width, y = frontier.items[f] / width;
-            for (int k = 0; k < 8; ++k) {
-                int64_t nx = (int64_t)x + neighbour_dx[k], ny = (int64_t)y + neighbour_dy[k];
-                if (nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
-                size_t n = (size_t)ny * width + (size_t)nx;
-                if (source[n] != DWVB_UV_NO_SOURCE) continue;
-                source[n] = PENDING;
-                if (list_push(&next, (uint32_t)n, count)) goto out_of_memory;
+            int n = neighbours(width, height, offset, frontier.items[f], near);
+            for (int k = 0; k < n; ++k) {
+                if (source[near[k]] != DWVB_UV_NO_SOURCE) continue;
+                source[near[k]] = PENDING;
+                if (list_push(&next, near[k], count)) goto out_of_memory;
             }
         }
         /* Each one's source, from neighbours filled before this pass only (so the visiting order
-         * cannot matter): chosen first, written after. */
+         * cannot matter): all chosen first, written after. */
         chosen.count = 0;
         for (size_t f = 0; f < next.count; ++f) {
-            uint32_t x = next.items[f] % width, y = next.items[f] / width;
-            uint32_t best = DWVB_UV_NO_SOURCE;
-            int64_t best_d2 = INT64_MAX;
-            for (int k = 0; k < 8; ++k) {
-                int64_t nx = (int64_t)x + neighbour_dx[k], ny = (int64_t)y + neighbour_dy[k];
-                if (nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
-                uint32_t s = source[(size_t)ny * width + (size_t)nx];
+            uint32_t t = next.items[f], best = DWVB_UV_NO_SOURCE;
+            int64_t best_d2 = INT64_MAX, tx = t % width, ty = t / width;
+            int n = neighbours(width, height, offset, t, near);
+            for (int k = 0; k < n; ++k) {
+                uint32_t s = source[near[k]];
                 if (s >= PENDING) continue;
-                int64_t sx = (int64_t)(s % width) - x, sy = (int64_t)(s / width) - y;
+                int64_t sx = (int64_t)(s % width) - tx, sy = (int64_t)(s / width) - ty;
                 int64_t d2 = sx * sx + sy * sy;
                 if (d2 < best_d2) {
                     best_d2 = d2;

@@ -1,0 +1,422 @@
+"""Dwivedi Subsurface Bake: bakes subsurface scattering (Dwivedi-guided random walks, the dwivedi
+library) from Blender's scene, as the camera sees it or into an object's UV texture.
+
+Settings: Properties editor > Render > "Dwivedi Subsurface Bake" (scene.dwivedi_bake). The
+operator bpy.ops.dwivedi.bake() exports the evaluated scene, bakes it (modal with a progress bar
+and Esc to cancel in the UI; blocking in background mode), writes an OpenEXR and a PNG through
+the scene's colour management into the output folder and loads the EXR as a Blender image.
+"""
+from __future__ import annotations
+
+bl_info = {
+    "name": "Dwivedi Subsurface Bake",
+    "author": "dwivedi developers",
+    "version": (0, 1, 0),
+    "blender": (3, 4, 0),
+    "location": "Properties > Render > Dwivedi Subsurface Bake",
+    "description": "Bake random-walk subsurface scattering with Dwivedi-guided walks (Cycles-compatible)",
+    "category": "Render",
+}
+
+import os
+import traceback
+
+import bpy
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
+
+from . import export
+
+ADDON_NAME = __name__
+
+TECHNIQUES = [
+    ('AUTO', "Auto", "Chosen per scene: incident-illumination guiding with a classical share"),
+    ('CLASSICAL', "Classical", "Analog phase-function and free-flight sampling"),
+    ('POE', "Entry Normal", "Dwivedi sampling about the entry point's normal (Krivanek, d'Eon 2014)"),
+    ('CLOSEST', "Closest Point", "Dwivedi sampling about the closest surface point's normal (Meng 2016)"),
+    ('INCIDENT', "Incident Illumination", "Dwivedi sampling toward lit surface patches (Meng 2016)"),
+    ('BACKWARD', "Backward", "Entry normal or an opposite interface, by depth (as Cycles)"),
+    ('CYCLES', "Cycles Mixture", "Cycles' own mixture: half classical, half backward-guided"),
+]
+
+
+_custom_library = False  # the preferences' library is in use (not the bundled one)
+
+
+def shim():
+    """The dwivedi Python shim: the copy bundled in the add-on, else one on sys.path; with the
+    library from the add-on preferences when one is set."""
+    try:
+        from . import dwivedi  # bundled by tools/package_addon.py
+    except ImportError:
+        import dwivedi  # a development checkout with python_shim on sys.path
+    prefs = preferences()
+    wanted = prefs.library_path.strip() if prefs is not None else ""
+    global _custom_library
+    if wanted:
+        wanted = os.path.abspath(bpy.path.abspath(wanted))
+        if dwivedi._library.loaded_path() != wanted:
+            dwivedi.use_library(wanted)
+            _custom_library = True
+    elif _custom_library:
+        dwivedi.use_library(None)  # back to the bundled library
+        _custom_library = False
+    return dwivedi
+
+
+def preferences():
+    addon = bpy.context.preferences.addons.get(ADDON_NAME)
+    return addon.preferences if addon is not None else None
+
+
+class DwivediBakePreferences(bpy.types.AddonPreferences):
+    bl_idname = ADDON_NAME
+
+    library_path: StringProperty(
+        name="Library",
+        description="libdwivedi.so.1 to use; empty: the one bundled with the add-on (or found on the system)",
+        subtype='FILE_PATH', default="")
+
+    def draw(self, context):
+        layout = self.layout
+        layout.prop(self, "library_path")
+        try:
+            path = shim().library_path()
+            layout.label(text=f"In use: {path}", icon='CHECKMARK')
+        except Exception as error:  # the library may be missing: show why, never fail drawing
+            layout.label(text=f"Library not usable: {str(error).splitlines()[0]}", icon='ERROR')
+
+
+def _poll_mesh(self, obj):
+    return obj.type == 'MESH'
+
+
+class DwivediBakeSettings(bpy.types.PropertyGroup):
+    target: EnumProperty(name="Target", default='CAMERA', items=[
+        ('CAMERA', "Camera", "The active camera's view at the render resolution"),
+        ('UV', "UV", "The outgoing subsurface radiance of one object laid out in its UV map")])
+    technique: EnumProperty(name="Technique", items=TECHNIQUES, default='AUTO')
+    samples: IntProperty(name="Samples", description="Samples per pixel (the bake stops there)",
+                         default=64, min=0, soft_min=1, max=1 << 24)
+    time_limit: FloatProperty(name="Time Limit", description="Seconds; 0: no limit", default=0.0, min=0.0,
+                              subtype='TIME_ABSOLUTE' if bpy.app.version >= (3, 0, 0) else 'NONE', unit='TIME')
+    target_error: FloatProperty(name="Target Error", description="Relative error of the image to stop at; 0: none",
+                                default=0.0, min=0.0, max=1.0, precision=4)
+    threads: IntProperty(name="Threads", description="0: all cores", default=0, min=0, max=1024)
+    seed: IntProperty(name="Seed", default=0, min=0)
+    output_dir: StringProperty(name="Output Folder", description="Where the EXR and PNG are written",
+                               default="//dwivedi_bake/", subtype='DIR_PATH')
+    uv_object: PointerProperty(name="UV Object", type=bpy.types.Object, poll=_poll_mesh,
+                               description="The mesh whose UV map the UV bake fills")
+    uv_size: IntProperty(name="Image Size", description="Width and height of the UV texture", default=1024,
+                         min=1, max=16384)
+    uv_margin: IntProperty(name="Margin", description="Pixels of dilation around UV islands", default=16,
+                           min=0, max=64)
+    load_result: BoolProperty(name="Load Result", description="Load the baked EXR as a Blender image",
+                              default=True)
+    # Runtime state shown in the panel while a bake runs.
+    running: BoolProperty(default=False, options={'SKIP_SAVE'})
+    progress: FloatProperty(name="Progress", default=0.0, min=0.0, max=100.0, subtype='PERCENTAGE',
+                            options={'SKIP_SAVE'})
+    last_result: StringProperty(default="", options={'SKIP_SAVE'})
+
+
+def output_folder(settings):
+    """The output folder as an absolute path: relative to the .blend ("//"), or to Blender's
+    temporary folder for an unsaved file."""
+    raw = settings.output_dir.strip() or "//dwivedi_bake/"
+    if raw.startswith("//") and not bpy.data.filepath:
+        return os.path.join(bpy.app.tempdir or os.path.realpath("/tmp"), raw[2:])
+    return os.path.abspath(bpy.path.abspath(raw))
+
+
+def _check_folder(folder):
+    try:
+        os.makedirs(folder, exist_ok=True)
+    except OSError as error:
+        raise export.ExportError(f"cannot create the output folder {folder}: {error.strerror}") from None
+    if not os.path.isdir(folder) or not os.access(folder, os.W_OK | os.X_OK):
+        raise export.ExportError(f"the output folder {folder} is not writable")
+
+
+def _safe_name(name):
+    return "".join(c if c.isalnum() or c in "-_." else "_" for c in name) or "scene"
+
+
+class _Job:
+    """One bake: the exported scene, the running dwivedi bake and where its files go."""
+
+    def __init__(self, context, settings):
+        self.dwivedi = shim()
+        if settings.samples < 1:
+            raise export.ExportError(f"Samples is {settings.samples}: a bake needs at least 1 sample per pixel")
+        self.folder = output_folder(settings)
+        _check_folder(self.folder)
+        self.exported = export.export_scene(context, settings, self.dwivedi)
+        scene = context.scene
+        stem = _safe_name(scene.name) + ("_camera" if settings.target == 'CAMERA'
+                                         else "_uv_" + _safe_name(settings.uv_object.name))
+        self.exr = os.path.join(self.folder, stem + ".exr")
+        self.png = os.path.join(self.folder, stem + ".png")
+        self.bake_settings = self.dwivedi.BakeSettings(
+            target=settings.target.lower(), width=self.exported.width, height=self.exported.height,
+            uv_mesh=self.exported.uv_mesh, uv_margin=settings.uv_margin, technique=settings.technique.lower(),
+            samples=settings.samples, time_limit=settings.time_limit, target_error=settings.target_error,
+            threads=settings.threads, seed=settings.seed)
+        self.display = display_settings(scene, self.dwivedi)
+        self.bake = None
+
+    def start(self):
+        self.bake = self.dwivedi.start_bake(self.exported.scene, self.bake_settings)
+
+    def finish(self, context, settings):
+        """Writes the files and loads the image; returns a one-line summary."""
+        image = self.bake.finish()
+        try:
+            image.write_exr(self.exr)
+            image.write_png(self.png, self.display)
+            stats = image.stats
+            if settings.load_result:
+                blender_image(image, "Dwivedi " + ("Camera" if settings.target == 'CAMERA' else "UV"), self.exr)
+        finally:
+            image.close()
+            self.close()
+        return (f"Dwivedi bake: {self.exported.width} x {self.exported.height}, {stats.samples_per_pixel} spp, "
+                f"{stats.seconds:.2f} s, est. error {stats.estimated_relative_error:.2%} -> {self.exr}")
+
+    def close(self):
+        if self.bake is not None:
+            self.bake.close()
+            self.bake = None
+        if self.exported.scene is not None:
+            self.exported.scene.close()
+            self.exported.scene = None
+
+
+def display_settings(scene, dwivedi):
+    """The scene's colour management as dwivedi.DisplaySettings, with Blender's own OCIO config."""
+    view = scene.view_settings
+    look = view.look
+    return dwivedi.DisplaySettings(config=export.ocio_config_path(), display=scene.display_settings.display_device,
+                                   view=view.view_transform, look=None if look in ("", "None") else look,
+                                   exposure=view.exposure, gamma=view.gamma)
+
+
+def blender_image(image, name, path):
+    """The baked pixels as a float Blender image `name` (made again if its size changed), in
+    scene-linear colour, with `path` as its file for Image > Save. Made from memory rather than by
+    loading the EXR: Blender 3.4 cannot read an EXR whose unlayered RGBA sits beside layered
+    channels (variance.R...), which ours has."""
+    import array
+    width, height = image.width, image.height
+    target = bpy.data.images.get(name)
+    if target is not None and (tuple(target.size) != (width, height) or not target.is_float
+                               or target.source != 'GENERATED'):
+        bpy.data.images.remove(target)
+        target = None
+    if target is None:
+        target = bpy.data.images.new(name, width, height, alpha=True, float_buffer=True)
+    for colorspace in ("Linear Rec.709", "Linear"):  # Blender 4.x, 3.x names of scene linear
+        try:
+            target.colorspace_settings.name = colorspace
+            break
+        except TypeError:
+            continue
+    raw = image.rgba.cast("B")  # rows of 16 x width bytes, row 0 at the top; Blender's is the bottom
+    stride = 16 * width
+    flipped = array.array("f")
+    flipped.frombytes(b"".join(raw[y * stride:(y + 1) * stride] for y in range(height - 1, -1, -1)))
+    target.pixels.foreach_set(flipped)
+    target.filepath_raw = path
+    target.file_format = 'OPEN_EXR'
+    target.update()
+    return target
+
+
+class DWIVEDI_OT_bake(bpy.types.Operator):
+    """Bake subsurface scattering with dwivedi (Esc cancels)"""
+    bl_idname = "dwivedi.bake"
+    bl_label = "Dwivedi Subsurface Bake"
+    bl_options = {'REGISTER'}
+
+    _timer = None
+    _job = None
+
+    def _fail(self, context, error):
+        message = str(error) or type(error).__name__
+        if not isinstance(error, (export.ExportError, ValueError, OSError, TypeError)):
+            traceback.print_exc()
+        self.report({'ERROR'}, f"Dwivedi bake failed: {message}")
+        settings = context.scene.dwivedi_bake
+        settings.running = False
+        settings.last_result = message.splitlines()[0] if message else ""
+        return {'CANCELLED'}
+
+    def execute(self, context):
+        settings = context.scene.dwivedi_bake
+        job = None
+        try:
+            job = _Job(context, settings)
+            for warning in job.exported.warnings:
+                self.report({'WARNING'}, warning)
+            image = job.dwivedi.bake(job.exported.scene, job.bake_settings)
+            job.bake = _Finished(image)
+            summary = job.finish(context, settings)
+        except KeyboardInterrupt:
+            if job is not None:
+                job.close()
+            self.report({'WARNING'}, "Dwivedi bake cancelled")
+            return {'CANCELLED'}
+        except Exception as error:  # every failure is reported, none escapes into Blender
+            if job is not None:
+                job.close()
+            return self._fail(context, error)
+        settings.last_result = summary
+        self.report({'INFO'}, summary)
+        return {'FINISHED'}
+
+    def invoke(self, context, event):
+        if bpy.app.background:
+            return self.execute(context)
+        settings = context.scene.dwivedi_bake
+        if settings.running:
+            self.report({'ERROR'}, "a Dwivedi bake is already running")
+            return {'CANCELLED'}
+        try:
+            self._job = _Job(context, settings)
+            for warning in self._job.exported.warnings:
+                self.report({'WARNING'}, warning)
+            self._job.start()
+        except Exception as error:
+            if self._job is not None:
+                self._job.close()
+                self._job = None
+            return self._fail(context, error)
+        settings.running = True
+        settings.progress = 0.0
+        settings.last_result = "baking..."
+        wm = context.window_manager
+        self._timer = wm.event_timer_add(0.1, window=context.window)
+        wm.progress_begin(0, 100)
+        wm.modal_handler_add(self)
+        return {'RUNNING_MODAL'}
+
+    def _end(self, context):
+        wm = context.window_manager
+        if self._timer is not None:
+            wm.event_timer_remove(self._timer)
+            self._timer = None
+        wm.progress_end()
+        context.scene.dwivedi_bake.running = False
+        if context.area is not None:
+            context.area.tag_redraw()
+        for window in wm.windows:
+            for area in window.screen.areas:
+                if area.type == 'PROPERTIES':
+                    area.tag_redraw()
+
+    def modal(self, context, event):
+        settings = context.scene.dwivedi_bake
+        job = self._job
+        try:
+            if event.type == 'ESC':
+                job.bake.cancel()
+                job.bake.wait(1.0)
+                job.close()
+                self._end(context)
+                settings.last_result = "cancelled"
+                self.report({'WARNING'}, "Dwivedi bake cancelled")
+                return {'CANCELLED'}
+            if event.type != 'TIMER':
+                return {'PASS_THROUGH'}
+            progress = job.bake.progress()
+            settings.progress = 100.0 * progress.fraction
+            context.window_manager.progress_update(int(100 * progress.fraction))
+            if context.area is not None:
+                context.area.tag_redraw()
+            for window in context.window_manager.windows:
+                for area in window.screen.areas:
+                    if area.type == 'PROPERTIES':
+                        area.tag_redraw()
+            if not progress.done:
+                return {'RUNNING_MODAL'}
+            summary = job.finish(context, settings)
+        except Exception as error:
+            job.close()
+            self._end(context)
+            return self._fail(context, error)
+        self._end(context)
+        settings.last_result = summary
+        self.report({'INFO'}, summary)
+        return {'FINISHED'}
+
+    def cancel(self, context):
+        # Blender ends the modal operator (file load, quit): stop the bake, free everything.
+        if self._job is not None:
+            self._job.close()
+        self._end(context)
+
+
+class _Finished:
+    """A finished bake's image in the shape of a running bake (execute() bakes in one call)."""
+
+    def __init__(self, image):
+        self._image = image
+
+    def finish(self):
+        return self._image
+
+    def close(self):
+        pass
+
+
+class DWIVEDI_PT_bake(bpy.types.Panel):
+    bl_label = "Dwivedi Subsurface Bake"
+    bl_idname = "DWIVEDI_PT_bake"
+    bl_space_type = 'PROPERTIES'
+    bl_region_type = 'WINDOW'
+    bl_context = "render"
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        settings = context.scene.dwivedi_bake
+        layout.prop(settings, "target", expand=True)
+        if settings.target == 'UV':
+            layout.prop(settings, "uv_object")
+            layout.prop(settings, "uv_size")
+            layout.prop(settings, "uv_margin")
+        else:
+            width, height = export.render_size(context.scene)
+            layout.label(text=f"{width} x {height} (render resolution)")
+        layout.prop(settings, "technique")
+        col = layout.column(align=True)
+        col.prop(settings, "samples")
+        col.prop(settings, "time_limit")
+        col.prop(settings, "target_error")
+        layout.prop(settings, "threads")
+        layout.prop(settings, "seed")
+        layout.prop(settings, "output_dir")
+        layout.prop(settings, "load_result")
+        if settings.running:
+            layout.prop(settings, "progress", slider=True)
+            layout.label(text="Esc cancels", icon='INFO')
+        else:
+            layout.operator(DWIVEDI_OT_bake.bl_idname, icon='RENDER_STILL')
+        if settings.last_result:
+            layout.label(text=settings.last_result)
+
+
+CLASSES = (DwivediBakePreferences, DwivediBakeSettings, DWIVEDI_OT_bake, DWIVEDI_PT_bake)
+
+
+def register():
+    for cls in CLASSES:
+        bpy.utils.register_class(cls)
+    bpy.types.Scene.dwivedi_bake = PointerProperty(type=DwivediBakeSettings)
+
+
+def unregister():
+    del bpy.types.Scene.dwivedi_bake
+    for cls in reversed(CLASSES):
+        bpy.utils.unregister_class(cls)

@@ -1,0 +1,465 @@
+"""Blender scene -> dwivedi.Scene: the evaluated depsgraph's meshes, materials, lights, world and
+camera in Blender's units, which are dwivedi's (capi/dwivedi.h).
+
+Everything here reads Blender data and calls the shim; nothing changes the .blend. Problems that
+make a bake meaningless raise ExportError (the operator reports it); things dwivedi does not model
+(textures on material inputs, spot lights, camera shift...) are collected as warnings and the bake
+goes on with the nearest supported meaning.
+"""
+from __future__ import annotations
+
+import array
+import math
+from typing import Any, Dict, List, Optional, Tuple
+
+import bpy
+
+
+class ExportError(Exception):
+    """The scene cannot be baked as asked (no camera, no UVs...); the message says why."""
+
+
+class Exported:
+    """The outcome of an export: the committed dwivedi scene, the bake's size, the UV mesh id."""
+
+    def __init__(self) -> None:
+        self.scene: Any = None
+        self.width = 0
+        self.height = 0
+        self.uv_mesh = 0
+        self.warnings: List[str] = []
+        self.mesh_count = 0
+        self.triangle_count = 0
+        self.light_count = 0
+
+
+# ---------------------------------------------------------------------------------------------
+# Materials
+# ---------------------------------------------------------------------------------------------
+
+def _input(node: Any, names: Tuple[str, ...]) -> Any:
+    for name in names:
+        socket = node.inputs.get(name)
+        if socket is not None:
+            return socket
+    return None
+
+
+def _value(node: Any, names: Tuple[str, ...], default: Any, material_name: str, warnings: List[str]) -> Any:
+    """The unlinked value of the first input of `names` the node has (Blender 3.x and 4.x name
+    them differently); a linked input (a texture) is not evaluated: its default value is used."""
+    socket = _input(node, names)
+    if socket is None:
+        return default
+    if socket.is_linked:
+        warnings.append(f"material '{material_name}': input '{socket.name}' is linked (textures are not baked); "
+                        "its own value is used")
+    value = socket.default_value
+    try:
+        return tuple(value)
+    except TypeError:
+        return float(value)
+
+
+SHADER_TYPES = ('BSDF_PRINCIPLED', 'SUBSURFACE_SCATTERING')
+
+
+def _surface_shader(material: Any) -> Any:
+    """The Principled BSDF or Subsurface Scattering node that feeds the material's active output
+    (Cycles or All), else the first such node in the tree, else None."""
+    if not material.use_nodes or material.node_tree is None:
+        return None
+    nodes = material.node_tree.nodes
+    output = None
+    for node in nodes:
+        if node.type == 'OUTPUT_MATERIAL' and node.is_active_output and node.target in {'ALL', 'CYCLES'}:
+            output = node
+            break
+    if output is not None:
+        surface = output.inputs.get("Surface")
+        if surface is not None and surface.is_linked:
+            linked = surface.links[0].from_node
+            if linked.type in SHADER_TYPES:
+                return linked
+    for node in nodes:
+        if node.type in SHADER_TYPES:
+            return node
+    return None
+
+
+def material_from_blender(material: Any, dwivedi: Any, warnings: List[str]) -> Any:
+    """A dwivedi.Material from a Blender material (None: Blender's default grey surface).
+
+    Blender 4.x: Subsurface Weight, Subsurface Scale, Subsurface Radius, the base colour is the
+    subsurface colour. Blender 3.x: Subsurface (a factor that also scales the radius), Subsurface
+    Color mixed with Base Color by it, Subsurface Radius (see dwv_material_t)."""
+    if material is None:
+        return dwivedi.Material.diffuse((0.8, 0.8, 0.8))
+    name = material.name
+    node = _surface_shader(material)
+    if node is None:
+        warnings.append(f"material '{name}' has no Principled BSDF or Subsurface Scattering node: baked as "
+                        "diffuse in its viewport colour")
+        return dwivedi.Material.diffuse(tuple(material.diffuse_color)[:3])
+    if node.type == 'SUBSURFACE_SCATTERING':
+        # Color is the walk's albedo, Radius x Scale its radius; exit Lambertian (Cycles gives
+        # this node no roughness: no retro-reflection, no Fresnel-weighted exit).
+        color = _value(node, ("Color",), (0.8, 0.8, 0.8, 1.0), name, warnings)[:3]
+        out = dwivedi.Material(base_color=color, subsurface_weight=1.0, subsurface_color=color,
+                               subsurface_radius=_value(node, ("Radius",), (1.0, 0.2, 0.1), name, warnings)[:3],
+                               subsurface_scale=_value(node, ("Scale",), 0.05, name, warnings),
+                               subsurface_anisotropy=max(-0.9, min(0.9, _value(node, ("Anisotropy",), 0.0, name,
+                                                                                 warnings))),
+                               subsurface_ior=min(max(_value(node, ("IOR",), 1.4, name, warnings), 1.0), 4.0))
+        if getattr(node, "falloff", 'RANDOM_WALK_FIXED_RADIUS') != 'RANDOM_WALK_FIXED_RADIUS':
+            warnings.append(f"material '{name}': subsurface method {node.falloff} is baked as Random Walk "
+                            "(Fixed Radius)")
+        return out
+    method = getattr(node, "subsurface_method", 'RANDOM_WALK_FIXED_RADIUS')
+    base = _value(node, ("Base Color",), (0.8, 0.8, 0.8, 1.0), name, warnings)[:3]
+    radius = _value(node, ("Subsurface Radius",), (1.0, 0.2, 0.1), name, warnings)[:3]
+    anisotropy = _value(node, ("Subsurface Anisotropy",), 0.0, name, warnings)
+    ior = _value(node, ("Subsurface IOR", "IOR"), 1.4, name, warnings)
+    ior = min(max(ior, 1.0), 4.0)
+    for label, names in (("Metallic", ("Metallic",)), ("Transmission", ("Transmission Weight", "Transmission"))):
+        socket = _input(node, names)
+        if socket is not None and not socket.is_linked and float(socket.default_value) > 0.0:
+            warnings.append(f"material '{name}': {label} is not modelled by dwivedi (ignored)")
+    if _input(node, ("Subsurface Weight",)) is not None:  # Blender 4.x
+        weight = _value(node, ("Subsurface Weight",), 0.0, name, warnings)
+        scale = _value(node, ("Subsurface Scale",), 0.05, name, warnings)
+        out = dwivedi.Material(base_color=base, subsurface_weight=weight, subsurface_color=base,
+                               subsurface_radius=radius, subsurface_scale=scale, subsurface_anisotropy=anisotropy,
+                               subsurface_ior=ior, kind="subsurface" if weight > 0.0 else "diffuse")
+    else:  # Blender 3.x
+        factor = _value(node, ("Subsurface",), 0.0, name, warnings)
+        roughness = _value(node, ("Roughness",), 0.5, name, warnings)
+        if factor > 0.0:
+            # Cycles 3.x's Principled (v1) adds to the walk a retro-reflection lobe (by Roughness)
+            # and weights the exit by 1 - (1 - cos)^5 / 2 (PRINCIPLED_DIFFUSE_LAMBERT_EXIT): dwivedi
+            # bakes the plain walk, as the Subsurface Scattering node and Blender 4.x do.
+            warnings.append(f"material '{name}': Blender 3.x's Principled adds retro-reflection (roughness "
+                            f"{roughness:.2f}) and a Fresnel-weighted exit to subsurface; dwivedi bakes the "
+                            "Lambertian-exit walk (front-lit results can differ from Cycles by a few %)")
+        color = _value(node, ("Subsurface Color",), (0.8, 0.8, 0.8, 1.0), name, warnings)[:3]
+        out = dwivedi.Material.from_blender_3x(base, factor, color, radius, anisotropy, ior)
+        if factor <= 0.0:
+            out.kind = "diffuse"
+    if out.kind == "subsurface" and method != 'RANDOM_WALK_FIXED_RADIUS':
+        warnings.append(f"material '{name}': subsurface method {method} is baked as Random Walk (Fixed Radius)")
+    out.subsurface_anisotropy = max(-0.9, min(0.9, out.subsurface_anisotropy))  # Cycles' clamp
+    return out
+
+
+# ---------------------------------------------------------------------------------------------
+# Geometry
+# ---------------------------------------------------------------------------------------------
+
+def _rows(matrix: Any) -> List[float]:
+    return [float(matrix[r][c]) for r in range(3) for c in range(4)]
+
+
+def _mesh_arrays(mesh: Any, want_uvs: bool) -> Dict[str, Any]:
+    """Positions, triangle indices, per-corner UVs, normals and per-triangle material indices of
+    an evaluated mesh, in float32 / uint32 arrays (foreach_get fills them without Python loops).
+
+    Smooth and flat faces both come out right: all-flat meshes share vertices without normals
+    (flat shading); otherwise every triangle corner gets its own vertex with Blender's corner
+    (split) normal, which is the face normal on flat faces and honours sharp edges."""
+    mesh.calc_loop_triangles()
+    tris = mesh.loop_triangles
+    t = len(tris)
+    loops = array.array("i", [0]) * (3 * t)
+    tris.foreach_get("loops", loops)
+    material_index = array.array("i", [0]) * t
+    tris.foreach_get("material_index", material_index)
+    out: Dict[str, Any] = {"triangles": t, "material_index": material_index}
+
+    smooth = array.array("b", [0]) * len(mesh.polygons)
+    try:
+        mesh.polygons.foreach_get("use_smooth", smooth)
+    except (AttributeError, TypeError, RuntimeError):
+        smooth = array.array("b")
+    any_smooth = any(smooth)
+
+    if want_uvs and mesh.uv_layers.active is not None:
+        loop_uv = array.array("f", [0.0]) * (2 * len(mesh.loops))
+        mesh.uv_layers.active.data.foreach_get("uv", loop_uv)
+        uvs = array.array("f", [0.0]) * (6 * t)
+        for c, loop in enumerate(loops):
+            uvs[2 * c] = loop_uv[2 * loop]
+            uvs[2 * c + 1] = loop_uv[2 * loop + 1]
+        out["uvs"] = uvs
+    else:
+        out["uvs"] = None
+
+    vertex_co = array.array("f", [0.0]) * (3 * len(mesh.vertices))
+    mesh.vertices.foreach_get("co", vertex_co)
+    if not any_smooth:
+        indices = array.array("I", [0]) * (3 * t)
+        tris.foreach_get("vertices", indices)
+        out.update(positions=vertex_co, indices=indices, normals=None)
+        return out
+
+    if hasattr(mesh, "calc_normals_split"):  # Blender < 4.1 computes corner normals on demand
+        mesh.calc_normals_split()
+    corner_normals = array.array("f", [0.0]) * (9 * t)
+    tris.foreach_get("split_normals", corner_normals)
+    corner_vertices = array.array("I", [0]) * (3 * t)
+    tris.foreach_get("vertices", corner_vertices)
+    positions = array.array("f", [0.0]) * (9 * t)
+    for c, v in enumerate(corner_vertices):
+        positions[3 * c:3 * c + 3] = vertex_co[3 * v:3 * v + 3]
+    out.update(positions=positions, indices=array.array("I", range(3 * t)), normals=corner_normals)
+    return out
+
+
+def _subset(arrays: Dict[str, Any], keep: List[int]) -> Dict[str, Any]:
+    """The triangles `keep` of a split-corner or shared-vertex mesh, as a mesh of their own
+    (vertices are kept whole: unreferenced ones cost nothing to the library)."""
+    indices = array.array("I", [0]) * (3 * len(keep))
+    uvs = None if arrays["uvs"] is None else array.array("f", [0.0]) * (6 * len(keep))
+    for n, tri in enumerate(keep):
+        indices[3 * n:3 * n + 3] = arrays["indices"][3 * tri:3 * tri + 3]
+        if uvs is not None:
+            uvs[6 * n:6 * n + 6] = arrays["uvs"][6 * tri:6 * tri + 6]
+    return {**arrays, "indices": indices, "uvs": uvs, "triangles": len(keep)}
+
+
+def _is_geometry(obj: Any) -> bool:
+    return obj.type in {'MESH', 'CURVE', 'SURFACE', 'META', 'FONT'}
+
+
+# ---------------------------------------------------------------------------------------------
+# Lights, world, camera
+# ---------------------------------------------------------------------------------------------
+
+def _light(obj: Any, matrix: Any, dwivedi: Any, warnings: List[str]) -> Any:
+    data = obj.data
+    color = tuple(data.color)
+    if getattr(data, "use_nodes", False):
+        warnings.append(f"light '{obj.name}': light nodes are ignored (its colour and power are used)")
+    location, rotation, scale = matrix.decompose()
+    rot = rotation.to_matrix()
+    if data.type == 'SUN':
+        direction = rot @ _vector((0.0, 0.0, -1.0))
+        return dwivedi.SunLight(direction=tuple(direction), strength=data.energy, color=color, angle=data.angle)
+    if data.type in {'POINT', 'SPOT'}:
+        if data.type == 'SPOT':
+            warnings.append(f"light '{obj.name}': a spot light is baked as a point light of the same power "
+                            "(its cone is ignored)")
+        return dwivedi.PointLight(position=tuple(location), power=data.energy, color=color,
+                                  radius=data.shadow_soft_size)
+    if data.type == 'AREA':
+        sx = data.size * abs(scale[0])
+        sy = (data.size_y if data.shape in {'RECTANGLE', 'ELLIPSE'} else data.size) * abs(scale[1])
+        shape = "disk" if data.shape in {'DISK', 'ELLIPSE'} else "rectangle"
+        rigid = _rigid(location, rot)
+        return dwivedi.AreaLight(transform=rigid, size_x=sx, size_y=sy, power=data.energy, color=color, shape=shape)
+    warnings.append(f"light '{obj.name}' of type {data.type} is not supported (left out)")
+    return None
+
+
+def _vector(values: Tuple[float, float, float]) -> Any:
+    from mathutils import Vector
+    return Vector(values)
+
+
+def _rigid(location: Any, rot3: Any) -> List[float]:
+    return [float(rot3[r][c]) if c < 3 else float(location[r]) for r in range(3) for c in range(4)]
+
+
+def _world(scene: Any, warnings: List[str]) -> Tuple[Tuple[float, float, float], float]:
+    world = scene.world
+    if world is None:
+        return (0.0, 0.0, 0.0), 0.0
+    if not world.use_nodes or world.node_tree is None:
+        return tuple(world.color), 1.0
+    nodes = world.node_tree.nodes
+    background = None
+    for node in nodes:
+        if node.type == 'OUTPUT_WORLD' and node.is_active_output:
+            surface = node.inputs.get("Surface")
+            if surface is not None and surface.is_linked and surface.links[0].from_node.type == 'BACKGROUND':
+                background = surface.links[0].from_node
+            elif surface is not None and not surface.is_linked:
+                return (0.0, 0.0, 0.0), 0.0
+            break
+    if background is None:
+        background = next((n for n in nodes if n.type == 'BACKGROUND'), None)
+    if background is None:
+        warnings.append("the world has no Background node: baked with a black world")
+        return (0.0, 0.0, 0.0), 0.0
+    color_in, strength_in = background.inputs["Color"], background.inputs["Strength"]
+    if color_in.is_linked or strength_in.is_linked:
+        warnings.append("the world's Background is linked (an environment texture?): its own colour and "
+                        "strength are used")
+    return tuple(color_in.default_value)[:3], float(strength_in.default_value)
+
+
+def render_size(scene: Any) -> Tuple[int, int]:
+    """The render resolution times its percentage, as Blender renders it."""
+    r = scene.render
+    width = max(1, int(r.resolution_x * r.resolution_percentage / 100))
+    height = max(1, int(r.resolution_y * r.resolution_percentage / 100))
+    return width, height
+
+
+def camera_from_blender(scene: Any, width: int, height: int, dwivedi: Any, warnings: List[str]) -> Any:
+    """The scene's active camera as dwivedi's, which always fits the larger image side: Blender's
+    sensor fit (Auto, Horizontal, Vertical) becomes the extent of that side."""
+    obj = scene.camera
+    if obj is None:
+        raise ExportError("the scene has no active camera (Scene properties > Camera): a camera bake needs one")
+    if obj.type != 'CAMERA':
+        raise ExportError(f"the scene's camera '{obj.name}' is a {obj.type} object, not a camera")
+    cam = obj.data
+    if cam.type not in {'PERSP', 'ORTHO'}:
+        raise ExportError(f"camera '{obj.name}' is {cam.type}: only perspective and orthographic cameras are baked")
+    if cam.shift_x != 0.0 or cam.shift_y != 0.0:
+        warnings.append(f"camera '{obj.name}': lens shift is ignored")
+    r = scene.render
+    if r.pixel_aspect_x != r.pixel_aspect_y:
+        warnings.append("non-square pixel aspect is ignored")
+    larger = max(width, height)
+    fit = cam.sensor_fit
+    if fit == 'HORIZONTAL':
+        factor = larger / width
+    elif fit == 'VERTICAL':
+        factor = larger / height
+    else:
+        factor = 1.0
+    sensor = (cam.sensor_height if fit == 'VERTICAL' else cam.sensor_width) * factor
+    evaluated = obj.evaluated_get(bpy.context.evaluated_depsgraph_get()) if hasattr(obj, "evaluated_get") else obj
+    location, rotation, _scale = evaluated.matrix_world.decompose()
+    transform = _rigid(location, rotation.to_matrix())
+    if cam.type == 'ORTHO':
+        return dwivedi.Camera(transform=transform, kind="orthographic", ortho_scale=cam.ortho_scale * factor)
+    return dwivedi.Camera(transform=transform, kind="perspective", focal_length=cam.lens, sensor_width=sensor)
+
+
+# ---------------------------------------------------------------------------------------------
+# The whole scene
+# ---------------------------------------------------------------------------------------------
+
+def export_scene(context: Any, settings: Any, dwivedi: Any) -> Exported:
+    """Builds and commits the dwivedi scene of `context.scene` for the bake `settings`
+    (scene.dwivedi_bake); ExportError if it cannot be baked as asked."""
+    scene = context.scene
+    depsgraph = context.evaluated_depsgraph_get()
+    out = Exported()
+    warnings = out.warnings
+    target = settings.target
+    uv_object = settings.uv_object if target == 'UV' else None
+    if target == 'UV':
+        if uv_object is None:
+            raise ExportError("choose the object to bake in UV space (UV Object)")
+        if uv_object.type != 'MESH':
+            raise ExportError(f"'{uv_object.name}' is a {uv_object.type} object: a UV bake needs a mesh")
+        if len(uv_object.data.uv_layers) == 0:
+            raise ExportError(f"mesh '{uv_object.name}' has no UV map: unwrap it (UV > Unwrap) before a UV bake")
+        out.width = out.height = settings.uv_size
+    else:
+        out.width, out.height = render_size(scene)
+
+    dw_scene = dwivedi.Scene()
+    try:
+        material_ids: Dict[Any, int] = {}
+
+        def material_id(material: Any) -> int:
+            key = None if material is None else material.name_full
+            if key not in material_ids:
+                material_ids[key] = dw_scene.add_material(material_from_blender(material, dwivedi, warnings))
+            return material_ids[key]
+
+        uv_found = False
+        skipped: List[str] = []
+        for instance in depsgraph.object_instances:
+            obj = instance.object
+            matrix = instance.matrix_world.copy()
+            if obj.type == 'LIGHT':
+                light = _light(obj, matrix, dwivedi, warnings)
+                if light is not None:
+                    dw_scene.add_light(light)
+                    out.light_count += 1
+                continue
+            if not _is_geometry(obj):
+                if obj.type not in {'CAMERA', 'EMPTY', 'LIGHT_PROBE', 'SPEAKER', 'ARMATURE', 'LATTICE'}:
+                    skipped.append(obj.name)
+                continue
+            if obj.hide_render:
+                continue
+            original = obj.original if hasattr(obj, "original") else obj
+            is_uv_target = (uv_object is not None and original == uv_object and not instance.is_instance)
+            mesh = obj.to_mesh()
+            try:
+                if mesh is None or len(mesh.polygons) == 0:
+                    continue
+                arrays = _mesh_arrays(mesh, want_uvs=is_uv_target)
+                slots = [slot.material for slot in obj.material_slots]
+                by_material: Dict[int, List[int]] = {}
+                for tri, index in enumerate(arrays["material_index"]):
+                    by_material.setdefault(index, []).append(tri)
+                transform = _rows(matrix)
+                if is_uv_target:
+                    if arrays["uvs"] is None:
+                        raise ExportError(f"mesh '{uv_object.name}' has no active UV map")
+                    # A UV bake names one mesh: the object is one mesh with its main material.
+                    main = max(by_material, key=lambda m: len(by_material[m]))
+                    if len(by_material) > 1:
+                        warnings.append(f"'{obj.name}' has {len(by_material)} materials: the UV bake uses "
+                                        f"slot {main + 1}'s for the whole object")
+                    material = slots[main] if main < len(slots) else None
+                    out.uv_mesh = dw_scene.add_mesh(arrays["positions"], arrays["indices"], material_id(material),
+                                                    normals=arrays["normals"], uvs=arrays["uvs"], transform=transform)
+                    uv_found = True
+                    out.mesh_count += 1
+                    out.triangle_count += arrays["triangles"]
+                    continue
+                for index, tris in sorted(by_material.items()):
+                    part = arrays if len(by_material) == 1 else _subset(arrays, tris)
+                    material = slots[index] if index < len(slots) else None
+                    dw_scene.add_mesh(part["positions"], part["indices"], material_id(material),
+                                      normals=part["normals"], transform=transform)
+                    out.mesh_count += 1
+                    out.triangle_count += part["triangles"]
+            finally:
+                obj.to_mesh_clear()
+        if skipped:
+            warnings.append(f"objects that are not geometry were left out: {', '.join(sorted(skipped)[:8])}")
+        if out.mesh_count == 0:
+            raise ExportError("the scene has no visible mesh objects to bake")
+        if target == 'UV' and not uv_found:
+            raise ExportError(f"'{uv_object.name}' is not rendered in this view layer (hidden or excluded)")
+        color, strength = _world(scene, warnings)
+        dw_scene.set_world(color, strength)
+        if target == 'CAMERA':
+            dw_scene.set_camera(camera_from_blender(scene, out.width, out.height, dwivedi, warnings))
+        elif scene.camera is not None and scene.camera.type == 'CAMERA' and scene.camera.data.type in {'PERSP', 'ORTHO'}:
+            dw_scene.set_camera(camera_from_blender(scene, out.width, out.height, dwivedi, []))
+        dw_scene.commit()
+    except BaseException:
+        dw_scene.close()
+        raise
+    out.scene = dw_scene
+    return out
+
+
+def ocio_config_path() -> Optional[str]:
+    """Blender's own OCIO config (the one its colour management uses), or None."""
+    import os
+    env = os.environ.get("OCIO")
+    candidates = []
+    for kind in ('LOCAL', 'SYSTEM', 'USER'):
+        try:
+            base = bpy.utils.resource_path(kind)
+        except (TypeError, ValueError):
+            continue
+        if base:
+            candidates.append(os.path.join(base, "datafiles", "colormanagement", "config.ocio"))
+    if env:  # Blender itself honours $OCIO first
+        candidates.insert(0, env)
+    for path in candidates:
+        if os.path.isfile(path):
+            return path
+    return None

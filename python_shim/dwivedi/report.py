@@ -1,0 +1,427 @@
+"""The error-against-run-time report: python3 -m dwivedi.report --out DIR [--quick] [--no-cycles]
+
+Runs benchmark scenes through the shim and writes DIR/report.md, DIR/report.json and plots
+(matplotlib, Debian python3-matplotlib; without it the report has tables only):
+
+1. v0 methods: the relative error of kappa0 = 1/v0 of every method against the exact root over
+   albedos 0.01 to 0.999999 (v0_methods.png).
+2. Walk techniques, image level: each technique bakes each benchmark scene at growing sample
+   counts on 2 threads; the RMSE of the image against a reference (the auto technique at 16x the
+   largest count, another seed) is plotted against the bake's own seconds
+   (rmse_<scene>.png). Scenes: the default scene, a thin back-lit slab and a thick front-lit
+   sphere (both built here from triangles, with Cycles-compatible materials).
+3. Cycles (where Blender is installed and the source tree is at hand): the Blender test scenes of
+   tests/blender/scenes.py (the slab with a Principled BSDF, the sphere with the Subsurface
+   Scattering node, whose walk is the one dwivedi bakes: see docs/cycles-conventions.md), rendered by Cycles and baked by dwivedi (through the add-on's export)
+   at growing sample counts inside one headless Blender; the RMSE of each against a converged
+   reference (Cycles at the largest count x 4, another seed) is plotted against seconds, and the
+   time each needs to reach the same RMSE is compared (cycles_<scene>.png). Cycles' time is its
+   render time minus that of a 1-sample render (scene sync), dwivedi's the bake's own seconds.
+
+Timings are measured on whatever else runs on the machine: ratios within one run are fair,
+absolute seconds are not. Exit status 1 with a message on failure.
+"""
+from __future__ import annotations
+
+import argparse
+import datetime
+import json
+import math
+import os
+import platform
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+from typing import Any, Dict, List, Optional, Sequence, Tuple
+
+import dwivedi
+
+PACKAGE_DIR = Path(__file__).resolve().parent
+SOURCE_DIR = PACKAGE_DIR.parent.parent  # python_shim/dwivedi -> the source tree (when run from it)
+
+
+# ---------------------------------------------------------------------------------------------
+# Scenes built from triangles (no files, no Blender)
+# ---------------------------------------------------------------------------------------------
+
+def box(sx: float, sy: float, sz: float) -> Tuple[List[Tuple[float, float, float]], List[Tuple[int, int, int]]]:
+    """An axis-aligned box centred at the origin, outward triangles."""
+    p = [(x * sx / 2, y * sy / 2, z * sz / 2) for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]
+    t = [(0, 1, 3), (0, 3, 2), (4, 6, 7), (4, 7, 5), (0, 4, 5), (0, 5, 1), (2, 3, 7), (2, 7, 6), (0, 2, 6), (0, 6, 4),
+         (1, 5, 7), (1, 7, 3)]
+    return p, t
+
+
+def uv_sphere(segments: int = 48, rings: int = 24) -> Tuple[list, list]:
+    """A unit UV sphere (as Blender's primitive: poles on z), outward triangles; its positions
+    are its smooth normals."""
+    points = [(0.0, 0.0, 1.0)]
+    for r in range(1, rings):
+        theta = math.pi * r / rings
+        for s in range(segments):
+            phi = 2 * math.pi * s / segments
+            points.append((math.sin(theta) * math.cos(phi), math.sin(theta) * math.sin(phi), math.cos(theta)))
+    points.append((0.0, 0.0, -1.0))
+    south = len(points) - 1
+
+    def ring(r: int, s: int) -> int:
+        return 1 + (r - 1) * segments + s % segments
+
+    tris = []
+    for s in range(segments):
+        tris.append((0, ring(1, s), ring(1, s + 1)))
+        tris.append((south, ring(rings - 1, s + 1), ring(rings - 1, s)))
+    for r in range(1, rings - 1):
+        for s in range(segments):
+            a, b, c, d = ring(r, s), ring(r, s + 1), ring(r + 1, s), ring(r + 1, s + 1)
+            tris.append((a, c, d))
+            tris.append((a, d, b))
+    return points, tris
+
+
+def slab_scene() -> dwivedi.Scene:
+    """The back-lit slab of tests/blender/scenes.py: 4 x 4 x 0.1 m, radius (1, 0.5, 0.25), colour
+    0.8 (1.3 / 2.5 / 5 mean free paths thick), a sun of 3 W/m^2 from below, orthographic camera."""
+    scene = dwivedi.Scene()
+    material = scene.add_material(dwivedi.Material(base_color=(0.8, 0.8, 0.8), subsurface_color=(0.8, 0.8, 0.8),
+                                                   subsurface_radius=(1.0, 0.5, 0.25), subsurface_scale=1.0))
+    p, t = box(4.0, 4.0, 0.1)
+    scene.add_mesh(p, t, material)
+    scene.add_light(dwivedi.SunLight(direction=(0.0, 0.0, 1.0), strength=3.0))
+    scene.set_camera(dwivedi.Camera(transform=[1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 3], kind="orthographic",
+                                    ortho_scale=1.0))
+    return scene.commit()
+
+
+def sphere_scene() -> dwivedi.Scene:
+    """The front-lit wax sphere of tests/blender/scenes.py."""
+    scene = dwivedi.Scene()
+    material = scene.add_material(dwivedi.Material(base_color=(0.9, 0.6, 0.4), subsurface_color=(0.9, 0.6, 0.4),
+                                                   subsurface_radius=(0.5, 0.25, 0.1), subsurface_scale=1.0))
+    p, t = uv_sphere()
+    scene.add_mesh(p, t, material, normals=p)
+    c, s = math.cos(math.radians(45)), math.sin(math.radians(45))
+    cz, sz = math.cos(math.radians(-30)), math.sin(math.radians(-30))
+    # The sun's local -z after Blender's XYZ Euler (45, 0, -30) degrees: Rz Rx (0, 0, -1).
+    d = (0.0, s, -c)
+    d = (cz * d[0] - sz * d[1], sz * d[0] + cz * d[1], d[2])
+    scene.add_light(dwivedi.SunLight(direction=d, strength=2.0))
+    scene.set_camera(dwivedi.Camera(transform=[1, 0, 0, 0, 0, 0, -1, -3.5, 0, 1, 0, 0], focal_length=50.0))
+    return scene.commit()
+
+
+def default_scene() -> dwivedi.Scene:
+    return dwivedi.Scene.default()
+
+
+SCENES = {"default": default_scene, "slab": slab_scene, "sphere": sphere_scene}
+
+
+# ---------------------------------------------------------------------------------------------
+# Measurements
+# ---------------------------------------------------------------------------------------------
+
+def rmse(a: Sequence[float], b: Sequence[float]) -> float:
+    """Root mean square difference over the RGB channels of two RGBA arrays."""
+    total = 0.0
+    n = 0
+    for i in range(0, len(a), 4):
+        for c in range(3):
+            total += (a[i + c] - b[i + c]) ** 2
+            n += 1
+    return math.sqrt(total / n)
+
+
+def v0_section(quick: bool) -> Dict[str, Any]:
+    albedos = [1 - 10 ** (-k / 4) for k in range(1, 25)] + [0.01, 0.05, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7]
+    albedos = sorted(a for a in albedos if 0 < a < 1)
+    out: Dict[str, Any] = {"albedo": albedos}
+    for method in dwivedi.methods():
+        errors = []
+        for a in albedos:
+            exact = dwivedi.diffusion_constants(a, "exact").kappa
+            value = dwivedi.diffusion_constants(a, method).kappa
+            errors.append(abs(value - exact) / exact if exact > 0 else 0.0)
+        out[method] = errors
+    return out
+
+
+def technique_section(quick: bool, size: int) -> Dict[str, Any]:
+    counts = [2, 8, 32] if quick else [4, 16, 64, 256]
+    result: Dict[str, Any] = {}
+    for name, build in SCENES.items():
+        with build() as scene:
+            reference = dwivedi.bake(scene, width=size, height=size, samples=16 * counts[-1], threads=2, seed=99)
+            ref_pixels = reference.pixels()
+            entry: Dict[str, Any] = {"reference_samples": 16 * counts[-1],
+                                     "reference_seconds": reference.stats.seconds,
+                                     "reference_mean_rgb": list(reference.stats.mean_rgb), "techniques": {}}
+            for technique in dwivedi.techniques():
+                points = []
+                for samples in counts:
+                    image = dwivedi.bake(scene, width=size, height=size, samples=samples, threads=2, seed=1,
+                                         technique=technique)
+                    points.append({"samples": samples, "seconds": image.stats.seconds,
+                                   "rmse": rmse(image.pixels(), ref_pixels),
+                                   "estimated_relative_error": image.stats.estimated_relative_error})
+                entry["techniques"][technique] = points
+                print(f"  {name:8s} {technique:10s} " + "  ".join(f"{p['seconds']:.3f}s:{p['rmse']:.4g}"
+                                                               for p in points), file=sys.stderr, flush=True)
+            result[name] = entry
+    return result
+
+
+BLENDER_SCRIPT = r'''
+import json, sys, time, math
+args = json.loads(sys.argv[sys.argv.index("--") + 1])
+sys.path[:0] = [args["shim"], args["addon"], args["scenes"]]
+import bpy, dwivedi, scenes
+import dwivedi_bake.export as export
+
+class Props:  # what export_scene reads of scene.dwivedi_bake
+    target = 'CAMERA'; uv_object = None; uv_size = 0
+
+def pixels_of(path):
+    image = bpy.data.images.load(path, check_existing=False)
+    px = [0.0] * (4 * image.size[0] * image.size[1]); image.pixels.foreach_get(px)
+    bpy.data.images.remove(image)
+    return px
+
+def flip(rgba, w, h):  # dwivedi's rows from the top -> Blender's from the bottom
+    out = []
+    for y in range(h - 1, -1, -1):
+        out.extend(rgba[4 * w * y: 4 * w * (y + 1)])
+    return out
+
+def rmse(a, b):
+    return math.sqrt(sum((a[i + c] - b[i + c]) ** 2 for i in range(0, len(a), 4) for c in range(3)) / (3 * len(a) // 4))
+
+def cycles(scene, spp, seed, path):
+    scene.cycles.samples = spp; scene.cycles.seed = seed
+    scene.render.image_settings.file_format = 'OPEN_EXR'; scene.render.image_settings.color_depth = '32'
+    scene.render.filepath = path
+    t = time.monotonic(); bpy.ops.render.render(write_still=True); return time.monotonic() - t
+
+out = {}
+for name in args["scenes_list"]:
+    builders = {"slab": scenes.slab_scene,
+                # The Subsurface Scattering node: the plain walk, which Blender 3.x's Principled is not.
+                "sphere": lambda r, s: scenes.sphere_scene(r, s, shader='SSS')}
+    scene = builders[name](args["size"], 16)
+    work = args["work"]
+    overhead = cycles(scene, 1, 0, f"{work}/{name}_c1.exr")
+    ref_spp = 4 * args["cycles_counts"][-1]
+    ref_seconds = cycles(scene, ref_spp, 1234, f"{work}/{name}_ref.exr")
+    ref = pixels_of(f"{work}/{name}_ref.exr")
+    entry = {"reference_samples": ref_spp, "reference_seconds": ref_seconds, "sync_seconds": overhead,
+             "cycles": [], "dwivedi": []}
+    for spp in args["cycles_counts"]:
+        seconds = cycles(scene, spp, 7, f"{work}/{name}_c.exr")
+        entry["cycles"].append({"samples": spp, "seconds": max(seconds - overhead, 1e-3),
+                                "rmse": rmse(pixels_of(f"{work}/{name}_c.exr"), ref)})
+    exported = export.export_scene(bpy.context, Props, dwivedi)
+    for spp in args["dwivedi_counts"]:
+        image = dwivedi.bake(exported.scene, width=exported.width, height=exported.height, samples=spp,
+                             threads=2, seed=7)
+        ours = flip(list(image.pixels()), image.width, image.height)
+        n = len(ours) // 4
+        entry["dwivedi"].append({"samples": spp, "seconds": image.stats.seconds, "rmse": rmse(ours, ref),
+                                 "mean_rgb": [sum(ours[c::4]) / n for c in range(3)]})
+    n = len(ref) // 4
+    entry["cycles_reference_mean_rgb"] = [sum(ref[c::4]) / n for c in range(3)]
+    exported.scene.close()
+    out[name] = entry
+    print("scene", name, "done", file=sys.stderr, flush=True)
+with open(args["result"], "w") as f:
+    json.dump(out, f)
+'''
+
+
+def cycles_section(quick: bool, blender: str, size: int) -> Dict[str, Any]:
+    scenes_dir = SOURCE_DIR / "tests" / "blender"
+    addon_dir = SOURCE_DIR / "blender_addon"
+    if not (scenes_dir / "scenes.py").is_file() or not (addon_dir / "dwivedi_bake").is_dir():
+        raise RuntimeError(f"the Cycles comparison needs the source tree (tests/blender, blender_addon) at {SOURCE_DIR}")
+    with tempfile.TemporaryDirectory() as work:
+        result_path = Path(work) / "result.json"
+        args = {"shim": str(PACKAGE_DIR.parent), "addon": str(addon_dir), "scenes": str(scenes_dir), "work": work,
+                "result": str(result_path), "size": size, "scenes_list": ["slab", "sphere"],
+                # Counts large enough that Cycles' render time, not its per-render overhead, is
+                # what is measured.
+                "cycles_counts": [32, 128, 512] if quick else [64, 256, 1024],
+                "dwivedi_counts": [8, 32, 128] if quick else [16, 64, 256, 1024]}
+        script = Path(work) / "bench.py"
+        script.write_text(BLENDER_SCRIPT)
+        env = dict(os.environ)
+        library = dwivedi.library_path()
+        env["DWIVEDI_LIBRARY"] = library if os.path.isabs(library) else env.get("DWIVEDI_LIBRARY", "")
+        completed = subprocess.run([blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python",
+                                    str(script), "--", json.dumps(args)], env=env, capture_output=True, text=True)
+        if completed.returncode != 0 or not result_path.is_file():
+            tail = "\n".join((completed.stdout + completed.stderr).splitlines()[-15:])
+            raise RuntimeError(f"the Blender benchmark failed:\n{tail}")
+        return json.loads(result_path.read_text())
+
+
+def time_to_rmse(points: List[Dict[str, float]], target: float) -> Optional[float]:
+    """Seconds to reach `target` RMSE, interpolated log-log between measured points (RMSE falls
+    as 1/sqrt(time)); extrapolated along that slope beyond the last point."""
+    pts = sorted((p["seconds"], p["rmse"]) for p in points if p["rmse"] > 0 and p["seconds"] > 0)
+    if not pts:
+        return None
+    for (t0, e0), (t1, e1) in zip(pts, pts[1:]):
+        if e0 >= target >= e1 and e0 != e1:
+            f = math.log(e0 / target) / math.log(e0 / e1)
+            return math.exp(math.log(t0) + f * math.log(t1 / t0))
+    t, e = pts[-1] if target < pts[-1][1] else pts[0]
+    return t * (e / target) ** 2
+
+
+# ---------------------------------------------------------------------------------------------
+# Output
+# ---------------------------------------------------------------------------------------------
+
+def plots(out: Path, data: Dict[str, Any]) -> List[str]:
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as pyplot
+    except ImportError:
+        return []
+    made = []
+    v0 = data["v0"]
+    fig, ax = pyplot.subplots(figsize=(6, 4))
+    for method in dwivedi.methods():
+        if method == "exact":
+            continue
+        ax.loglog([1 - a for a in v0["albedo"]], [max(e, 1e-17) for e in v0[method]], marker=".", label=method)
+    ax.set_xlabel("1 - albedo")
+    ax.set_ylabel("relative error of kappa0")
+    ax.legend()
+    ax.grid(True, which="both", alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(out / "v0_methods.png", dpi=100)
+    pyplot.close(fig)
+    made.append("v0_methods.png")
+    for name, entry in data.get("techniques", {}).items():
+        fig, ax = pyplot.subplots(figsize=(6, 4))
+        for technique, points in entry["techniques"].items():
+            ax.loglog([p["seconds"] for p in points], [p["rmse"] for p in points], marker="o", label=technique)
+        ax.set_xlabel("bake seconds (2 threads)")
+        ax.set_ylabel("image RMSE")
+        ax.set_title(f"{name}: RMSE against time")
+        ax.legend(fontsize="small")
+        ax.grid(True, which="both", alpha=0.3)
+        fig.tight_layout()
+        fig.savefig(out / f"rmse_{name}.png", dpi=100)
+        pyplot.close(fig)
+        made.append(f"rmse_{name}.png")
+    for name, entry in data.get("cycles", {}).items():
+        fig, ax = pyplot.subplots(figsize=(6, 4))
+        for who in ("cycles", "dwivedi"):
+            ax.loglog([p["seconds"] for p in entry[who]], [p["rmse"] for p in entry[who]], marker="o", label=who)
+        ax.set_xlabel("seconds (2 threads)")
+        ax.set_ylabel("RMSE against converged Cycles")
+        ax.set_title(f"{name}: dwivedi against Cycles")
+        ax.legend()
+        ax.grid(True, which="both", alpha=0.3)
+        fig.tight_layout()
+        fig.savefig(out / f"cycles_{name}.png", dpi=100)
+        pyplot.close(fig)
+        made.append(f"cycles_{name}.png")
+    return made
+
+
+def markdown(data: Dict[str, Any], made: List[str]) -> str:
+    lines = ["# dwivedi: error against run time", "",
+             f"Made by `python3 -m dwivedi.report` on {data['date']} ({data['machine']}), library "
+             f"{data['version']} ({data['library']}). Timings are ratios within this run; other load on the "
+             "machine moves the absolute seconds.", ""]
+    lines += ["## v0 methods", "", "Largest relative error of kappa0 = 1/v0 against the exact root, albedo 0.01 to "
+              "1 - 10^-6:", "", "| method | largest relative error |", "|---|---|"]
+    for method in dwivedi.methods():
+        lines.append(f"| {method} | {max(data['v0'][method]):.3g} |")
+    if "v0_methods.png" in made:
+        lines += ["", "![v0 methods](v0_methods.png)"]
+    if data.get("techniques"):
+        lines += ["", "## Walk techniques, image RMSE against time", "",
+                  "Each technique at growing samples per pixel (2 threads, seed 1); RMSE over the RGB pixels "
+                  "against the auto technique at 16x the largest count (seed 99).", ""]
+        for name, entry in data["techniques"].items():
+            lines += [f"### {name}", "", f"Reference: {entry['reference_samples']} spp in "
+                      f"{entry['reference_seconds']:.2f} s, mean RGB "
+                      + ", ".join(f"{v:.4f}" for v in entry["reference_mean_rgb"]), "",
+                      "| technique | " + " | ".join(f"{p['samples']} spp" for p in
+                                                      next(iter(entry["techniques"].values()))) + " |",
+                      "|---|" + "---|" * len(next(iter(entry["techniques"].values())))]
+            for technique, points in entry["techniques"].items():
+                lines.append(f"| {technique} | " + " | ".join(f"{p['rmse']:.4g} ({p['seconds']:.3f} s)"
+                                                             for p in points) + " |")
+            if f"rmse_{name}.png" in made:
+                lines += ["", f"![{name}](rmse_{name}.png)"]
+            lines.append("")
+    if data.get("cycles"):
+        lines += ["## Against Cycles", "",
+                  "Same Blender scene, 2 threads; RMSE against Cycles at 4x its largest count. Cycles' seconds "
+                  "exclude its scene sync (a 1-sample render's time). Speed-up = Cycles' time / dwivedi's time "
+                  "to reach the RMSE of dwivedi's second-largest bake.", "",
+                  "| scene | converged Cycles mean RGB | dwivedi mean RGB (largest bake) | target RMSE | Cycles s | "
+                  "dwivedi s | speed-up |", "|---|---|---|---|---|---|---|"]
+        for name, entry in data["cycles"].items():
+            target = entry["dwivedi"][-2]["rmse"]
+            tc = time_to_rmse(entry["cycles"], target)
+            td = time_to_rmse(entry["dwivedi"], target)
+            speed = f"{tc / td:.2f}x" if tc and td else "n/a"
+            lines.append(f"| {name} | " + ", ".join(f"{v:.4f}" for v in entry["cycles_reference_mean_rgb"]) + " | "
+                         + ", ".join(f"{v:.4f}" for v in entry["dwivedi"][-1]["mean_rgb"]) +
+                         f" | {target:.4g} | {tc or math.nan:.3g} | {td or math.nan:.3g} | {speed} |")
+            entry["speedup_at_rmse"] = {"rmse": target, "cycles_seconds": tc, "dwivedi_seconds": td}
+        for name in data["cycles"]:
+            if f"cycles_{name}.png" in made:
+                lines += ["", f"![{name} against Cycles](cycles_{name}.png)"]
+    elif data.get("cycles_skipped"):
+        lines += ["", "## Against Cycles", "", f"Not run: {data['cycles_skipped']}"]
+    return "\n".join(lines) + "\n"
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    parser = argparse.ArgumentParser(prog="python3 -m dwivedi.report", description=__doc__.splitlines()[0])
+    parser.add_argument("--out", required=True, type=Path, help="folder for report.md, report.json and plots")
+    parser.add_argument("--quick", action="store_true", help="fewer and smaller bakes (a smoke run)")
+    parser.add_argument("--size", type=int, default=None,
+                        help="image width and height (default 32, quick 16; the Cycles part 48, quick 32)")
+    parser.add_argument("--no-cycles", action="store_true", help="skip the comparison with Cycles")
+    parser.add_argument("--blender", default=shutil.which("blender"), help="the Blender executable")
+    args = parser.parse_args(argv)
+    size = args.size or (16 if args.quick else 32)
+    try:
+        args.out.mkdir(parents=True, exist_ok=True)
+        data: Dict[str, Any] = {"date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+                                "machine": f"{platform.machine()}, {os.cpu_count()} cores",
+                                "version": dwivedi.version(), "library": dwivedi.library_path(), "size": size}
+        print("v0 methods", file=sys.stderr, flush=True)
+        data["v0"] = v0_section(args.quick)
+        print("walk techniques", file=sys.stderr, flush=True)
+        data["techniques"] = technique_section(args.quick, size)
+        if args.no_cycles:
+            data["cycles_skipped"] = "--no-cycles"
+        elif not args.blender:
+            data["cycles_skipped"] = "Blender was not found"
+        else:
+            print("Cycles", file=sys.stderr, flush=True)
+            data["cycles"] = cycles_section(args.quick, args.blender, args.size or (32 if args.quick else 48))
+        made = plots(args.out, data)
+        text = markdown(data, made)
+        (args.out / "report.md").write_text(text)
+        (args.out / "report.json").write_text(json.dumps(data, indent=1))
+    except (dwivedi.Error, RuntimeError, OSError) as error:
+        print(f"dwivedi.report: {error}", file=sys.stderr)
+        return 1
+    print(f"dwivedi.report: wrote {args.out / 'report.md'} and {len(made)} plot(s)", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,217 @@
+"""Test scenes for the add-on, built by script inside Blender (nothing binary is committed).
+
+Each builder empties the current file and makes one small scene with Cycles settings that render
+only what dwivedi bakes: Principled BSDF with subsurface method RANDOM_WALK_FIXED_RADIUS, specular,
+sheen and clearcoat 0 (so only the subsurface lobe reflects light), a black or constant world,
+a box pixel filter one pixel wide and no denoising.
+"""
+import math
+
+import bpy
+
+
+def _reset():
+    # read_homefile keeps the preferences (and so the enabled add-ons); read_factory_settings would not.
+    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+    scene = bpy.context.scene
+    scene.render.engine = 'CYCLES'
+    scene.cycles.device = 'CPU'
+    scene.cycles.use_denoising = False
+    scene.cycles.use_adaptive_sampling = False
+    scene.cycles.pixel_filter_type = 'BOX'
+    scene.cycles.filter_width = 1.0
+    scene.cycles.seed = 0
+    # Paths that matter: camera -> entry -> walk -> exit -> light. Allow a few bounces so that
+    # concave or multi-object light transport is not cut, none of it is needed in these scenes.
+    scene.cycles.max_bounces = 4
+    scene.cycles.diffuse_bounces = 4
+    scene.cycles.glossy_bounces = 0
+    scene.cycles.transmission_bounces = 0
+    scene.cycles.transparent_max_bounces = 0
+    scene.cycles.caustics_reflective = False
+    scene.cycles.caustics_refractive = False
+    scene.cycles.sample_clamp_direct = 0.0
+    scene.cycles.sample_clamp_indirect = 0.0
+    scene.render.threads_mode = 'FIXED'
+    scene.render.threads = 2
+    scene.render.resolution_percentage = 100
+    scene.render.film_transparent = False
+    scene.view_settings.view_transform = 'Standard'
+    scene.view_settings.look = 'None'
+    scene.view_settings.exposure = 0.0
+    scene.view_settings.gamma = 1.0
+    world = bpy.data.worlds.new("World")
+    world.use_nodes = True
+    scene.world = world
+    set_world(scene, (0.0, 0.0, 0.0), 1.0)
+    return scene
+
+
+def set_world(scene, color, strength):
+    background = scene.world.node_tree.nodes["Background"]
+    background.inputs["Color"].default_value = (color[0], color[1], color[2], 1.0)
+    background.inputs["Strength"].default_value = strength
+
+
+def principled_material(name, color, radius, scale=1.0, weight=1.0, anisotropy=0.0):
+    """A Principled BSDF that is pure random-walk subsurface (Blender 3.x and 4.x inputs)."""
+    material = bpy.data.materials.new(name)
+    material.use_nodes = True
+    bsdf = material.node_tree.nodes["Principled BSDF"]
+    bsdf.subsurface_method = 'RANDOM_WALK_FIXED_RADIUS'
+    inputs = bsdf.inputs
+    rgba = (color[0], color[1], color[2], 1.0)
+    if "Subsurface Weight" in inputs:  # Blender 4.x
+        inputs["Base Color"].default_value = rgba
+        inputs["Subsurface Weight"].default_value = weight
+        inputs["Subsurface Scale"].default_value = scale
+        inputs["Specular IOR Level"].default_value = 0.0
+    else:  # Blender 3.x: the subsurface colour is mixed with the base colour by "Subsurface"
+        inputs["Base Color"].default_value = rgba
+        inputs["Subsurface Color"].default_value = rgba
+        inputs["Subsurface"].default_value = weight * scale
+        inputs["Specular"].default_value = 0.0
+        inputs["Clearcoat"].default_value = 0.0
+        inputs["Sheen"].default_value = 0.0
+    inputs["Subsurface Radius"].default_value = tuple(radius)
+    inputs["Subsurface Anisotropy"].default_value = anisotropy
+    inputs["Metallic"].default_value = 0.0
+    inputs["Roughness"].default_value = 0.5
+    return material
+
+
+def sss_node_material(name, color, radius, scale=1.0):
+    """The Subsurface Scattering node, Random Walk (Fixed Radius): walks entering by cosine-weighted
+    diffuse transmission and leaving through a Lambertian exit, nothing else (Cycles gives it no
+    roughness, so no Principled retro-reflection and no Fresnel-weighted exit)."""
+    material = bpy.data.materials.new(name)
+    material.use_nodes = True
+    tree = material.node_tree
+    tree.nodes.remove(tree.nodes["Principled BSDF"])
+    node = tree.nodes.new("ShaderNodeSubsurfaceScattering")
+    node.falloff = 'RANDOM_WALK_FIXED_RADIUS'
+    node.inputs["Color"].default_value = (color[0], color[1], color[2], 1.0)
+    node.inputs["Scale"].default_value = scale
+    node.inputs["Radius"].default_value = tuple(radius)
+    tree.links.new(node.outputs[0], tree.nodes["Material Output"].inputs["Surface"])
+    return material
+
+
+def diffuse_material(name, color):
+    material = bpy.data.materials.new(name)
+    material.use_nodes = True
+    bsdf = material.node_tree.nodes["Principled BSDF"]
+    inputs = bsdf.inputs
+    inputs["Base Color"].default_value = (color[0], color[1], color[2], 1.0)
+    if "Specular IOR Level" in inputs:
+        inputs["Specular IOR Level"].default_value = 0.0
+    else:
+        inputs["Specular"].default_value = 0.0
+        inputs["Sheen"].default_value = 0.0
+        inputs["Subsurface"].default_value = 0.0
+    inputs["Roughness"].default_value = 1.0
+    return material
+
+
+def _camera(scene, location, rotation, ortho_scale=None, lens=50.0):
+    data = bpy.data.cameras.new("Camera")
+    if ortho_scale is not None:
+        data.type = 'ORTHO'
+        data.ortho_scale = ortho_scale
+    else:
+        data.lens = lens
+    camera = bpy.data.objects.new("Camera", data)
+    camera.location = location
+    camera.rotation_euler = rotation
+    scene.collection.objects.link(camera)
+    scene.camera = camera
+    return camera
+
+
+def _sun(scene, rotation, strength, angle=0.0, color=(1.0, 1.0, 1.0)):
+    data = bpy.data.lights.new("Sun", 'SUN')
+    data.energy = strength
+    data.angle = angle
+    data.color = color
+    sun = bpy.data.objects.new("Sun", data)
+    sun.rotation_euler = rotation
+    scene.collection.objects.link(sun)
+    return sun
+
+
+def _box(scene, name, size, location, material):
+    bpy.ops.mesh.primitive_cube_add(size=1.0, location=location)
+    obj = bpy.context.active_object
+    obj.name = name
+    obj.scale = size
+    obj.data.materials.append(material)
+    return obj
+
+
+def slab_scene(resolution=32, samples=256, thickness=0.1, color=(0.8, 0.8, 0.8), radius=(1.0, 0.5, 0.25),
+               width=4.0):
+    """A wide slab `thickness` m thick (4 x 4 m), lit from below by a sun travelling straight
+    up, seen from above by an orthographic camera over its centre: only light transmitted
+    through the slab reaches the camera. Radius (1.0, 0.5, 0.25) m, colour 0.8: Cycles' fixed
+    radius walk has the mean free path radius / (4 pi) (bssrdf_setup_radius), so a 0.1 m slab
+    is about 1.26, 2.5 and 5.0 mean free paths thick in R, G, B."""
+    scene = _reset()
+    scene.render.resolution_x = resolution
+    scene.render.resolution_y = resolution
+    scene.cycles.samples = samples
+    material = principled_material("Slab", color, radius)
+    _box(scene, "Slab", (width, width, thickness), (0.0, 0.0, 0.0), material)
+    _camera(scene, (0.0, 0.0, 3.0), (0.0, 0.0, 0.0), ortho_scale=1.0)
+    # A sun's light travels along its local -z: rotated by pi about x it travels +z (upwards).
+    _sun(scene, (math.pi, 0.0, 0.0), 3.0)
+    return scene
+
+
+def sphere_scene(resolution=32, samples=256, shader='PRINCIPLED'):
+    """A sphere of radius 1 m, smooth shaded, lit by a sun from the camera's side (45 degrees
+    off the view axis), seen by a perspective camera. Radius (0.5, 0.25, 0.1) m (mean free
+    paths 0.04, 0.02, 0.008 m), colour (0.9, 0.6, 0.4): thick front-lit wax-like. shader:
+    'PRINCIPLED' (Principled BSDF) or 'SSS' (the Subsurface Scattering node)."""
+    scene = _reset()
+    scene.render.resolution_x = resolution
+    scene.render.resolution_y = resolution
+    scene.cycles.samples = samples
+    if shader == 'PRINCIPLED':
+        material = principled_material("Wax", (0.9, 0.6, 0.4), (0.5, 0.25, 0.1))
+    else:
+        material = sss_node_material("Wax", (0.9, 0.6, 0.4), (0.5, 0.25, 0.1))
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=48, ring_count=24, radius=1.0)
+    sphere = bpy.context.active_object
+    sphere.name = "Sphere"
+    bpy.ops.object.shade_smooth()
+    sphere.data.materials.append(material)
+    _camera(scene, (0.0, -3.5, 0.0), (math.pi / 2, 0.0, 0.0), lens=50.0)
+    _sun(scene, (math.radians(45.0), 0.0, math.radians(-30.0)), 2.0)
+    return scene
+
+
+def lights_scene(kind, resolution=16, samples=64):
+    """A white diffuse 4 x 4 m plane at z = 0 seen from above (orthographic) with one light of
+    `kind` ('SUN', 'POINT', 'AREA' square 0.5 m, 'SPOT' not used) 2 m above its centre, strength 10:
+    measures Cycles' light units (the radiance of the plane's centre is albedo / pi times the
+    irradiance)."""
+    scene = _reset()
+    scene.render.resolution_x = resolution
+    scene.render.resolution_y = resolution
+    scene.cycles.samples = samples
+    scene.cycles.max_bounces = 0
+    bpy.ops.mesh.primitive_plane_add(size=4.0)
+    plane = bpy.context.active_object
+    plane.data.materials.append(diffuse_material("White", (1.0, 1.0, 1.0)))
+    _camera(scene, (0.0, 0.0, 3.0), (0.0, 0.0, 0.0), ortho_scale=0.2)
+    data = bpy.data.lights.new("Light", kind)
+    data.energy = 10.0
+    if kind == 'POINT':
+        data.shadow_soft_size = 0.0
+    if kind == 'AREA':
+        data.shape = 'SQUARE'
+        data.size = 0.5
+    light = bpy.data.objects.new("Light", data)
+    light.location = (0.0, 0.0, 2.0)
+    scene.collection.objects.link(light)
+    return scene

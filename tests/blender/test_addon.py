@@ -1,0 +1,206 @@
+"""The add-on in headless Blender: it installs and enables from the zip, its settings and panel
+register, the operator bakes small scenes (camera and UV) into EXR + PNG and loads the result,
+and every failure is reported as an error with CANCELLED, never a crash.
+
+    blender -b --factory-startup --python-exit-code 1 --python tests/blender/test_addon.py
+(through ctest, which sets the user folders and the zip's path: see harness.py)
+"""
+import math
+import os
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import bpy  # noqa: E402
+
+import harness  # noqa: E402
+import scenes  # noqa: E402
+
+WORK = harness.install_addon()
+
+
+def small_slab():
+    scene = scenes.slab_scene(resolution=16, samples=4)
+    props = scene.dwivedi_bake
+    props.samples = 4
+    props.threads = 2
+    props.output_dir = str(WORK / "out")
+    return scene
+
+
+class AddonTest(harness.unittest.TestCase):
+    def setUp(self):
+        prefs = bpy.context.preferences.addons["dwivedi_bake"].preferences
+        prefs.library_path = ""
+
+    def test_registered(self):
+        import addon_utils
+        self.assertTrue(addon_utils.check("dwivedi_bake")[1], "the add-on is enabled")
+        self.assertTrue(hasattr(bpy.types, "DWIVEDI_PT_bake"))
+        self.assertEqual(bpy.types.DWIVEDI_PT_bake.bl_context, "render")
+        props = bpy.context.scene.dwivedi_bake
+        for name in ("target", "technique", "samples", "time_limit", "threads", "seed", "output_dir", "uv_object",
+                     "uv_size", "uv_margin"):
+            self.assertTrue(hasattr(props, name), name)
+        self.assertEqual(props.target, 'CAMERA')
+        self.assertIn("Dwivedi", bpy.ops.dwivedi.bake.get_rna_type().name)
+        module = sys.modules["dwivedi_bake"]
+        self.assertEqual(module.bl_info["blender"][:2], (3, 4))
+        # The bundled library is the one in use.
+        shim = module.shim()
+        self.assertTrue(shim.library_path().startswith(str(Path(os.environ["BLENDER_USER_SCRIPTS"]).resolve()))
+                        or shim.library_path().startswith(os.environ["BLENDER_USER_SCRIPTS"]), shim.library_path())
+
+    def test_camera_bake(self):
+        scene = small_slab()
+        result, error = harness.call_operator()
+        self.assertEqual(result, {'FINISHED'}, error)
+        exr = WORK / "out" / f"{scene.name}_camera.exr"
+        png = WORK / "out" / f"{scene.name}_camera.png"
+        self.assertTrue(exr.is_file())
+        self.assertTrue(png.is_file())
+        image = bpy.data.images.get("Dwivedi Camera")
+        self.assertIsNotNone(image, "the result is loaded as a Blender image")
+        self.assertEqual(tuple(image.size), (16, 16))
+        self.assertEqual(exr.read_bytes()[:4], b"\x76\x2f\x31\x01")  # OpenEXR magic
+        width, height, pixels = harness.image_pixels("Dwivedi Camera")
+        self.assertEqual((width, height), (16, 16))
+        self.assertTrue(all(math.isfinite(v) for v in pixels))
+        mean_r = sum(pixels[0::4]) / (width * height)
+        self.assertGreater(mean_r, 0.0, "light comes through the slab")
+        self.assertIn("spp", scene.dwivedi_bake.last_result)
+
+    # Blender 3.4 reads no pixels from an EXR whose unlayered R, G, B, A sit beside layered
+    # channels (variance.R, samples.Y: capi/dwivedi.h's layout): "does not have any image data".
+    # The add-on therefore makes its image from memory. Expected to fail until the library's EXR
+    # loads in Blender (e.g. extra channels without a dot, or a full layer.pass.channel naming).
+    @harness.unittest.expectedFailure
+    def test_exr_opens_in_blender(self):
+        scene = small_slab()
+        result, error = harness.call_operator()
+        self.assertEqual(result, {'FINISHED'}, error)
+        width, height, pixels = harness.read_pixels(WORK / "out" / f"{scene.name}_camera.exr")
+        self.assertEqual((width, height), (16, 16))
+        _, _, ours = harness.image_pixels("Dwivedi Camera")
+        self.assertEqual(pixels, ours)
+
+    def test_render_percentage(self):
+        scene = small_slab()
+        scene.render.resolution_x = 40
+        scene.render.resolution_y = 20
+        scene.render.resolution_percentage = 50
+        result, error = harness.call_operator()
+        self.assertEqual(result, {'FINISHED'}, error)
+        width, height, _ = harness.image_pixels("Dwivedi Camera")
+        self.assertEqual((width, height), (20, 10))
+
+    def test_uv_bake(self):
+        scene = small_slab()
+        slab = bpy.data.objects["Slab"]  # the cube primitive comes with a UV map
+        result, error = harness.call_operator(target='UV', uv_object=slab, uv_size=32, uv_margin=2)
+        self.assertEqual(result, {'FINISHED'}, error)
+        self.assertTrue((WORK / "out" / f"{scene.name}_uv_Slab.exr").is_file())
+        width, height, pixels = harness.image_pixels("Dwivedi UV")
+        self.assertEqual((width, height), (32, 32))
+        covered = sum(1 for a in pixels[3::4] if a > 0.0)
+        self.assertGreater(covered, 32 * 32 // 4)
+        self.assertIsNotNone(bpy.data.images.get("Dwivedi UV"))
+
+    def test_modifiers_are_evaluated(self):
+        """A subdivision modifier changes what is baked (the evaluated mesh, not the original)."""
+        scenes.sphere_scene(resolution=16, samples=4)
+        scene = bpy.context.scene
+        module = sys.modules["dwivedi_bake"]
+        props = scene.dwivedi_bake
+        plain = module.export.export_scene(bpy.context, props, module.shim())
+        sphere = bpy.data.objects["Sphere"]
+        sphere.modifiers.new("Subdivision", 'SUBSURF').levels = 1
+        subdivided = module.export.export_scene(bpy.context, props, module.shim())
+        # Quads become 4 quads (8 triangles), the poles' triangles 3 quads (6 triangles).
+        self.assertGreater(subdivided.triangle_count, 3 * plain.triangle_count)
+        plain.scene.close()
+        subdivided.scene.close()
+
+    def assertFails(self, pattern, **settings):
+        result, error = harness.call_operator(**settings)
+        self.assertEqual(result, {'CANCELLED'})
+        self.assertIsNotNone(error, "an error is reported")
+        self.assertIn(pattern.lower(), error.lower())
+        return error
+
+    def test_no_camera(self):
+        scene = small_slab()
+        scene.camera = None
+        self.assertFails("no active camera")
+
+    def test_no_uvs(self):
+        small_slab()
+        slab = bpy.data.objects["Slab"]
+        while slab.data.uv_layers:
+            slab.data.uv_layers.remove(slab.data.uv_layers[0])
+        self.assertFails("no UV map", target='UV', uv_object=slab)
+
+    def test_uv_target_missing_or_not_a_mesh(self):
+        small_slab()
+        self.assertFails("choose the object", target='UV', uv_object=None)
+        props = bpy.context.scene.dwivedi_bake
+        try:
+            props.uv_object = bpy.data.objects["Camera"]
+        except (TypeError, ValueError, AttributeError):
+            return  # the property's poll refuses it already
+        self.assertFails("needs a mesh", target='UV')
+
+    def test_unwritable_folder(self):
+        small_slab()
+        blocker = WORK / "a_file"
+        blocker.write_text("not a folder")
+        self.assertFails("output folder", output_dir=str(blocker / "sub"))
+        if os.geteuid() != 0:  # root writes anywhere
+            locked = WORK / "locked"
+            locked.mkdir()
+            locked.chmod(0o500)
+            try:
+                self.assertFails("not writable", output_dir=str(locked))
+            finally:
+                locked.chmod(0o700)
+
+    def test_missing_library(self):
+        small_slab()
+        prefs = bpy.context.preferences.addons["dwivedi_bake"].preferences
+        prefs.library_path = str(WORK / "no_such" / "libdwivedi.so.1")
+        try:
+            self.assertFails("libdwivedi.so.1")
+        finally:
+            prefs.library_path = ""
+
+    def test_zero_samples(self):
+        small_slab()
+        self.assertFails("at least 1 sample", samples=0)
+
+    def test_bad_values_from_the_library(self):
+        scene = small_slab()
+        node = bpy.data.materials["Slab"].node_tree.nodes["Principled BSDF"]
+        node.inputs["Subsurface Radius"].default_value = (-1.0, 0.5, 0.25)
+        self.assertFails("radius")
+
+    def test_no_meshes(self):
+        scene = small_slab()
+        bpy.data.objects.remove(bpy.data.objects["Slab"])
+        self.assertFails("no visible mesh")
+
+    def test_non_mesh_geometry_is_converted(self):
+        """Text and curves are geometry: they are baked through their evaluated mesh."""
+        scene = small_slab()
+        bpy.ops.object.text_add(location=(0.0, 0.0, 0.06))
+        result, error = harness.call_operator()
+        self.assertEqual(result, {'FINISHED'}, error)
+
+    def test_unregister_and_register(self):
+        bpy.ops.preferences.addon_disable(module="dwivedi_bake")
+        self.assertFalse(hasattr(bpy.types.Scene, "dwivedi_bake"))
+        bpy.ops.preferences.addon_enable(module="dwivedi_bake")
+        self.assertTrue(hasattr(bpy.types.Scene, "dwivedi_bake"))
+
+
+harness.run(AddonTest)

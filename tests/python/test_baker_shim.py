@@ -1,0 +1,458 @@
+"""Tests of the shim's baker part (python_shim/dwivedi/baker.py): the ctypes mirrors of the capi
+structs, scenes from sequences and buffers, errors, images and their zero-copy views, bakes with
+progress, cancellation and Ctrl-C, output files, scene files.
+
+Run by ctest with DWIVEDI_LIBRARY set (tests/CMakeLists.txt). Standard library only; numpy is used
+where it is installed.
+"""
+import array
+import ctypes
+import math
+import os
+import re
+import shutil
+import signal
+import struct
+import subprocess
+import sys
+import tempfile
+import textwrap
+import unittest
+from pathlib import Path
+
+SOURCE_DIR = Path(os.environ.get("DWIVEDI_SOURCE_DIR", Path(__file__).resolve().parents[2]))
+sys.path.append(str(SOURCE_DIR / "python_shim"))
+
+import dwivedi  # noqa: E402
+from dwivedi import _buffers, _library  # noqa: E402
+
+try:
+    import numpy
+except ImportError:  # numpy is optional for the shim
+    numpy = None
+
+# A unit cube [-0.5, 0.5]^3: 8 corners, 12 outward-facing triangles (counter-clockwise seen from
+# outside), and per-corner UVs laying each face over the whole [0, 1]^2 square's lower triangle
+# or upper triangle.
+CUBE_POSITIONS = [(x, y, z) for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.5, 0.5)]
+CUBE_TRIANGLES = [
+    (0, 1, 3), (0, 3, 2),  # x = -0.5
+    (4, 6, 7), (4, 7, 5),  # x = +0.5
+    (0, 4, 5), (0, 5, 1),  # y = -0.5
+    (2, 3, 7), (2, 7, 6),  # y = +0.5
+    (0, 2, 6), (0, 6, 4),  # z = -0.5
+    (1, 5, 7), (1, 7, 3),  # z = +0.5
+]
+CUBE_UVS = [c for i in range(6) for c in ((0.02, 0.02), (0.98, 0.02), (0.98, 0.98),
+                                           (0.02, 0.02), (0.98, 0.98), (0.02, 0.98))]
+
+
+def cube_scene(world=(0.0, 0.0, 0.0), sun=3.0, camera=True, uvs=False, radius=(0.5, 0.25, 0.1)):
+    """A lit subsurface cube seen from the front; not committed."""
+    scene = dwivedi.Scene()
+    material = scene.add_material(dwivedi.Material(subsurface_color=(0.9, 0.6, 0.4), subsurface_radius=radius,
+                                                   subsurface_scale=1.0))
+    scene.add_mesh(CUBE_POSITIONS, CUBE_TRIANGLES, material, uvs=CUBE_UVS if uvs else None)
+    if sun:
+        scene.add_light(dwivedi.SunLight(direction=(0.3, 1.0, -0.5), strength=sun))
+    scene.set_world(world, 1.0)
+    if camera:
+        scene.set_camera(dwivedi.Camera.look_at((0.0, -3.0, 0.5), (0.0, 0.0, 0.0)))
+    return scene
+
+
+def luminance_sum(image):
+    rgba = image.pixels()
+    return sum(rgba[i] + rgba[i + 1] + rgba[i + 2] for i in range(0, len(rgba), 4))
+
+
+class StructLayoutTest(unittest.TestCase):
+    """The ctypes mirrors have the C structs' sizes and offsets (a C compiler checks, if any)."""
+
+    STRUCTS = {
+        "dwv_material_t": _library.Material, "dwv_mesh_t": _library.Mesh, "dwv_light_desc_t": _library.LightDesc,
+        "dwv_camera_t": _library.CameraDesc, "dwv_bake_progress_t": _library.BakeProgress,
+        "dwv_bake_options_t": _library.BakeOptions, "dwv_image_info_t": _library.ImageInfo,
+        "dwv_bake_stats_t": _library.BakeStats, "dwv_error_point_t": _library.ErrorPoint,
+        "dwv_display_options_t": _library.DisplayOptions,
+    }
+
+    def test_sizes_on_lp64(self):
+        if ctypes.sizeof(ctypes.c_void_p) != 8:
+            self.skipTest("the sizes below are those of an LP64 ABI")
+        sizes = {"dwv_material_t": 112, "dwv_mesh_t": 144, "dwv_light_desc_t": 216, "dwv_camera_t": 128,
+                 "dwv_bake_progress_t": 48, "dwv_bake_options_t": 96, "dwv_image_info_t": 40,
+                 "dwv_bake_stats_t": 128, "dwv_error_point_t": 24, "dwv_display_options_t": 56}
+        for name, size in sizes.items():
+            self.assertEqual(ctypes.sizeof(self.STRUCTS[name]), size, name)
+
+    def test_offsets_match_a_c_compiler(self):
+        cc = shutil.which("cc") or shutil.which("gcc") or shutil.which("clang")
+        if cc is None:
+            self.skipTest("no C compiler to compare with")
+        lines = []
+        for c_name, py in self.STRUCTS.items():
+            lines.append(f'printf("{c_name} %zu\\n", sizeof({c_name}));')
+            for field_name, *_ in py._fields_:
+                lines.append(f'printf("{c_name}.{field_name} %zu\\n", offsetof({c_name}, {field_name}));')
+        source = "#include <stdio.h>\n#include <stddef.h>\n#include \"dwivedi.h\"\nint main(void){\n" + \
+                 "\n".join(lines) + "\nreturn 0;}\n"
+        with tempfile.TemporaryDirectory() as tmp:
+            (Path(tmp) / "layout.c").write_text(source)
+            exe = Path(tmp) / "layout"
+            subprocess.run([cc, "-I", str(SOURCE_DIR / "capi"), str(Path(tmp) / "layout.c"), "-o", str(exe)],
+                           check=True)
+            out = subprocess.run([str(exe)], check=True, capture_output=True, text=True).stdout
+        for line in out.splitlines():
+            key, value = line.rsplit(" ", 1)
+            if "." in key:
+                struct_name, field_name = key.split(".")
+                actual = getattr(self.STRUCTS[struct_name], field_name).offset
+            else:
+                actual = ctypes.sizeof(self.STRUCTS[key])
+            self.assertEqual(actual, int(value), key)
+
+    def test_defaults_are_the_init_macros(self):
+        options = _library.BakeOptions()
+        self.assertEqual((options.struct_size, options.width, options.height, options.uv_margin, options.samples),
+                         (96, 256, 256, 16, 64))
+        settings = dwivedi.BakeSettings()
+        self.assertEqual((settings.width, settings.height, settings.uv_margin, settings.samples, settings.technique),
+                         (256, 256, 16, 64, "auto"))
+        material = dwivedi.Material()._to_c()
+        self.assertEqual(tuple(material.subsurface_radius), (1.0, 0.2, 0.1))
+        self.assertEqual((material.subsurface_scale, material.subsurface_ior), (0.05, 1.4))
+        self.assertEqual(_library.DisplayOptions().gamma, 1.0)
+
+
+class BufferTest(unittest.TestCase):
+    """Arrays reach the library without a copy where their layout allows it."""
+
+    def test_float32_buffers_are_not_copied(self):
+        data = array.array("f", range(9))
+        passed = _buffers.as_c_array(data, "f", "positions", 3)
+        self.assertEqual(passed.address, data.buffer_info()[0])
+        view = memoryview(data)
+        self.assertEqual(_buffers.as_c_array(view, "f", "positions", 3).address, data.buffer_info()[0])
+        if numpy is not None:
+            a = numpy.arange(9, dtype=numpy.float32).reshape(3, 3)
+            self.assertEqual(_buffers.as_c_array(a, "f", "positions", 3).address, a.ctypes.data)
+            i = numpy.arange(6, dtype=numpy.uint32)
+            self.assertEqual(_buffers.as_c_array(i, "I", "indices", 3).address, i.ctypes.data)
+
+    def test_other_layouts_are_converted(self):
+        for values in ([(0, 1, 2), (3, 4, 5)], [0, 1, 2, 3, 4, 5], array.array("d", range(6)),
+                       memoryview(array.array("d", range(6)))):
+            passed = _buffers.as_c_array(values, "f", "positions", 3)
+            self.assertEqual(passed.count, 6)
+            self.assertEqual(list((ctypes.c_float * 6).from_address(passed.address)), [0, 1, 2, 3, 4, 5])
+        if numpy is not None:
+            a = numpy.arange(12, dtype=numpy.float64).reshape(4, 3)[::2]  # strided float64
+            passed = _buffers.as_c_array(a, "f", "positions", 3)
+            self.assertEqual(list((ctypes.c_float * 6).from_address(passed.address)), [0, 1, 2, 6, 7, 8])
+            ints = numpy.array([[0, 1, 2]], dtype=numpy.int64)
+            passed = _buffers.as_c_array(ints, "I", "indices", 3)
+            self.assertEqual(list((ctypes.c_uint32 * 3).from_address(passed.address)), [0, 1, 2])
+
+    def test_bad_arrays(self):
+        with self.assertRaises(dwivedi.Error) as caught:
+            _buffers.as_c_array([0, 1, 2, 3], "f", "positions", 3)
+        self.assertIn("not a multiple of 3", str(caught.exception))
+        with self.assertRaises(TypeError):
+            _buffers.as_c_array(["a", "b", "c"], "f", "positions", 3)
+        with self.assertRaises(TypeError):
+            _buffers.as_c_array([0.5, 1, 2], "I", "indices", 3)
+        with self.assertRaises(dwivedi.Error):
+            _buffers.as_c_array([-1, 1, 2], "I", "indices", 3)
+        with self.assertRaises(dwivedi.Error):
+            _buffers.transform12([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 1, 1]])
+
+
+class SceneTest(unittest.TestCase):
+    def test_ids_and_states(self):
+        with dwivedi.Scene() as scene:
+            self.assertEqual(scene.add_material(dwivedi.Material()), 0)
+            self.assertEqual(scene.add_material(dwivedi.Material.diffuse((0.5, 0.5, 0.5))), 1)
+            self.assertEqual(scene.add_mesh(CUBE_POSITIONS, CUBE_TRIANGLES, 1), 0)
+            flat = array.array("f", [c for p in CUBE_POSITIONS for c in p])
+            self.assertEqual(scene.add_mesh(memoryview(flat), array.array("I", [i for t in CUBE_TRIANGLES for i in t]),
+                                            0, transform=[[1, 0, 0, 2], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]),
+                             1)
+            self.assertFalse(scene.committed)
+            scene.commit()
+            self.assertTrue(scene.committed)
+            with self.assertRaises(dwivedi.Error) as caught:
+                scene.add_material(dwivedi.Material())
+            self.assertEqual(caught.exception.code, _library.DWV_ERROR_INVALID_STATE)
+        with self.assertRaises(dwivedi.Error):
+            scene.commit()  # closed
+
+    def test_library_errors_carry_codes(self):
+        with dwivedi.Scene() as scene:
+            material = scene.add_material(dwivedi.Material())
+            cases = [
+                (lambda: scene.add_mesh(CUBE_POSITIONS, [(0, 1, 8)], material), _library.DWV_ERROR_OUT_OF_RANGE),
+                (lambda: scene.add_mesh(CUBE_POSITIONS, CUBE_TRIANGLES, 5), _library.DWV_ERROR_OUT_OF_RANGE),
+                (lambda: scene.add_mesh([(math.nan, 0, 0)] + CUBE_POSITIONS[1:], CUBE_TRIANGLES, material), None),
+                (lambda: scene.add_material(dwivedi.Material(subsurface_color=(2.0, 0.5, 0.5))), None),
+                (lambda: scene.add_material(dwivedi.Material(kind="glass")), _library.DWV_ERROR_UNKNOWN_NAME),
+                (lambda: scene.add_light(dwivedi.SunLight(strength=-1.0)), _library.DWV_ERROR_OUT_OF_RANGE),
+                (lambda: scene.add_light(dwivedi.AreaLight(size_x=0.0)), _library.DWV_ERROR_OUT_OF_RANGE),
+                (lambda: scene.set_world((0.1, 0.1, math.inf)), None),
+                (lambda: scene.set_camera(dwivedi.Camera(focal_length=0.0)), _library.DWV_ERROR_OUT_OF_RANGE),
+                (lambda: scene.add_mesh(CUBE_POSITIONS, CUBE_TRIANGLES, material, uvs=[0.0] * 6), 2),
+            ]
+            for call, code in cases:
+                with self.assertRaises(dwivedi.Error) as caught:
+                    call()
+                self.assertTrue(caught.exception.message, "an error has a message")
+                self.assertIsInstance(caught.exception.code, int)
+                if code is not None:
+                    self.assertEqual(caught.exception.code, code, caught.exception.message)
+            with self.assertRaises(TypeError):
+                scene.add_light("sun")
+            with self.assertRaises(TypeError):
+                scene.add_mesh(CUBE_POSITIONS, CUBE_TRIANGLES, "wax")
+
+    def test_camera_look_at(self):
+        camera = dwivedi.Camera.look_at((0.0, -3.0, 0.0), (0.0, 0.0, 0.0))
+        t = camera.transform
+        # Looks along its local -z: the third column is the direction from target to eye.
+        self.assertAlmostEqual(t[2], 0.0)
+        self.assertAlmostEqual(t[6], -1.0)
+        self.assertAlmostEqual(t[10], 0.0)
+        self.assertAlmostEqual(t[9], 1.0)  # local +y is world +z (up)
+        self.assertEqual((t[3], t[7], t[11]), (0.0, -3.0, 0.0))
+        with self.assertRaises(dwivedi.Error):
+            dwivedi.Camera.look_at((0, 0, 0), (0, 0, 0))
+
+    def test_blender_3x_material_mapping(self):
+        m = dwivedi.Material.from_blender_3x((1.0, 0.0, 0.0), 0.25, (0.0, 1.0, 0.0), (1.0, 0.5, 0.25))
+        self.assertEqual(m.subsurface_weight, 1.0)
+        self.assertEqual(m.subsurface_scale, 0.25)
+        self.assertEqual(m.subsurface_color, (0.75, 0.25, 0.0))
+        self.assertEqual(dwivedi.Material.from_blender_3x((1, 1, 1), 0.0, (0, 0, 0), (1, 1, 1)).subsurface_weight, 0.0)
+
+
+class ImageTest(unittest.TestCase):
+    def test_views_share_the_library_memory(self):
+        pixels = [float(i) / 10 for i in range(4 * 3 * 2)]
+        image = dwivedi.Image(3, 2, pixels)
+        self.assertEqual((image.width, image.height), (3, 2))
+        rgba = image.rgba
+        self.assertEqual(rgba.shape, (2, 3, 4))
+        self.assertEqual(rgba.format, "f")
+        self.assertEqual([round(v, 6) for v in image.pixels()], [round(v, 6) for v in pixels])
+        rgba[1, 2, 3] = 42.0
+        self.assertEqual(image.pixels()[-1], 42.0)  # a view, not a copy
+        self.assertEqual(image.samples.shape, (2, 3))
+        self.assertEqual(image.variance.shape, (2, 3, 3))
+        image.close()
+        del image
+        # The view keeps its own reference: the pixels are still there.
+        self.assertEqual(rgba[1, 2, 3], 42.0)
+        self.assertAlmostEqual(rgba[0, 0, 1], 0.1, places=6)
+
+    @unittest.skipIf(numpy is None, "numpy is not installed")
+    def test_numpy_without_copy(self):
+        image = dwivedi.Image(4, 2, [0.5] * 32)
+        rgba, variance, samples = image.numpy()
+        self.assertEqual(rgba.shape, (2, 4, 4))
+        self.assertEqual(rgba.dtype, numpy.float32)
+        rgba[0, 0, 0] = 7.0
+        self.assertEqual(image.pixels()[0], 7.0)
+        del image
+        self.assertEqual(float(rgba.sum()), 0.5 * 31 + 7.0)
+
+    def test_bad_images(self):
+        with self.assertRaises(dwivedi.Error):
+            dwivedi.Image(2, 2, [0.0] * 15)
+        with self.assertRaises(dwivedi.Error):
+            dwivedi.Image(0, 2, [])
+        with self.assertRaises(dwivedi.Error):
+            dwivedi.Image(1, 1, [0.0, math.nan, 0.0, 1.0])
+
+    def test_exr_and_png_files(self):
+        image = dwivedi.Image(2, 2, [0.0, 0.0, 0.0, 1.0, 0.18, 0.18, 0.18, 1.0, 1.0, 0.5, 0.25, 1.0, 4.0, 4.0, 4.0, 1.0])
+        with tempfile.TemporaryDirectory() as tmp:
+            exr = Path(tmp) / "a.exr"
+            png = Path(tmp) / "a.png"
+            image.write_exr(exr)
+            self.assertEqual(exr.read_bytes()[:4], b"\x76\x2f\x31\x01")  # OpenEXR magic
+            image.write_png(png, view="Standard")
+            self.assertEqual(png.read_bytes()[:8], b"\x89PNG\r\n\x1a\n")
+            shown = image.to_display(view="Standard")
+            self.assertEqual(len(shown), 16)
+            self.assertEqual(tuple(shown[0:4]), (0, 0, 0, 255))
+            self.assertEqual(tuple(shown[12:16]), (255, 255, 255, 255))  # clipped by the Standard view
+            brighter = image.to_display(view="Standard", exposure=1.0)
+            self.assertGreater(brighter[4], shown[4])
+            with self.assertRaises(dwivedi.Error) as caught:
+                image.write_exr(Path(tmp) / "missing" / "a.exr")
+            self.assertEqual(caught.exception.code, _library.DWV_ERROR_IO)
+            with self.assertRaises(dwivedi.Error):
+                image.write_png(png, view="No Such View")
+            self.assertEqual(sorted(os.listdir(tmp)), ["a.exr", "a.png"])  # nothing partial left
+
+
+class BakeTest(unittest.TestCase):
+    def test_camera_bake(self):
+        with cube_scene(world=(0.05, 0.05, 0.05)).commit() as scene:
+            seen = []
+            image = dwivedi.bake(scene, width=24, height=16, samples=8, threads=2, seed=3, progress=seen.append)
+            self.assertEqual((image.width, image.height), (24, 16))
+            pixels = image.pixels()
+            self.assertTrue(all(math.isfinite(v) for v in pixels))
+            self.assertGreater(luminance_sum(image), 0.0)
+            stats = image.stats
+            self.assertEqual(stats.samples_per_pixel, 8)
+            self.assertGreater(stats.walks, 0)
+            self.assertIn("subsurface", stats.features)
+            self.assertTrue(seen and seen[-1].done)
+            self.assertEqual(sorted(p.fraction for p in seen), [p.fraction for p in seen])
+            points = image.error_vs_time
+            self.assertTrue(points)
+            self.assertEqual([p.seconds for p in points], sorted(p.seconds for p in points))
+            # Deterministic for any thread count.
+            again = dwivedi.bake(scene, width=24, height=16, samples=8, threads=1, seed=3)
+            self.assertEqual(again.pixels().tobytes(), pixels.tobytes())
+            other = dwivedi.bake(scene, width=24, height=16, samples=8, threads=2, seed=4)
+            self.assertNotEqual(other.pixels().tobytes(), pixels.tobytes())
+
+    def test_uv_bake(self):
+        with cube_scene(uvs=True, camera=False).commit() as scene:
+            image = scene.bake(target="uv", uv_mesh=0, width=32, height=32, samples=4, uv_margin=2)
+            alpha = image.rgba.tolist()
+            covered = sum(1 for row in alpha for px in row if px[3] > 0.0)
+            self.assertGreater(covered, 32 * 32 // 2)
+            with self.assertRaises(dwivedi.Error):
+                scene.bake(target="uv", uv_mesh=7, width=8, height=8, samples=1)
+
+    def test_bad_settings(self):
+        with cube_scene().commit() as scene:
+            for overrides in ({"samples": 0}, {"width": 0}, {"time_limit": -1.0}, {"technique": "magic"},
+                              {"target": "screen"}):
+                with self.assertRaises(dwivedi.Error, msg=str(overrides)):
+                    dwivedi.bake(scene, **{"width": 8, "height": 8, "samples": 1, **overrides})
+            with self.assertRaises(TypeError):
+                dwivedi.bake(scene, colour=1)
+        with cube_scene(camera=False).commit() as scene:
+            with self.assertRaises(dwivedi.Error):  # a camera bake needs a camera
+                dwivedi.bake(scene, width=8, height=8, samples=1)
+        with cube_scene() as scene:
+            with self.assertRaises(dwivedi.Error):  # not committed
+                dwivedi.bake(scene, width=8, height=8, samples=1)
+
+    def test_progress_callback_cancels(self):
+        with cube_scene().commit() as scene:
+            calls = []
+
+            def stop(progress):
+                calls.append(progress)
+                return True
+
+            with self.assertRaises(dwivedi.Cancelled) as caught:
+                dwivedi.bake(scene, width=64, height=64, samples=1 << 20, progress=stop, interval=0.01)
+            self.assertEqual(caught.exception.code, _library.DWV_ERROR_CANCELLED)
+            self.assertGreaterEqual(len(calls), 1)
+
+    def test_keyboard_interrupt_in_the_wait_cancels(self):
+        with cube_scene().commit() as scene:
+            def interrupt(progress):
+                raise KeyboardInterrupt
+
+            with self.assertRaises(KeyboardInterrupt):
+                dwivedi.bake(scene, width=64, height=64, samples=1 << 20, progress=interrupt, interval=0.01)
+            # The scene is usable again at once: the bake's threads have stopped.
+            image = dwivedi.bake(scene, width=4, height=4, samples=1)
+            self.assertEqual(image.width, 4)
+
+    def test_ctrl_c_in_a_process(self):
+        """A real SIGINT while bake() waits stops the bake and raises KeyboardInterrupt."""
+        script = textwrap.dedent(f"""
+            import sys, time
+            sys.path.insert(0, {str(SOURCE_DIR / 'python_shim')!r})
+            sys.path.insert(0, {str(Path(__file__).resolve().parent)!r})
+            import dwivedi
+            from test_baker_shim import cube_scene
+            scene = cube_scene().commit()
+            def started(progress):
+                if not getattr(started, "said", False):
+                    started.said = True
+                    print("started", flush=True)
+            try:
+                dwivedi.bake(scene, width=64, height=64, samples=1 << 24, progress=started)
+            except KeyboardInterrupt:
+                print("interrupted", flush=True)
+                sys.exit(3)
+            print("finished", flush=True)
+        """)
+        process = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True,
+                                   env={**os.environ, "PYTHONDONTWRITEBYTECODE": "1"})
+        try:
+            self.assertEqual(process.stdout.readline().strip(), "started")
+            process.send_signal(signal.SIGINT)
+            out, _ = process.communicate(timeout=60)
+        finally:
+            if process.poll() is None:
+                process.kill()
+                process.wait()
+        self.assertEqual(out.strip(), "interrupted")
+        self.assertEqual(process.returncode, 3)
+
+    def test_start_bake_handle(self):
+        with cube_scene().commit() as scene:
+            with dwivedi.start_bake(scene, width=16, height=16, samples=4) as job:
+                self.assertTrue(job.wait(None))
+                self.assertTrue(job.progress().done)
+                image = job.finish()
+            self.assertEqual(image.stats.samples_per_pixel, 4)
+            with self.assertRaises(dwivedi.Error):
+                job.finish()  # already finished
+            job = dwivedi.start_bake(scene, width=64, height=64, samples=1 << 20)
+            job.cancel()
+            with self.assertRaises(dwivedi.Cancelled):
+                job.finish()
+
+
+class SceneFileTest(unittest.TestCase):
+    def test_default_scene(self):
+        with dwivedi.Scene.default() as scene:
+            self.assertTrue(scene.committed)
+            settings = scene.settings
+            self.assertGreater(settings.width, 0)
+            image = dwivedi.bake(scene, width=16, height=12, samples=2)
+            self.assertEqual((image.width, image.height), (16, 12))
+            self.assertGreater(luminance_sum(image), 0.0)
+
+    def test_scene_file_errors(self):
+        with self.assertRaises(dwivedi.Error) as caught:
+            dwivedi.Scene.from_json("{ not json")
+        self.assertEqual(caught.exception.code, _library.DWV_ERROR_FORMAT)
+        with self.assertRaises(dwivedi.Error) as caught:
+            dwivedi.Scene.load("/nonexistent/scene.json")
+        self.assertEqual(caught.exception.code, _library.DWV_ERROR_IO)
+
+    def test_example_scenes_load(self):
+        scenes = sorted((SOURCE_DIR / "examples" / "scenes").glob("*.json"))
+        if not scenes:
+            self.skipTest("no example scenes in this tree")
+        for path in scenes:
+            with dwivedi.Scene.load(path) as scene:
+                self.assertTrue(scene.committed, path.name)
+
+
+class ExampleScriptTest(unittest.TestCase):
+    def test_bake_example_runs(self):
+        script = SOURCE_DIR / "examples" / "python" / "bake_example.py"
+        with tempfile.TemporaryDirectory() as tmp:
+            result = subprocess.run([sys.executable, str(script), "--out", tmp, "--size", "24", "--samples", "2"],
+                                    capture_output=True, text=True, timeout=120,
+                                    env={**os.environ, "PYTHONPATH": str(SOURCE_DIR / "python_shim")})
+            self.assertEqual(result.returncode, 0, result.stderr)
+            self.assertTrue((Path(tmp) / "example.exr").is_file())
+            self.assertTrue((Path(tmp) / "example.png").is_file())
+
+
+if __name__ == "__main__":
+    unittest.main()

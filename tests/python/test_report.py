@@ -1,0 +1,53 @@
+"""The error-against-time report tool, `python3 -m dwivedi.report`, in its quick form without
+Cycles: it runs, writes report.md and report.json with every technique on every benchmark scene,
+RMSE falls with samples, and plots appear where matplotlib is installed."""
+import importlib.util
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import unittest
+from pathlib import Path
+
+SOURCE_DIR = Path(os.environ.get("DWIVEDI_SOURCE_DIR", Path(__file__).resolve().parents[2]))
+sys.path.append(str(SOURCE_DIR / "python_shim"))
+
+import dwivedi  # noqa: E402
+
+
+class ReportTest(unittest.TestCase):
+    def test_quick_report(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            env = {**os.environ, "PYTHONPATH": str(SOURCE_DIR / "python_shim")}
+            result = subprocess.run([sys.executable, "-m", "dwivedi.report", "--quick", "--no-cycles", "--size", "8",
+                                     "--out", tmp], capture_output=True, text=True, env=env, timeout=300)
+            self.assertEqual(result.returncode, 0, result.stderr[-2000:])
+            text = (Path(tmp) / "report.md").read_text()
+            for heading in ("## v0 methods", "## Walk techniques", "## Against Cycles"):
+                self.assertIn(heading, text)
+            data = json.loads((Path(tmp) / "report.json").read_text())
+            self.assertEqual(sorted(data["techniques"]), ["default", "slab", "sphere"])
+            for scene, entry in data["techniques"].items():
+                self.assertEqual(sorted(entry["techniques"]), sorted(dwivedi.techniques()))
+                auto = entry["techniques"]["auto"]
+                self.assertLess(auto[-1]["rmse"], auto[0]["rmse"], f"{scene}: more samples, less error")
+            self.assertLess(max(data["v0"]["fast"]), 1e-4)
+            if importlib.util.find_spec("matplotlib") is not None:
+                self.assertTrue((Path(tmp) / "v0_methods.png").is_file())
+                self.assertTrue((Path(tmp) / "rmse_slab.png").is_file())
+
+    def test_bad_output_folder(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            blocker = Path(tmp) / "file"
+            blocker.write_text("x")
+            env = {**os.environ, "PYTHONPATH": str(SOURCE_DIR / "python_shim")}
+            result = subprocess.run([sys.executable, "-m", "dwivedi.report", "--quick", "--no-cycles",
+                                     "--out", str(blocker / "sub")], capture_output=True, text=True, env=env,
+                                    timeout=60)
+            self.assertEqual(result.returncode, 1)
+            self.assertIn("dwivedi.report:", result.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main()
