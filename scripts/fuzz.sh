@@ -14,7 +14,9 @@ shift || true
 build=${DWV_FUZZ_BUILD_DIR:-build-fuzz}
 cc=${DWV_FUZZ_CC:-$(command -v clang-14 || command -v clang || true)}
 [ -n "$cc" ] || { echo "fuzz: no clang (Debian: apt-get install clang-14 libclang-rt-14-dev)" >&2; exit 2; }
-cmake -S . -B "$build" -DCMAKE_C_COMPILER="$cc" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDWV_BUILD_FUZZERS=ON \
+# the C++ part of the library (OpenColorIO) needs the matching clang++ for -fsanitize=fuzzer-no-link
+cxx=${DWV_FUZZ_CXX:-$(command -v "${cc/clang/clang++}" || command -v clang++ || true)}
+cmake -S . -B "$build" -DCMAKE_C_COMPILER="$cc" -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDWV_BUILD_FUZZERS=ON \
   -DDWV_BUILD_TESTS=OFF -DDWV_WARNINGS_AS_ERRORS=ON >/dev/null
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
