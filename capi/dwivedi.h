@@ -567,7 +567,7 @@ typedef struct dwv_bake_options_t {
     uint32_t threads;         /* 0: all cores; at most 1024 */
     uint32_t max_events;      /* cap on scattering events per walk; 0: 10^6 */
     uint64_t seed;
-    uint32_t tile_size;       /* pixels per tile side, 0: 32 */
+    uint32_t tile_size;       /* pixels per tile side, 0: 32, or down to 8 on small images (16 tiles per thread) */
     uint32_t reserved;
     dwv_progress_callback_t progress;  /* optional */
     void *progress_user;

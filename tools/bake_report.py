@@ -24,7 +24,7 @@ COLORS = {"classical": "black", "poe": "tab:blue", "closest": "tab:orange", "inc
           "backward": "tab:purple", "cycles": "tab:brown", "auto": "tab:red"}
 SCALING_TARGET = 1.9
 MODES = {
-    "full": ["--width", "160", "--height", "90", "--spp", "16", "--reference-spp", "1024", "--max-spp", "64"],
+    "full": ["--width", "160", "--height", "90", "--spp", "32", "--reference-spp", "1024", "--max-spp", "64"],
     "quick": ["--width", "32", "--height", "18", "--spp", "2", "--reference-spp", "16", "--max-spp", "4"],
 }
 

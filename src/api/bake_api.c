@@ -17,6 +17,8 @@
 #define MAX_THREADS 1024u
 #define MAX_MARGIN 64u
 #define DEFAULT_TILE 32u
+#define SMALLEST_DEFAULT_TILE 8u
+#define TILES_PER_THREAD 16u /* enough that the last tiles of a pass even out between workers */
 #define DEFAULT_MAX_EVENTS 1000000u
 
 struct dwv_bake_s {
@@ -56,6 +58,18 @@ static dwv_result_t check_options(const char *fn, const dwvb_scene *s, const dwv
     return DWV_SUCCESS;
 }
 
+/* 32 pixels, halved down to 8 while the image has fewer than TILES_PER_THREAD tiles per thread:
+ * small images would otherwise leave one worker idle at the end of every pass. The tile size
+ * changes only timing, never the pixels. */
+static uint32_t default_tile_size(uint32_t width, uint32_t height, uint32_t threads)
+{
+    uint32_t tile = DEFAULT_TILE;
+    while (tile > SMALLEST_DEFAULT_TILE &&
+           (uint64_t)((width + tile - 1u) / tile) * ((height + tile - 1u) / tile) < (uint64_t)TILES_PER_THREAD * threads)
+        tile /= 2u;
+    return tile;
+}
+
 dwv_result_t dwv_bake_start(dwv_scene_t *scene, const dwv_bake_options_t *options, dwv_bake_t **bake)
 {
     static const char fn[] = "dwv_bake_start";
@@ -72,7 +86,7 @@ dwv_result_t dwv_bake_start(dwv_scene_t *scene, const dwv_bake_options_t *option
         long cores = sysconf(_SC_NPROCESSORS_ONLN);
         resolved.threads = cores < 1 ? 1u : cores > (long)MAX_THREADS ? MAX_THREADS : (uint32_t)cores;
     }
-    if (resolved.tile_size == 0u) resolved.tile_size = DEFAULT_TILE;
+    if (resolved.tile_size == 0u) resolved.tile_size = default_tile_size(resolved.width, resolved.height, resolved.threads);
     if (resolved.max_events == 0u) resolved.max_events = DEFAULT_MAX_EVENTS;
     dwv_bake_t *handle = calloc(1, sizeof *handle);
     if (!handle) return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "%s: out of memory", fn);

@@ -39,6 +39,12 @@ struct dwvb_bake {
     uint32_t *counts;
     uint32_t tiles_x, tile_count;
     dwvb_tally *tile_tallies;
+    /* Tiles are handed out longest first, by the seconds each took in the previous pass, so that
+     * no worker is left with one long tile at the end of a pass (longest-processing-time-first
+     * scheduling). The order changes only timing: each pixel's samples are keyed by its index. */
+    uint32_t *tile_order;
+    double *tile_seconds;
+    struct timed_tile *tile_ranking; /* scratch for the ordering */
     uint64_t pass_first, pass_end; /* sample indices of the running pass */
     atomic_uint next_tile;
     atomic_uint tiles_done;
@@ -149,8 +155,11 @@ static void *worker(void *arg)
     uint32_t tile_size = bake->options.tile_size;
     int stop = 0;
     while (!stop && !must_stop(bake)) {
-        uint32_t tile = atomic_fetch_add(&bake->next_tile, 1u);
-        if (tile >= bake->tile_count) break;
+        uint32_t slot = atomic_fetch_add(&bake->next_tile, 1u);
+        if (slot >= bake->tile_count) break;
+        uint32_t tile = bake->tile_order[slot];
+        struct timespec tile_start, tile_end;
+        clock_gettime(CLOCK_MONOTONIC, &tile_start);
         uint32_t x0 = (tile % bake->tiles_x) * tile_size, y0 = (tile / bake->tiles_x) * tile_size;
         uint32_t x1 = x0 + tile_size < bake->width ? x0 + tile_size : bake->width;
         uint32_t y1 = y0 + tile_size < bake->height ? y0 + tile_size : bake->height;
@@ -179,6 +188,9 @@ static void *worker(void *arg)
             }
         }
         atomic_fetch_add(&bake->events, tally->events - events_before);
+        clock_gettime(CLOCK_MONOTONIC, &tile_end);
+        bake->tile_seconds[tile] = (double)(tile_end.tv_sec - tile_start.tv_sec) +
+                                   1e-9 * (double)(tile_end.tv_nsec - tile_start.tv_nsec);
         if (!stop) atomic_fetch_add(&bake->tiles_done, 1u);
     }
     pthread_mutex_lock(&bake->lock);
@@ -278,9 +290,33 @@ static void timed_wait(dwvb_bake *bake, double seconds)
     pthread_cond_timedwait(&bake->changed, &bake->lock, &until);
 }
 
+typedef struct timed_tile {
+    double seconds;
+    uint32_t tile;
+} timed_tile;
+
+static int longer_first(const void *a, const void *b)
+{
+    const timed_tile *x = a, *y = b;
+    if (x->seconds != y->seconds) return x->seconds > y->seconds ? -1 : 1;
+    return x->tile < y->tile ? -1 : x->tile > y->tile;
+}
+
+/* Orders the tiles by the seconds they took in the previous pass, longest first; the first pass
+ * keeps the raster order. Passes double in samples, so the previous pass predicts the next. */
+static void order_tiles(dwvb_bake *bake)
+{
+    timed_tile *ranking = bake->tile_ranking;
+    if (bake->spp_done == 0u) return;
+    for (uint32_t t = 0; t < bake->tile_count; ++t) ranking[t] = (timed_tile){bake->tile_seconds[t], t};
+    qsort(ranking, bake->tile_count, sizeof *ranking, longer_first);
+    for (uint32_t t = 0; t < bake->tile_count; ++t) bake->tile_order[t] = ranking[t].tile;
+}
+
 /* Runs one pass on `threads` workers while reporting progress; 0, or -1 if threads could not start. */
 static int run_pass(dwvb_bake *bake)
 {
+    order_tiles(bake);
     atomic_store(&bake->next_tile, 0u);
     atomic_store(&bake->tiles_done, 0u);
     pthread_t ids[1024];
@@ -409,6 +445,9 @@ static void release_parts(dwvb_bake *bake)
     free(bake->sums);
     free(bake->counts);
     free(bake->tile_tallies);
+    free(bake->tile_order);
+    free(bake->tile_seconds);
+    free(bake->tile_ranking);
     dwvb_uv_raster_free(&bake->raster);
     if (bake->image) dwvb_image_free(bake->image);
     pthread_mutex_destroy(&bake->lock);
@@ -503,12 +542,17 @@ dwv_result_t dwvb_bake_start(dwvb_scene *scene, const dwv_bake_options_t *option
     bake->sums = calloc(pixels, sizeof *bake->sums);
     bake->counts = calloc(pixels, sizeof *bake->counts);
     bake->tile_tallies = calloc(bake->tile_count, sizeof *bake->tile_tallies);
+    bake->tile_order = malloc(bake->tile_count * sizeof *bake->tile_order);
+    bake->tile_seconds = calloc(bake->tile_count, sizeof *bake->tile_seconds);
+    bake->tile_ranking = malloc(bake->tile_count * sizeof *bake->tile_ranking);
     bake->image = dwvb_image_new(bake->width, bake->height);
-    if (!bake->guides || !bake->needs_closest || !bake->sums || !bake->counts || !bake->tile_tallies || !bake->image) {
+    if (!bake->guides || !bake->needs_closest || !bake->sums || !bake->counts || !bake->tile_tallies || !bake->tile_order ||
+        !bake->tile_seconds || !bake->tile_ranking || !bake->image) {
         release_parts(bake);
         snprintf(message, size, "out of memory for a %u x %u bake", options->width, options->height);
         return DWV_ERROR_OUT_OF_MEMORY;
     }
+    for (uint32_t t = 0; t < bake->tile_count; ++t) bake->tile_order[t] = t;
     if (options->target == DWV_BAKE_UV) {
         const dwvg_mesh *mesh = &scene->meshes[options->uv_mesh];
         dwv_result_t r = dwvb_uv_rasterize(mesh->uvs, mesh->triangle_count, bake->width, bake->height, &bake->raster);
