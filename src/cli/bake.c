@@ -299,6 +299,37 @@ done:
     return status;
 }
 
+/* Checks, before any time is spent baking, what would otherwise fail only at the end: that a file
+ * can be created beside PREFIX (a probe file, created and removed: access() says yes to root on any
+ * folder) and that the OCIO config, display, view and look exist (a 1 x 1 image through them). */
+static int check_outputs_possible(const char *prefix, const dwv_display_options_t *display)
+{
+    char suffix[64];
+    snprintf(suffix, sizeof suffix, ".probe-%ld", (long)getpid());
+    char *probe = join(prefix, suffix);
+    if (!probe) return -1;
+    FILE *f = fopen(probe, "wb");
+    if (!f) {
+        fprintf(stderr, "dwivedi bake: --out %s: cannot create files there (%s): %s\n", prefix, probe, strerror(errno));
+        free(probe);
+        return -1;
+    }
+    fclose(f);
+    remove(probe);
+    free(probe);
+    static const float grey[4] = {0.18f, 0.18f, 0.18f, 1.0f};
+    dwv_image_t *pixel = NULL;
+    uint8_t rgba8[4];
+    int status = 0;
+    if (dwv_image_create(1u, 1u, grey, &pixel) != DWV_SUCCESS ||
+        dwv_image_to_display(pixel, display, rgba8, sizeof rgba8) != DWV_SUCCESS) {
+        fprintf(stderr, "dwivedi bake: %s\n", dwv_last_error_message());
+        status = -1;
+    }
+    dwv_image_release(pixel);
+    return status;
+}
+
 static int run(int argc, char **argv)
 {
     bake_flags f = {NULL, NULL, DWV_DISPLAY_OPTIONS_INIT, 0};
@@ -316,6 +347,10 @@ static int run(int argc, char **argv)
     if (parse_overrides(argc, argv, &f, &o, 1)) {
         dwv_scene_release(scene);
         return CLI_USAGE;
+    }
+    if (check_outputs_possible(f.prefix, &f.display) != 0) {
+        dwv_scene_release(scene);
+        return CLI_FAILED;
     }
 
     progress_state progress = {!f.quiet && isatty(STDERR_FILENO), 0};

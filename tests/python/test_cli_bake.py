@@ -104,6 +104,26 @@ class BakeCli(unittest.TestCase):
         self.assertIn("no/such/dir", done.stderr)
         self.assertEqual(os.listdir(self.folder), [])
 
+    def test_outputs_are_checked_before_the_bake(self):
+        """A bake of 10^9 samples per pixel would outlast run_cli's 60 s timeout: each of these must
+        be refused before it starts, not after."""
+        endless = ["--spp", "1000000000", "--quiet"]
+        cases = [
+            (["--out", os.path.join(self.folder, "missing", "x")], "missing"),
+            (["--out", os.path.join(self.folder, "file", "x")], "Not a directory"),
+            (["--out", self.prefix, "--view", "No Such View"], "No Such View"),
+            (["--out", self.prefix, "--look", "No Such Look"], "No Such Look"),
+            (["--out", self.prefix, "--ocio", os.path.join(self.folder, "none.ocio")], "none.ocio"),
+        ]
+        with open(os.path.join(self.folder, "file"), "w") as handle:
+            handle.write("a file where a folder should be")
+        before = snapshot(self.folder)
+        for args, message in cases:
+            done = run_cli("bake", *args, *endless)
+            self.assertEqual(done.returncode, 1, done.stderr)
+            self.assertIn(message, done.stderr)
+            self.assertEqual(snapshot(self.folder), before)
+
     def test_interrupt_cancels_and_keeps_earlier_outputs(self):
         self.bake()
         before = snapshot(self.folder)
