@@ -608,8 +608,9 @@ typedef struct dwv_image_info_t {
 #define DWV_IMAGE_INFO_INIT {sizeof(dwv_image_info_t), 0u, 0u, 0u, NULL, NULL, NULL}
 DWV_API dwv_result_t dwv_image_info(const dwv_image_t *image, dwv_image_info_t *info);
 
-/* What a bake did. The estimated relative error is sqrt(sum of pixel-mean variances) / sum of
- * pixel luminances over the covered pixels (the relative standard error of the image's mean). */
+/* What a bake did. The estimated relative error is the image's relative RMSE against its converged
+ * self, from the pixels' own variances: sqrt(mean of the pixel-mean luminance variances) / mean
+ * pixel luminance, over the covered pixels (target_error of the options is in the same terms). */
 typedef struct dwv_bake_stats_t {
     uint32_t struct_size;    /* sizeof(dwv_bake_stats_t): set by DWV_BAKE_STATS_INIT */
     dwv_technique_t technique;

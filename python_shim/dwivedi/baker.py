@@ -314,8 +314,8 @@ _TARGETS = {"camera": 0, "uv": 1}
 @dataclass
 class BakeSettings:
     """What to bake and how long (dwv_bake_options_t). Whichever budget is reached first ends the
-    bake: `samples` per pixel, `time_limit` seconds (0: none), `target_error` relative error of
-    the image (0: none). threads 0 uses every core; the image is the same for any thread count."""
+    bake: `samples` per pixel, `time_limit` seconds (0: none), `target_error` relative RMSE of
+    the image, as in BakeStats (0: none). threads 0 uses every core; the image is the same for any thread count."""
 
     target: str = "camera"
     width: int = 256
@@ -379,8 +379,9 @@ class ErrorPoint:
 
 @dataclass(frozen=True)
 class BakeStats:
-    """What a bake did (dwv_bake_stats_t). estimated_relative_error is the relative standard
-    error of the image's mean; mean_rgb the mean of the covered pixels."""
+    """What a bake did (dwv_bake_stats_t). estimated_relative_error is the image's estimated
+    relative RMSE (per-pixel noise over mean brightness, from the pixels' own variances); mean_rgb
+    the mean of the covered pixels."""
 
     technique: str
     samples_per_pixel: int

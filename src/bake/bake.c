@@ -226,16 +226,20 @@ static double mean_variance(double sum, double sum_squares, uint32_t n)
     return v > 0.0 ? v : 0.0;
 }
 
-/* sqrt(sum of pixel-mean luminance variances) / sum of pixel-mean luminances over the covered
- * pixels: the relative standard error of the image's mean. +inf while a covered pixel has fewer
- * than two samples, 0 for an image that is black with no variance. */
+/* The image's relative RMSE against its converged self, estimated from the pixels' own variances:
+ * sqrt(mean over the covered pixels of the variance of the pixel's mean luminance) / (mean of the
+ * pixels' mean luminances) = sqrt(N sum var) / sum luminance for N covered pixels. This is the
+ * "relative RMSE" of an image against a reference (RMSE / mean), so a target of 0.01 means noise
+ * of 1% of the image's brightness per pixel. +inf while a covered pixel has fewer than two
+ * samples, 0 for an image that is black with no variance. */
 static double estimate_error(const dwvb_bake *bake)
 {
     int any = any_surface_seen(bake);
     size_t pixels = (size_t)bake->width * bake->height;
-    double variance = 0.0, total = 0.0;
+    double variance = 0.0, total = 0.0, count = 0.0;
     for (size_t i = 0; i < pixels; ++i) {
         if (!covered(bake, (uint32_t)i, any)) continue;
+        count += 1.0;
         uint32_t n = bake->counts[i];
         if (n < 2u) return INFINITY;
         const pixel_sums *p = &bake->sums[i];
@@ -244,7 +248,7 @@ static double estimate_error(const dwvb_bake *bake)
         variance += mean_variance(l, p->sum_luminance_squares, n);
     }
     if (variance == 0.0) return 0.0;
-    return total > 0.0 ? sqrt(variance) / total : INFINITY;
+    return total > 0.0 ? sqrt(count * variance) / total : INFINITY;
 }
 
 static double fraction_done(dwvb_bake *bake)

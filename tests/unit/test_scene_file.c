@@ -136,7 +136,7 @@ static void test_examples(void)
 
     dwv_bake_options_t uv = DWV_BAKE_OPTIONS_INIT;
     CHECK(dwv_scene_load(EXAMPLES "/uv_tile.json", &scene, &uv) == DWV_SUCCESS, "%s", dwv_last_error_message());
-    CHECK(uv.target == DWV_BAKE_UV && uv.uv_mesh == 0u && uv.uv_margin == 8u && uv.target_error == 0.002 &&
+    CHECK(uv.target == DWV_BAKE_UV && uv.uv_mesh == 0u && uv.uv_margin == 8u && uv.target_error == 0.02 &&
               uv.seed == UINT64_MAX && uv.samples == 32u,
           "uv_tile options: target %d mesh %u margin %u seed %llu", (int)uv.target, uv.uv_mesh, uv.uv_margin,
           (unsigned long long)uv.seed);
