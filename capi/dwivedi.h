@@ -650,8 +650,8 @@ DWV_API dwv_result_t dwv_image_create(uint32_t width, uint32_t height, const flo
  * the same folder and renamed over the target only when complete: a failure never leaves a
  * partial file and never replaces a good one.
  * ------------------------------------------------------------------------------------------- */
-/* Float RGBA, scene-linear Rec.709 with the chromaticities attribute, plus the variance layer
- * (variance.R/G/B) and the sample counts (samples.Y), and metadata: technique, samples, seconds,
+/* Float RGBA, scene-linear Rec.709 with the chromaticities attribute, plus the variance channels
+ * (variance_R/G/B) and the sample counts (samples), and metadata: technique, samples, seconds,
  * estimated error, features, library version, the error-against-time series. */
 DWV_API dwv_result_t dwv_image_write_exr(const dwv_image_t *image, const char *path);
 

@@ -278,7 +278,10 @@ static void test_exr_round_trip(void)
     CHECK(read_exr(path, &ch, &c) == 0, "OpenEXR's core API reads the file back");
     CHECK(ch.width == W && ch.height == H, "size %d x %d", ch.width, ch.height);
     CHECK(ch.count == 8, "8 channels, got %d", ch.count);
-    const char *floats[] = {"R", "G", "B", "A", "variance.R", "variance.G", "variance.B"};
+    /* A dot makes a layer ("x.R" is R of layer x), and Blender 3.4 loads a file with layers only
+     * as render passes, with no pixels for bpy.data.images.load: see src/io/exr.c. */
+    for (int k = 0; k < ch.count; ++k) CHECK(strchr(ch.names[k], '.') == NULL, "channel '%s' has no dot", ch.names[k]);
+    const char *floats[] = {"R", "G", "B", "A", "variance_R", "variance_G", "variance_B"};
     for (int k = 0; k < 7; ++k) {
         int type = -1;
         const float *data = channel(&ch, floats[k], &type);
@@ -292,9 +295,9 @@ static void test_exr_round_trip(void)
         CHECK(mismatches == 0, "channel %s: %zu pixels differ in their bits", floats[k], mismatches);
     }
     int type = -1;
-    const uint32_t *samples = channel(&ch, "samples.Y", &type);
-    CHECK(samples && type == EXR_PIXEL_UINT, "samples.Y is UINT");
-    if (samples) CHECK(memcmp(samples, img->samples, (size_t)W * H * 4) == 0, "samples.Y equals the counts");
+    const uint32_t *samples = channel(&ch, "samples", &type);
+    CHECK(samples && type == EXR_PIXEL_UINT, "samples is UINT");
+    if (samples) CHECK(memcmp(samples, img->samples, (size_t)W * H * 4) == 0, "samples equals the counts");
 
     if (c) {
         exr_attr_chromaticities_t chroma;
@@ -337,8 +340,8 @@ static void test_exr_round_trip(void)
     CHECK(header != NULL, "exrheader runs");
     if (header) {
         const char *expected[] = {"chromaticities", "red   (0.64 0.33)", "white (0.3127 0.329)", "    R, 32-bit floating-point",
-                                  "    A, 32-bit floating-point", "    variance.G, 32-bit floating-point",
-                                  "    samples.Y, 32-bit unsigned integer", "zip", "dwivedi:technique (type string): \"incident\"",
+                                  "    A, 32-bit floating-point", "    variance_G, 32-bit floating-point",
+                                  "    samples, 32-bit unsigned integer", "zip", "dwivedi:technique (type string): \"incident\"",
                                   "dwivedi:samples (type int): 64", "dwivedi:seconds (type double): 1.25",
                                   "dwivedi:estimated_relative_error (type double)", "dwivedi:version (type string)",
                                   "dwivedi:features (type string): \"embree,subsurface,guided\"", "dwivedi:error_vs_time"};
