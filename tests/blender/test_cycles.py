@@ -179,10 +179,8 @@ class CyclesTest(harness.unittest.TestCase):
         self.assertGreater(count, 50, "the comparison sees the object")
         self.assertLessEqual(worst, 1.0 / 255 + 1e-6)
 
-    # PNG colour is not premultiplied: Blender divides by alpha before the view transform. The
-    # library's PNG (src/io) transforms the premultiplied EXR values as they are, so pixels the
-    # object covers only partly come out darker. Expected to fail until it does; a pass flags it.
-    @harness.unittest.expectedFailure
+    # PNG colour is not premultiplied: Blender divides by alpha before the view transform, and so
+    # does the library (src/io/display.cpp, docs/output.md).
     def test_display_png_partly_covered_pixels(self):
         ours, theirs = self.display_pngs()
         worst, count = self.worst(ours, theirs, opaque=False)
