@@ -120,6 +120,25 @@ class AddonTest(harness.unittest.TestCase):
         plain.scene.close()
         subdivided.scene.close()
 
+    def test_principled_exit_by_version(self):
+        """Blender 3.x's Principled BSDF exports the Principled v1 exit (retro-reflection by its
+        Roughness, 1 - (1 - cos)^5 / 2 exit weight); the Subsurface Scattering node, like 4.x's
+        Principled, the Lambertian exit."""
+        module = sys.modules["dwivedi_bake"]
+        shim = module.shim()
+        material = scenes.principled_material("Exit", (0.9, 0.6, 0.4), (0.5, 0.25, 0.1))
+        material.node_tree.nodes["Principled BSDF"].inputs["Roughness"].default_value = 0.3
+        warnings = []
+        exported = module.export.material_from_blender(material, shim, warnings)
+        if bpy.app.version < (4, 0, 0):
+            self.assertEqual(exported.subsurface_exit, "principled_v1")
+            self.assertAlmostEqual(exported.roughness, 0.3, places=6)
+        else:
+            self.assertEqual(exported.subsurface_exit, "lambert")
+        node = module.export.material_from_blender(scenes.sss_node_material("Node", (0.9, 0.6, 0.4), (1, 1, 1)),
+                                                   shim, warnings)
+        self.assertEqual(node.subsurface_exit, "lambert")
+
     def assertFails(self, pattern, **settings):
         result, error = harness.call_operator(**settings)
         self.assertEqual(result, {'CANCELLED'})
