@@ -409,14 +409,31 @@ enum {
     DWV_MATERIAL_DIFFUSE = 1     /* Lambertian reflection of base_color only */
 };
 
+/* How light leaves a subsurface material's walk (dwv_material_t.subsurface_exit). */
+typedef int32_t dwv_subsurface_exit_t;
+enum {
+    /* A Lambertian BSDF at the exit point: Cycles' Subsurface Scattering node and Blender 4.x's
+     * Principled BSDF. */
+    DWV_SUBSURFACE_EXIT_LAMBERT = 0,
+    /* Blender 3.x's Principled BSDF (Cycles' PRINCIPLED_DIFFUSE_LAMBERT_EXIT and
+     * PRINCIPLED_DIFFUSE_RETRO_REFLECTION): the exit's Lambertian BSDF weighted by
+     * 1 - F_L / 2, and at the entry point a retro-reflection lobe of weight subsurface_weight x
+     * subsurface_color, f = (1/pi) R_R (F_L + F_V + F_L F_V (R_R - 1)), with
+     * F_x = (1 - cos theta_x)^5 (Schlick's weight; L the light, V the viewer, angles to the
+     * shading normal) and R_R = roughness x (1 + L.V) (Burley 2015, "Extending the Disney BRDF
+     * to a BSDF with Integrated Subsurface Scattering", section 5.3). */
+    DWV_SUBSURFACE_EXIT_PRINCIPLED_V1 = 1
+};
+
 /* A material in the terms of Cycles' Principled BSDF with subsurface method "Random Walk (Fixed
  * Radius)", Blender 4.x naming: the surface is (1 - subsurface_weight) Lambertian diffuse of
  * base_color plus subsurface_weight random-walk subsurface scattering whose multiple-scattering
  * albedo is subsurface_color (turned into single-scattering albedo by Cycles' inversion fit) and
  * whose per-channel radius is subsurface_radius x subsurface_scale (scene units). Blender 3.x's
  * inputs map as: subsurface_weight = 1 where "Subsurface" > 0 (else 0), subsurface_color =
- * mix(Base Color, Subsurface Color, Subsurface), subsurface_scale = "Subsurface". Entry is
- * cosine-weighted diffuse transmission, exit Lambertian, as in Cycles. */
+ * mix(Base Color, Subsurface Color, Subsurface), subsurface_scale = "Subsurface",
+ * subsurface_exit = DWV_SUBSURFACE_EXIT_PRINCIPLED_V1, roughness = "Roughness". Entry is
+ * cosine-weighted diffuse transmission, exit as subsurface_exit says, as in Cycles. */
 typedef struct dwv_material_t {
     uint32_t struct_size;         /* sizeof(dwv_material_t): set by DWV_MATERIAL_INIT */
     dwv_material_kind_t kind;
@@ -428,10 +445,15 @@ typedef struct dwv_material_t {
     double subsurface_scale;      /* >= 0, finite */
     double subsurface_anisotropy; /* Henyey-Greenstein g in (-1, 1); used clamped to [0, 0.9], as Cycles */
     double subsurface_ior;        /* in [1, 4]; kept for compatibility (Cycles' walk ignores it) */
+    /* Added after 0.1.0. A caller whose struct_size ends before them gets the defaults
+     * (DWV_SUBSURFACE_EXIT_LAMBERT, roughness 0.5): its materials bake as they always did. */
+    dwv_subsurface_exit_t subsurface_exit; /* DWV_SUBSURFACE_EXIT_* */
+    uint32_t reserved;            /* 0 */
+    double roughness;             /* in [0, 1]: the retro-reflection lobe's (DWV_SUBSURFACE_EXIT_PRINCIPLED_V1) */
 } dwv_material_t;
 #define DWV_MATERIAL_INIT                                                                           \
     {sizeof(dwv_material_t), DWV_MATERIAL_SUBSURFACE, {0.8, 0.8, 0.8}, 1.0, {0.8, 0.8, 0.8},         \
-     {1.0, 0.2, 0.1}, 0.05, 0.0, 1.4}
+     {1.0, 0.2, 0.1}, 0.05, 0.0, 1.4, DWV_SUBSURFACE_EXIT_LAMBERT, 0u, 0.5}
 
 /* Adds a material; *material_id numbers them from 0 in order. */
 DWV_API dwv_result_t dwv_scene_add_material(dwv_scene_t *scene, const dwv_material_t *material,
@@ -651,8 +673,8 @@ DWV_API dwv_result_t dwv_image_create(uint32_t width, uint32_t height, const flo
  * the same folder and renamed over the target only when complete: a failure never leaves a
  * partial file and never replaces a good one.
  * ------------------------------------------------------------------------------------------- */
-/* Float RGBA, scene-linear Rec.709 with the chromaticities attribute, plus the variance layer
- * (variance.R/G/B) and the sample counts (samples.Y), and metadata: technique, samples, seconds,
+/* Float RGBA, scene-linear Rec.709 with the chromaticities attribute, plus the variance channels
+ * (variance_R/G/B) and the sample counts (samples), and metadata: technique, samples, seconds,
  * estimated error, features, library version, the error-against-time series. */
 DWV_API dwv_result_t dwv_image_write_exr(const dwv_image_t *image, const char *path);
 
@@ -672,7 +694,9 @@ typedef struct dwv_display_options_t {
     double gamma;         /* in [0.001, 1000] */
 } dwv_display_options_t;
 #define DWV_DISPLAY_OPTIONS_INIT {sizeof(dwv_display_options_t), 0u, NULL, NULL, NULL, NULL, 0.0, 1.0}
-/* Writes an 8-bit sRGB-encoded (as the display says) RGBA PNG of the image through the view. */
+/* Writes an 8-bit sRGB-encoded (as the display says) RGBA PNG of the image through the view. The
+ * image's colour is premultiplied by alpha; the PNG's is straight (the view transform gets
+ * rgb / alpha where alpha is neither 0 nor 1, as Blender's Image.save_render does). */
 DWV_API dwv_result_t dwv_image_write_display_png(const dwv_image_t *image, const char *path,
                                                  const dwv_display_options_t *display);
 /* The same pixels in memory: 4 x width x height bytes, as the PNG would hold them. */

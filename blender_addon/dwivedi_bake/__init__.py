@@ -204,8 +204,9 @@ def display_settings(scene, dwivedi):
 def blender_image(image, name, path):
     """The baked pixels as a float Blender image `name` (made again if its size changed), in
     scene-linear colour, with `path` as its file for Image > Save. Made from memory rather than by
-    loading the EXR: Blender 3.4 cannot read an EXR whose unlayered RGBA sits beside layered
-    channels (variance.R...), which ours has."""
+    loading the EXR, so that one named image is updated in place bake after bake (a loaded file
+    would be a new datablock, or a reload of a file the next bake replaces); the EXR itself loads
+    in Blender too, with the same pixels (tests/blender/test_addon.py checks it)."""
     import array
     width, height = image.width, image.height
     target = bpy.data.images.get(name)

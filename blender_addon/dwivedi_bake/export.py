@@ -133,16 +133,11 @@ def material_from_blender(material: Any, dwivedi: Any, warnings: List[str]) -> A
                                subsurface_ior=ior, kind="subsurface" if weight > 0.0 else "diffuse")
     else:  # Blender 3.x
         factor = _value(node, ("Subsurface",), 0.0, name, warnings)
-        roughness = _value(node, ("Roughness",), 0.5, name, warnings)
-        if factor > 0.0:
-            # Cycles 3.x's Principled (v1) adds to the walk a retro-reflection lobe (by Roughness)
-            # and weights the exit by 1 - (1 - cos)^5 / 2 (PRINCIPLED_DIFFUSE_LAMBERT_EXIT): dwivedi
-            # bakes the plain walk, as the Subsurface Scattering node and Blender 4.x do.
-            warnings.append(f"material '{name}': Blender 3.x's Principled adds retro-reflection (roughness "
-                            f"{roughness:.2f}) and a Fresnel-weighted exit to subsurface; dwivedi bakes the "
-                            "Lambertian-exit walk (front-lit results can differ from Cycles by a few %)")
+        # Cycles 3.x's Principled (v1) adds to the walk a retro-reflection lobe (by Roughness)
+        # and weights the exit by 1 - (1 - cos)^5 / 2: from_blender_3x selects that exit.
+        roughness = min(max(_value(node, ("Roughness",), 0.5, name, warnings), 0.0), 1.0)
         color = _value(node, ("Subsurface Color",), (0.8, 0.8, 0.8, 1.0), name, warnings)[:3]
-        out = dwivedi.Material.from_blender_3x(base, factor, color, radius, anisotropy, ior)
+        out = dwivedi.Material.from_blender_3x(base, factor, color, radius, anisotropy, ior, roughness)
         if factor <= 0.0:
             out.kind = "diffuse"
     if out.kind == "subsurface" and method != 'RANDOM_WALK_FIXED_RADIUS':

@@ -132,6 +132,9 @@ class Material(_SizedStructure):
         ("subsurface_scale", ctypes.c_double),
         ("subsurface_anisotropy", ctypes.c_double),
         ("subsurface_ior", ctypes.c_double),
+        ("subsurface_exit", ctypes.c_int32),
+        ("reserved", ctypes.c_uint32),
+        ("roughness", ctypes.c_double),
     ]
 
 

@@ -133,6 +133,7 @@ def feature_names(features: int) -> Tuple[str, ...]:
 # ---------------------------------------------------------------------------------------------
 
 _MATERIAL_KINDS = {"subsurface": 0, "diffuse": 1}
+_SUBSURFACE_EXITS = {"lambert": 0, "principled_v1": 1}
 
 
 @dataclass
@@ -144,6 +145,10 @@ class Material:
     channel is subsurface_radius x subsurface_scale (scene units), as Cycles' "Random Walk (Fixed
     Radius)". kind "diffuse" is a plain Lambertian surface of base_color. For Blender 3.x inputs
     use Material.from_blender_3x.
+
+    subsurface_exit: "lambert" (a Lambertian exit: the Subsurface Scattering node, Blender 4.x's
+    Principled) or "principled_v1" (Blender 3.x's Principled: the exit weighted by
+    1 - (1 - cos)^5 / 2 and a retro-reflection lobe of this roughness; see capi/dwivedi.h).
     """
 
     base_color: Color = (0.8, 0.8, 0.8)
@@ -154,6 +159,8 @@ class Material:
     subsurface_anisotropy: float = 0.0
     subsurface_ior: float = 1.4
     kind: str = "subsurface"
+    subsurface_exit: str = "lambert"
+    roughness: float = 0.5
 
     @classmethod
     def diffuse(cls, color: Color) -> "Material":
@@ -163,17 +170,19 @@ class Material:
 
     @classmethod
     def from_blender_3x(cls, base_color: Color, subsurface: float, subsurface_color: Color,
-                        subsurface_radius: Color, anisotropy: float = 0.0, ior: float = 1.4) -> "Material":
+                        subsurface_radius: Color, anisotropy: float = 0.0, ior: float = 1.4,
+                        roughness: float = 0.5) -> "Material":
         """The material of Blender 3.x's Principled inputs, mapped as Cycles 3.x does: the walk's
         albedo is mix(Base Color, Subsurface Color, Subsurface), its radius Subsurface Radius x
-        Subsurface; Subsurface = 0 is diffuse Base Color."""
+        Subsurface, its exit "principled_v1" with Roughness; Subsurface = 0 is diffuse Base Color."""
         s = _real("subsurface", subsurface)
         base = real_tuple(base_color, "base_color", 3)
         sss = real_tuple(subsurface_color, "subsurface_color", 3)
         mixed = tuple(b * (1.0 - s) + c * s for b, c in zip(base, sss))
         return cls(base_color=base, subsurface_weight=1.0 if s > 0.0 else 0.0, subsurface_color=mixed,
                    subsurface_radius=real_tuple(subsurface_radius, "subsurface_radius", 3), subsurface_scale=s,
-                   subsurface_anisotropy=anisotropy, subsurface_ior=ior)
+                   subsurface_anisotropy=anisotropy, subsurface_ior=ior, subsurface_exit="principled_v1",
+                   roughness=_real("roughness", roughness))
 
     def _to_c(self) -> _library.Material:
         out = _library.Material()
@@ -185,6 +194,8 @@ class Material:
         out.subsurface_scale = _real("subsurface_scale", self.subsurface_scale)
         out.subsurface_anisotropy = _real("subsurface_anisotropy", self.subsurface_anisotropy)
         out.subsurface_ior = _real("subsurface_ior", self.subsurface_ior)
+        out.subsurface_exit = _name_code("subsurface exit", self.subsurface_exit, _SUBSURFACE_EXITS)
+        out.roughness = _real("roughness", self.roughness)
         return out
 
 

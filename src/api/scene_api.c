@@ -1,6 +1,7 @@
 /* capi entry points that build a scene: every argument checked and copied, nothing kept from the
  * caller, nothing changed once the scene is committed. */
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -94,13 +95,20 @@ static dwv_result_t check_rigid(const char *fn, const char *name, const double m
     return DWV_SUCCESS;
 }
 
-dwv_result_t dwv_scene_add_material(dwv_scene_t *scene, const dwv_material_t *material, uint32_t *material_id)
+dwv_result_t dwv_scene_add_material(dwv_scene_t *scene, const dwv_material_t *material_in, uint32_t *material_id)
 {
     static const char fn[] = "dwv_scene_add_material";
     dwvb_scene *s;
     DWV_TRY(open_scene(fn, scene, &s));
-    DWV_TRY(dwv_check_struct(fn, "material", material, (uint32_t)sizeof(dwv_material_t)));
+    /* The struct as of 0.1.0 ended at subsurface_ior: such callers keep working, with the later
+     * fields' defaults. Only the caller's struct_size bytes are read. */
+    DWV_TRY(dwv_check_struct(fn, "material", material_in, (uint32_t)offsetof(dwv_material_t, subsurface_exit)));
     DWV_TRY(dwv_check_pointer(fn, "material_id", material_id));
+    dwv_material_t resolved = DWV_MATERIAL_INIT;
+    size_t given = material_in->struct_size < sizeof resolved ? material_in->struct_size : sizeof resolved;
+    memcpy(&resolved, material_in, given);
+    resolved.struct_size = (uint32_t)sizeof resolved;
+    const dwv_material_t *material = &resolved;
     if (material->kind != DWV_MATERIAL_SUBSURFACE && material->kind != DWV_MATERIAL_DIFFUSE)
         return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: material kind %d is neither subsurface (0) nor diffuse (1)",
                         fn, (int)material->kind);
@@ -114,10 +122,15 @@ dwv_result_t dwv_scene_add_material(dwv_scene_t *scene, const dwv_material_t *ma
         return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: subsurface_anisotropy = %.17g is outside (-1, 1)", fn,
                         material->subsurface_anisotropy);
     DWV_TRY(dwv_check_range(fn, "subsurface_ior", material->subsurface_ior, 1.0, 4.0));
+    if (material->subsurface_exit != DWV_SUBSURFACE_EXIT_LAMBERT &&
+        material->subsurface_exit != DWV_SUBSURFACE_EXIT_PRINCIPLED_V1)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
+                        "%s: subsurface_exit %d is neither Lambert (0) nor Principled v1 (1)", fn,
+                        (int)material->subsurface_exit);
+    DWV_TRY(dwv_check_range(fn, "roughness", material->roughness, 0.0, 1.0));
     if (s->material_count >= DWVB_MAX_MATERIALS)
         return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: a scene holds at most %u materials", fn, DWVB_MAX_MATERIALS);
     if (dwvb_scene_push_material(s, material)) return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "%s: out of memory", fn);
-    s->materials[s->material_count - 1u].struct_size = (uint32_t)sizeof(dwv_material_t);
     *material_id = s->material_count - 1u;
     return DWV_SUCCESS;
 }

@@ -39,16 +39,45 @@ double dwvb_albedo_inversion(double A, double g)
     return fmin(fmax(alpha, 0.0), 0.999999);
 }
 
+double dwvb_schlick_weight(double cos_theta)
+{
+    double m = fmin(fmax(1.0 - cos_theta, 0.0), 1.0);
+    double m2 = m * m;
+    return m2 * m2 * m;
+}
+
+double dwvb_principled_exit_factor(double cos_light)
+{
+    return 1.0 - 0.5 * dwvb_schlick_weight(cos_light);
+}
+
+double dwvb_principled_retro_factor(double cos_light, double cos_view, double light_dot_view, double roughness)
+{
+    double fl = dwvb_schlick_weight(cos_light), fv = dwvb_schlick_weight(cos_view);
+    double rr = roughness * (1.0 + light_dot_view);
+    return rr * (fl + fv + fl * fv * (rr - 1.0));
+}
+
 void dwvb_material_init(dwvb_material *out, const dwv_material_t *in)
 {
     out->subsurface = 0;
     out->grey = 0;
+    out->principled_v1 = 0;
+    out->roughness = 0.0;
     for (int c = 0; c < 3; ++c) {
         out->diffuse_albedo[c] = in->base_color[c];
         out->walk_scale[c] = 0.0;
+        out->retro_albedo[c] = 0.0;
     }
     if (in->kind != DWV_MATERIAL_SUBSURFACE) return;
     double w = in->subsurface_weight;
+    if (in->subsurface_exit == DWV_SUBSURFACE_EXIT_PRINCIPLED_V1 && w > 0.0) {
+        /* bssrdf_setup adds the retro-reflection BSDF with the BSSRDF's whole weight, before it
+         * moves channels of too small a radius to a Lambertian BSDF: every channel has it. */
+        out->principled_v1 = 1;
+        out->roughness = in->roughness;
+        for (int c = 0; c < 3; ++c) out->retro_albedo[c] = w * in->subsurface_color[c];
+    }
     double g = fmin(fmax(in->subsurface_anisotropy, 0.0), 0.9);
     double sigma_t[3], alpha[3];
     int walking = -1;

@@ -57,6 +57,28 @@ static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvb_materia
     return walk->status == DWVW_EXITED;
 }
 
+/* The retro-reflection lobe of Blender 3.x's Principled BSDF at a surface point. */
+typedef struct retro_lobe {
+    dwvw_vec3 n;       /* shading normal */
+    dwvw_vec3 to_view; /* unit, toward the viewer */
+    double cos_view;
+    double roughness;
+} retro_lobe;
+
+static double retro_factor(const void *context, dwvw_vec3 light)
+{
+    const retro_lobe *lobe = context;
+    return dwvb_principled_retro_factor(dwvw_dot(lobe->n, light), lobe->cos_view, dwvw_dot(light, lobe->to_view),
+                                        lobe->roughness);
+}
+
+/* The exit weight of Blender 3.x's Principled BSDF; the context is the exit's shading normal. */
+static double exit_factor(const void *context, dwvw_vec3 light)
+{
+    const dwvw_vec3 *n = context;
+    return dwvb_principled_exit_factor(dwvw_dot(*n, light));
+}
+
 void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, uint64_t key_shade,
                 uint32_t dimension, uint64_t key_walk, double rgb[3], dwvb_tally *tally)
 {
@@ -82,7 +104,15 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, 
     dwvw_vec3 x = dwvg_point(mesh, hit->prim, hit->u, hit->v);
     dwvw_vec3 n = dwvg_shading_normal(mesh, hit->prim, hit->u, hit->v, ng);
     uint32_t light_dims = dwvl_direct_dimensions(&shader->env);
-    if (material->diffuse_albedo[0] > 0.0 || material->diffuse_albedo[1] > 0.0 || material->diffuse_albedo[2] > 0.0) {
+    if (material->principled_v1) {
+        /* The Lambertian lobe and the retro-reflection lobe from the same light samples. */
+        retro_lobe lobe = {n, dwvw_scale(view, -1.0), -dwvw_dot(n, view), material->roughness};
+        double direct[3], retro[3];
+        dwvl_direct_lobe(&shader->env, x, n, ng, key_shade, dimension + DWVB_SHADE_DIMS, retro_factor, &lobe, direct,
+                         retro);
+        for (int c = 0; c < 3; ++c) rgb[c] += material->diffuse_albedo[c] * direct[c] + material->retro_albedo[c] * retro[c];
+    } else if (material->diffuse_albedo[0] > 0.0 || material->diffuse_albedo[1] > 0.0 ||
+               material->diffuse_albedo[2] > 0.0) {
         double direct[3];
         dwvl_direct(&shader->env, x, n, ng, key_shade, dimension + DWVB_SHADE_DIMS, direct);
         for (int c = 0; c < 3; ++c) rgb[c] += material->diffuse_albedo[c] * direct[c];
@@ -102,8 +132,12 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, 
     dwvw_vec3 exit_ng = walk.exit_normal;
     dwvw_vec3 exit_n = dwvg_shading_normal(mesh, exit.prim, exit.u, exit.v, exit_ng);
     double direct[3];
-    dwvl_direct(&shader->env, walk.position, exit_n, exit_ng, key_shade, dimension + DWVB_SHADE_DIMS + light_dims,
-                direct);
+    if (material->principled_v1)
+        dwvl_direct_lobe(&shader->env, walk.position, exit_n, exit_ng, key_shade,
+                         dimension + DWVB_SHADE_DIMS + light_dims, exit_factor, &exit_n, NULL, direct);
+    else
+        dwvl_direct(&shader->env, walk.position, exit_n, exit_ng, key_shade, dimension + DWVB_SHADE_DIMS + light_dims,
+                    direct);
     int grey = material->medium.channels == 1;
     for (int c = 0; c < 3; ++c) rgb[c] += walk.weight[grey ? 0 : c] * material->walk_scale[c] * direct[c];
 }

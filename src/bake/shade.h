@@ -2,7 +2,9 @@
  * lobe by next-event estimation, plus the random-walk subsurface lobe (Cycles-like, Fresnel-free):
  * enter by cosine-weighted diffuse transmission, walk in the mesh's own Embree scene with the
  * step machine of src/walk, leave through a Lambertian exit that gathers direct light and the
- * world. One bounce: surfaces do not light each other. */
+ * world. For DWV_SUBSURFACE_EXIT_PRINCIPLED_V1 the exit is weighted by 1 - F_L/2 and a
+ * retro-reflection lobe joins the Lambertian one (material.h). One bounce: surfaces do not light
+ * each other. */
 #ifndef DWV_BAKE_SHADE_H
 #define DWV_BAKE_SHADE_H
 

@@ -2,6 +2,7 @@
 //
 // The processing is Blender's colour management (its OCIO view pipeline, which OCIO 2 offers as
 // LegacyViewingPipeline):
+//   0. un-premultiply: rgb / alpha where alpha is neither 0 nor 1 (see straight_colour)
 //   1. exposure in scene linear: rgb * 2^exposure (alpha untouched)
 //   2. the look, if one is asked for (in the look's process space)            looks override
 //   3. the display/view transform from the config's scene_linear role          DisplayViewTransform
@@ -116,6 +117,17 @@ inline float sane(float v)
     return std::min(std::max(v, -max_scene_value), max_scene_value);
 }
 
+// The colour of a premultiplied pixel as straight (unassociated) colour: rgb / alpha, except where
+// alpha is 0 or 1 (kept as they are). This is what Blender does before its view transform when it
+// writes a display image (Image.save_render): OCIO_cpuProcessorApply_predivide divides by alpha
+// under exactly that condition, runs the processor and multiplies by alpha again, and
+// IMB_buffer_byte_from_float divides once more (premul_to_straight_v4_v4) before quantising; so
+// the bytes are display(rgb / alpha) with alpha as it was. PNG stores straight colour too.
+inline float straight_colour(float premultiplied, float alpha)
+{
+    return (alpha == 0.0f || alpha == 1.0f) ? premultiplied : premultiplied / alpha;
+}
+
 // Clamp to [0, 1] (NaN -> 0) and round to the nearest of 256 levels.
 inline uint8_t quantise(float v)
 {
@@ -191,10 +203,12 @@ void to_display(const float *rgba, uint32_t width, uint32_t height, const dwv_di
         const size_t values = static_cast<size_t>(width) * 4u * rows;
         const float *source = rgba + static_cast<size_t>(y0) * width * 4u;
         for (size_t i = 0; i < values; i += 4) {
-            strip[i + 0] = sane(sane(source[i + 0]) * gain);
-            strip[i + 1] = sane(sane(source[i + 1]) * gain);
-            strip[i + 2] = sane(sane(source[i + 2]) * gain);
-            strip[i + 3] = sane(source[i + 3]);
+            // sane() again after the division (a tiny alpha can overflow it) and the gain.
+            const float alpha = sane(source[i + 3]);
+            strip[i + 0] = sane(sane(straight_colour(sane(source[i + 0]), alpha)) * gain);
+            strip[i + 1] = sane(sane(straight_colour(sane(source[i + 1]), alpha)) * gain);
+            strip[i + 2] = sane(sane(straight_colour(sane(source[i + 2]), alpha)) * gain);
+            strip[i + 3] = alpha;
         }
         OCIO::PackedImageDesc desc(strip.data(), static_cast<long>(width), static_cast<long>(rows), 4);
         cpu->apply(desc);

@@ -12,8 +12,9 @@
 extern "C" {
 #endif
 
-/* Turns scene-linear Rec.709 RGBA floats (4 x width x height, row 0 at the top) into 8-bit display
- * RGBA as Blender's colour management does (see display.cpp): exposure, display/view/look through
+/* Turns scene-linear Rec.709 premultiplied RGBA floats (4 x width x height, row 0 at the top) into
+ * 8-bit straight-alpha display RGBA as Blender's colour management does (see display.cpp): colour
+ * divided by alpha (where alpha is neither 0 nor 1), exposure, display/view/look through
  * OpenColorIO, gamma, then [0, 1] clamped and rounded to 8 bits. `options` was validated by the
  * caller (exposure finite, gamma > 0 and finite); the names are checked here against the config
  * (DWV_ERROR_UNKNOWN_NAME with the valid names in the message). Non-finite inputs never reach the

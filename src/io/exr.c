@@ -1,9 +1,14 @@
 /* OpenEXR output through the OpenEXR core C API (OpenEXR 3.1, openexr.h).
  *
  * One scanline part, ZIP compression (lossless, 16 lines per chunk), channels
- *   R, G, B, A          FLOAT  scene-linear Rec.709 (the chromaticities attribute says which)
- *   variance.R, .G, .B  FLOAT  the estimated variance of each pixel's mean
- *   samples.Y           UINT   samples that went into each pixel
+ *   R, G, B, A                          FLOAT  scene-linear Rec.709 (the chromaticities attribute
+ *                                              says which)
+ *   variance_R, variance_G, variance_B  FLOAT  the estimated variance of each pixel's mean
+ *   samples                             UINT   samples that went into each pixel
+ * No channel name has a dot: OpenEXR reads "x.R" as channel R of layer "x", and Blender 3.4 takes
+ * a file with any layer (or with more than one part) as multilayer, whose pixels it loads only
+ * into render passes (bpy.data.images.load then has no pixels: size 0 x 0). With dotless names
+ * Blender loads the file as a plain RGBA image and ignores the extra channels.
  * and metadata (string unless said):
  *   dwivedi:version                  library version "major.minor.patch"
  *   dwivedi:technique                walk technique name ("none" for caller-made pixels)
@@ -180,10 +185,10 @@ dwv_result_t dwvio_write_exr(const dwvb_image *image, const char *path, char *me
         {"G", EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LOGARITHMIC, (const uint8_t *)(image->rgba + 1), 16},
         {"B", EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LOGARITHMIC, (const uint8_t *)(image->rgba + 2), 16},
         {"A", EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR, (const uint8_t *)(image->rgba + 3), 16},
-        {"variance.R", EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR, (const uint8_t *)(image->variance + 0), 12},
-        {"variance.G", EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR, (const uint8_t *)(image->variance + 1), 12},
-        {"variance.B", EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR, (const uint8_t *)(image->variance + 2), 12},
-        {"samples.Y", EXR_PIXEL_UINT, EXR_PERCEPTUALLY_LINEAR, (const uint8_t *)image->samples, 4},
+        {"variance_R", EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR, (const uint8_t *)(image->variance + 0), 12},
+        {"variance_G", EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR, (const uint8_t *)(image->variance + 1), 12},
+        {"variance_B", EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR, (const uint8_t *)(image->variance + 2), 12},
+        {"samples", EXR_PIXEL_UINT, EXR_PERCEPTUALLY_LINEAR, (const uint8_t *)image->samples, 4},
     };
     const size_t source_count = sizeof sources / sizeof *sources;
 

@@ -502,8 +502,9 @@ static dwv_result_t read_material(parser *ps, const cJSON *item, const char *pat
 {
     static const char *const keys[] = {"kind", "base_color", "subsurface_weight", "subsurface_color",
                                        "subsurface_radius", "subsurface_scale", "subsurface_anisotropy",
-                                       "subsurface_ior"};
+                                       "subsurface_ior", "subsurface_exit", "roughness"};
     static const char *const kinds[] = {"subsurface", "diffuse"};
+    static const char *const exits[] = {"lambert", "principled_v1"};
     DWV_TRY(check_keys(item, path, keys, sizeof keys / sizeof keys[0]));
     dwv_material_t m = DWV_MATERIAL_INIT;
     const cJSON *kind = member(item, "kind");
@@ -521,6 +522,15 @@ static dwv_result_t read_material(parser *ps, const cJSON *item, const char *pat
     DWV_TRY(opt_number(item, path, "subsurface_scale", &m.subsurface_scale));
     DWV_TRY(opt_number(item, path, "subsurface_anisotropy", &m.subsurface_anisotropy));
     DWV_TRY(opt_number(item, path, "subsurface_ior", &m.subsurface_ior));
+    const cJSON *exit = member(item, "subsurface_exit");
+    if (exit) {
+        char p[PATH_SIZE];
+        size_t k = 0;
+        path_key(p, path, "subsurface_exit");
+        DWV_TRY(read_choice(exit, p, exits, 2, &k));
+        m.subsurface_exit = k == 0 ? DWV_SUBSURFACE_EXIT_LAMBERT : DWV_SUBSURFACE_EXIT_PRINCIPLED_V1;
+    }
+    DWV_TRY(opt_number(item, path, "roughness", &m.roughness));
     uint32_t id;
     dwv_result_t r = dwv_scene_add_material(ps->scene, &m, &id);
     if (r != DWV_SUCCESS) return prefix_capi(r, path);

@@ -6,10 +6,11 @@
 
 #define INV_PI 0.31830988618379067154
 
-void dwvl_direct(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng, uint64_t key,
-                 uint32_t dimension, double out[3])
+void dwvl_direct_lobe(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng, uint64_t key,
+                      uint32_t dimension, dwvl_lobe_factor factor, const void *context, double lambert[3],
+                      double lobe[3])
 {
-    out[0] = out[1] = out[2] = 0.0;
+    double plain[3] = {0.0, 0.0, 0.0}, weighted[3] = {0.0, 0.0, 0.0};
     double eps = env->geometry ? env->geometry->epsilon : 0.0;
     dwvw_vec3 origin = dwvw_madd(x, ng, eps);
     for (uint32_t i = 0; i < env->light_count; ++i) {
@@ -22,14 +23,34 @@ void dwvl_direct(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec
         /* The segment stops short of the light by the offset, so that an area light lying on a
          * surface does not shadow itself. */
         if (env->geometry && dwvg_occluded(env->geometry, origin, s.direction, 0.0, s.distance - 2.0 * eps)) continue;
-        for (int c = 0; c < 3; ++c) out[c] += s.value[c] * cos_n * INV_PI;
+        double f = factor ? factor(context, s.direction) : 0.0;
+        for (int c = 0; c < 3; ++c) {
+            plain[c] += s.value[c] * cos_n * INV_PI;
+            weighted[c] += s.value[c] * cos_n * INV_PI * f;
+        }
     }
     if (env->world_lit) {
-        /* Cosine-weighted direction about n (pdf cos / pi): the estimate is L_world x visibility. */
+        /* Cosine-weighted direction about n (pdf cos / pi): the estimate is L_world x visibility
+         * (x the factor for the lobe). */
         uint32_t d = dimension + 2u * env->light_count;
         double u = dwvk_rng_uniform_d(key, d), mu = sqrt(u);
         dwvw_vec3 w = dwvw_direction_about(n, mu, 1.0 - mu, 1.0 + mu, dwvk_rng_uniform_d(key, d + 1u));
-        if (dwvw_dot(ng, w) > 0.0 && !(env->geometry && dwvg_occluded(env->geometry, origin, w, 0.0, INFINITY)))
-            for (int c = 0; c < 3; ++c) out[c] += env->world[c];
+        if (dwvw_dot(ng, w) > 0.0 && !(env->geometry && dwvg_occluded(env->geometry, origin, w, 0.0, INFINITY))) {
+            double f = factor ? factor(context, w) : 0.0;
+            for (int c = 0; c < 3; ++c) {
+                plain[c] += env->world[c];
+                weighted[c] += env->world[c] * f;
+            }
+        }
     }
+    for (int c = 0; c < 3; ++c) {
+        if (lambert) lambert[c] = plain[c];
+        if (lobe) lobe[c] = weighted[c];
+    }
+}
+
+void dwvl_direct(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng, uint64_t key,
+                 uint32_t dimension, double out[3])
+{
+    dwvl_direct_lobe(env, x, n, ng, key, dimension, NULL, NULL, out, NULL);
 }

@@ -28,4 +28,15 @@ static inline uint32_t dwvl_direct_dimensions(const dwvl_environment *env)
 void dwvl_direct(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng, uint64_t key,
                  uint32_t dimension, double out[3]);
 
+/* A BRDF's factor beside the Lambertian 1/pi for light arriving along unit `light` (toward the
+ * light): the BRDF is (1/pi) factor(context, light). */
+typedef double (*dwvl_lobe_factor)(const void *context, dwvw_vec3 light);
+
+/* dwvl_direct with the same light samples (the same numbers from `key`) also weighted by
+ * `factor`: lambert gets what dwvl_direct gives (NULL: not wanted), lobe the same integral with
+ * (1/pi) factor(light) cos as the BRDF term. */
+void dwvl_direct_lobe(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng, uint64_t key,
+                      uint32_t dimension, dwvl_lobe_factor factor, const void *context, double lambert[3],
+                      double lobe[3]);
+
 #endif

@@ -71,11 +71,8 @@ class AddonTest(harness.unittest.TestCase):
         self.assertGreater(mean_r, 0.0, "light comes through the slab")
         self.assertIn("spp", scene.dwivedi_bake.last_result)
 
-    # Blender 3.4 reads no pixels from an EXR whose unlayered R, G, B, A sit beside layered
-    # channels (variance.R, samples.Y: capi/dwivedi.h's layout): "does not have any image data".
-    # The add-on therefore makes its image from memory. Expected to fail until the library's EXR
-    # loads in Blender (e.g. extra channels without a dot, or a full layer.pass.channel naming).
-    @harness.unittest.expectedFailure
+    # Blender 3.4 takes an EXR with any layered channel name ("x.R") as multilayer and then gives
+    # bpy.data.images.load no pixels (size 0 x 0); the library's channel names have no dots.
     def test_exr_opens_in_blender(self):
         scene = small_slab()
         result, error = harness.call_operator()
@@ -84,6 +81,7 @@ class AddonTest(harness.unittest.TestCase):
         self.assertEqual((width, height), (16, 16))
         _, _, ours = harness.image_pixels("Dwivedi Camera")
         self.assertEqual(pixels, ours)
+        self.assertGreater(max(pixels[0::4]), 0.0, "the image is not empty")
 
     def test_render_percentage(self):
         scene = small_slab()
@@ -121,6 +119,25 @@ class AddonTest(harness.unittest.TestCase):
         self.assertGreater(subdivided.triangle_count, 3 * plain.triangle_count)
         plain.scene.close()
         subdivided.scene.close()
+
+    def test_principled_exit_by_version(self):
+        """Blender 3.x's Principled BSDF exports the Principled v1 exit (retro-reflection by its
+        Roughness, 1 - (1 - cos)^5 / 2 exit weight); the Subsurface Scattering node, like 4.x's
+        Principled, the Lambertian exit."""
+        module = sys.modules["dwivedi_bake"]
+        shim = module.shim()
+        material = scenes.principled_material("Exit", (0.9, 0.6, 0.4), (0.5, 0.25, 0.1))
+        material.node_tree.nodes["Principled BSDF"].inputs["Roughness"].default_value = 0.3
+        warnings = []
+        exported = module.export.material_from_blender(material, shim, warnings)
+        if bpy.app.version < (4, 0, 0):
+            self.assertEqual(exported.subsurface_exit, "principled_v1")
+            self.assertAlmostEqual(exported.roughness, 0.3, places=6)
+        else:
+            self.assertEqual(exported.subsurface_exit, "lambert")
+        node = module.export.material_from_blender(scenes.sss_node_material("Node", (0.9, 0.6, 0.4), (1, 1, 1)),
+                                                   shim, warnings)
+        self.assertEqual(node.subsurface_exit, "lambert")
 
     def assertFails(self, pattern, **settings):
         result, error = harness.call_operator(**settings)

@@ -120,10 +120,8 @@ class CyclesTest(harness.unittest.TestCase):
         self.check(compare("sphere_sss_node", lambda r, s: scenes.sphere_scene(r, s, shader='SSS')), (0, 1, 2))
 
     # Blender 3.x's Principled BSDF (v1) adds a retro-reflection lobe and weights the walk's exit
-    # by 1 - (1 - cos)^5 / 2; dwivedi bakes the Lambertian-exit walk (as Blender 4.x's Principled
-    # does), so on a front-lit object 3.x differs by about 3% (see docs/cycles-conventions.md).
-    # Expected to fail there until the library models the v1 exit; a pass then flags this line.
-    @(harness.unittest.expectedFailure if bpy.app.version < (4, 0, 0) else (lambda f: f))
+    # by 1 - (1 - cos)^5 / 2: the add-on exports it with DWV_SUBSURFACE_EXIT_PRINCIPLED_V1 (in 4.x
+    # the Principled walk has the plain Lambertian exit, which the add-on exports there).
     def test_front_lit_sphere_principled(self):
         self.check(compare("sphere_principled", scenes.sphere_scene), (0, 1, 2))
 
@@ -179,10 +177,8 @@ class CyclesTest(harness.unittest.TestCase):
         self.assertGreater(count, 50, "the comparison sees the object")
         self.assertLessEqual(worst, 1.0 / 255 + 1e-6)
 
-    # PNG colour is not premultiplied: Blender divides by alpha before the view transform. The
-    # library's PNG (src/io) transforms the premultiplied EXR values as they are, so pixels the
-    # object covers only partly come out darker. Expected to fail until it does; a pass flags it.
-    @harness.unittest.expectedFailure
+    # PNG colour is not premultiplied: Blender divides by alpha before the view transform, and so
+    # does the library (src/io/display.cpp, docs/output.md).
     def test_display_png_partly_covered_pixels(self):
         ours, theirs = self.display_pngs()
         worst, count = self.worst(ours, theirs, opaque=False)

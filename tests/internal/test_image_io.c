@@ -5,6 +5,7 @@
  *     --view` of the same pixels with the same config, within one 8-bit level (our rounding against
  *     OpenImageIO's), for the built-in config and an explicit path, Standard and Filmic views;
  *   - exposure, gamma and a look against closed forms (Raw view: identity; sRGB curve, IEC 61966-2-1);
+ *   - premultiplied colour becomes straight colour before the view (Blender's save_render);
  *   - atomic writes: a write that fails part way (a file-size limit, RLIMIT_FSIZE) leaves the good
  *     file byte-identical and no temporary file; a successful one replaces it and keeps its mode;
  *   - argument checks, unknown names, NaN and infinite pixels.
@@ -278,7 +279,10 @@ static void test_exr_round_trip(void)
     CHECK(read_exr(path, &ch, &c) == 0, "OpenEXR's core API reads the file back");
     CHECK(ch.width == W && ch.height == H, "size %d x %d", ch.width, ch.height);
     CHECK(ch.count == 8, "8 channels, got %d", ch.count);
-    const char *floats[] = {"R", "G", "B", "A", "variance.R", "variance.G", "variance.B"};
+    /* A dot makes a layer ("x.R" is R of layer x), and Blender 3.4 loads a file with layers only
+     * as render passes, with no pixels for bpy.data.images.load: see src/io/exr.c. */
+    for (int k = 0; k < ch.count; ++k) CHECK(strchr(ch.names[k], '.') == NULL, "channel '%s' has no dot", ch.names[k]);
+    const char *floats[] = {"R", "G", "B", "A", "variance_R", "variance_G", "variance_B"};
     for (int k = 0; k < 7; ++k) {
         int type = -1;
         const float *data = channel(&ch, floats[k], &type);
@@ -292,9 +296,9 @@ static void test_exr_round_trip(void)
         CHECK(mismatches == 0, "channel %s: %zu pixels differ in their bits", floats[k], mismatches);
     }
     int type = -1;
-    const uint32_t *samples = channel(&ch, "samples.Y", &type);
-    CHECK(samples && type == EXR_PIXEL_UINT, "samples.Y is UINT");
-    if (samples) CHECK(memcmp(samples, img->samples, (size_t)W * H * 4) == 0, "samples.Y equals the counts");
+    const uint32_t *samples = channel(&ch, "samples", &type);
+    CHECK(samples && type == EXR_PIXEL_UINT, "samples is UINT");
+    if (samples) CHECK(memcmp(samples, img->samples, (size_t)W * H * 4) == 0, "samples equals the counts");
 
     if (c) {
         exr_attr_chromaticities_t chroma;
@@ -337,8 +341,8 @@ static void test_exr_round_trip(void)
     CHECK(header != NULL, "exrheader runs");
     if (header) {
         const char *expected[] = {"chromaticities", "red   (0.64 0.33)", "white (0.3127 0.329)", "    R, 32-bit floating-point",
-                                  "    A, 32-bit floating-point", "    variance.G, 32-bit floating-point",
-                                  "    samples.Y, 32-bit unsigned integer", "zip", "dwivedi:technique (type string): \"incident\"",
+                                  "    A, 32-bit floating-point", "    variance_G, 32-bit floating-point",
+                                  "    samples, 32-bit unsigned integer", "zip", "dwivedi:technique (type string): \"incident\"",
                                   "dwivedi:samples (type int): 64", "dwivedi:seconds (type double): 1.25",
                                   "dwivedi:estimated_relative_error (type double)", "dwivedi:version (type string)",
                                   "dwivedi:features (type string): \"embree,subsurface,guided\"", "dwivedi:error_vs_time"};
@@ -353,6 +357,15 @@ static float srgb_encode(float v) /* IEC 61966-2-1 */
 {
     if (v <= 0.0031308f) return 12.92f * v;
     return 1.055f * powf(v, 1.0f / 2.4f) - 0.055f;
+}
+
+/* Value i of premultiplied RGBA pixels as straight colour: colour / alpha where alpha is neither 0
+ * nor 1 (Blender's rule, docs/output.md), alpha itself unchanged. */
+static float straight_value(const float *rgba, size_t i)
+{
+    float alpha = rgba[i - i % 4 + 3];
+    if (i % 4 == 3 || alpha == 0.0f || alpha == 1.0f) return rgba[i];
+    return rgba[i] / alpha;
 }
 
 static int quantise(float v)
@@ -372,7 +385,12 @@ static void test_display_against_ocioconvert(const char *view, int explicit_conf
     path_in(exr, sizeof exr, "linear.exr");
     snprintf(out, sizeof out, "%s/ocio_%s.exr", work, view);
     path_in(png, sizeof png, "display.png");
-    CHECK(write_plain_exr(exr, img->rgba, W, H) == 0, "the test's own EXR writer");
+    /* The display transform sees straight colour (rgb / alpha, as Blender's save_render), while
+     * ocioconvert transforms the values as they are: give it the un-premultiplied pixels. */
+    float *straight = malloc((size_t)W * H * 4 * sizeof *straight);
+    for (size_t i = 0; i < (size_t)W * H * 4; ++i) straight[i] = straight_value(img->rgba, i);
+    CHECK(write_plain_exr(exr, straight, W, H) == 0, "the test's own EXR writer");
+    free(straight);
     snprintf(command, sizeof command, "OCIO='%s' ocioconvert --view '%s' 'Linear Rec.709' '%s' sRGB '%s' 2>&1",
              config_path, exr, out, view);
     char *log = run(command);
@@ -454,7 +472,7 @@ static void test_exposure_gamma_look(void)
     CHECK(dwv_image_to_display(image, &o, bytes, (uint64_t)W * H * 4) == DWV_SUCCESS, "%s", dwv_last_error_message());
     int worst = 0;
     for (size_t i = 0; i < (size_t)W * H * 4; ++i) {
-        float v = img->rgba[i];
+        float v = straight_value(img->rgba, i);
         float want = (i % 4 == 3) ? v : powf(fmaxf(v * exp2f(-1.5f), 0.0f), 1.0f / 2.2f);
         int d = abs(quantise(want) - bytes[i]);
         if (d > worst) worst = d;
@@ -470,7 +488,7 @@ static void test_exposure_gamma_look(void)
     int changed = 0;
     for (size_t i = 0; i < (size_t)W * H * 4; ++i) {
         if (i % 4 == 3) continue;
-        float v = fmaxf(img->rgba[i], 0.0f);
+        float v = fmaxf(straight_value(img->rgba, i), 0.0f);
         float want = srgb_encode(0.18f * powf(v / 0.18f, 1.25f));
         int d = abs(quantise(want) - bytes[i]);
         if (d > worst) worst = d;
@@ -555,6 +573,39 @@ static void test_views_and_threads(void)
               views[v]);
         free(alone[v]);
         free(together[v]);
+    }
+    dwv_image_release(image);
+}
+
+/* Premultiplied in, straight out: a pixel covered by a quarter with a quarter of an opaque pixel's
+ * colour shows that opaque colour with alpha 64; alpha 0 keeps its colour as it is (a tiny alpha
+ * must not overflow into NaN either). */
+static void test_partly_covered_pixels(void)
+{
+    const float c[3] = {0.6f, 0.25f, 0.05f};
+    const float pixels[20] = {c[0], c[1], c[2], 1.0f,
+                              0.25f * c[0], 0.25f * c[1], 0.25f * c[2], 0.25f,
+                              0.0f, 0.0f, 0.0f, 0.0f,
+                              0.0f, 0.0f, 0.0f, 1.0f,
+                              1.0f, 1.0f, 1.0f, 1e-40f};
+    dwv_image_t *image = NULL;
+    CHECK(dwv_image_create(5, 1, pixels, &image) == DWV_SUCCESS, "%s", dwv_last_error_message());
+    const char *views[] = {"Standard", "Filmic"};
+    for (int v = 0; v < 2 && image; ++v) {
+        dwv_display_options_t o = DWV_DISPLAY_OPTIONS_INIT;
+        o.view = views[v];
+        o.exposure = 0.5;
+        o.gamma = 1.2;
+        uint8_t bytes[20];
+        CHECK(dwv_image_to_display(image, &o, bytes, sizeof bytes) == DWV_SUCCESS, "%s", dwv_last_error_message());
+        CHECK(abs(bytes[4] - bytes[0]) <= 1 && abs(bytes[5] - bytes[1]) <= 1 && abs(bytes[6] - bytes[2]) <= 1,
+              "%s: quarter-covered %u %u %u shows the opaque colour %u %u %u", views[v], bytes[4], bytes[5],
+              bytes[6], bytes[0], bytes[1], bytes[2]);
+        CHECK(bytes[7] == 64 && bytes[3] == 255, "%s: alpha bytes %u, %u", views[v], bytes[7], bytes[3]);
+        CHECK(bytes[8] == bytes[12] && bytes[9] == bytes[13] && bytes[10] == bytes[14] && bytes[11] == 0,
+              "%s: alpha 0 keeps its (black) colour", views[v]);
+        CHECK(bytes[16] > 200 && bytes[19] == 0, "%s: alpha 1e-40 divides to the brightest colour (%u)", views[v],
+              bytes[16]);
     }
     dwv_image_release(image);
 }
@@ -770,6 +821,7 @@ int main(void)
     test_display_against_ocioconvert("Filmic", 1);
     test_exposure_gamma_look();
     test_views_and_threads();
+    test_partly_covered_pixels();
     test_non_finite_pixels();
     test_atomic_writes();
     test_arguments();

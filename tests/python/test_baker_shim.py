@@ -80,7 +80,7 @@ class StructLayoutTest(unittest.TestCase):
     def test_sizes_on_lp64(self):
         if ctypes.sizeof(ctypes.c_void_p) != 8:
             self.skipTest("the sizes below are those of an LP64 ABI")
-        sizes = {"dwv_material_t": 112, "dwv_mesh_t": 144, "dwv_light_desc_t": 216, "dwv_camera_t": 128,
+        sizes = {"dwv_material_t": 128, "dwv_mesh_t": 144, "dwv_light_desc_t": 216, "dwv_camera_t": 128,
                  "dwv_bake_progress_t": 48, "dwv_bake_options_t": 96, "dwv_image_info_t": 40,
                  "dwv_bake_stats_t": 128, "dwv_error_point_t": 24, "dwv_display_options_t": 56}
         for name, size in sizes.items():
@@ -122,6 +122,7 @@ class StructLayoutTest(unittest.TestCase):
         material = dwivedi.Material()._to_c()
         self.assertEqual(tuple(material.subsurface_radius), (1.0, 0.2, 0.1))
         self.assertEqual((material.subsurface_scale, material.subsurface_ior), (0.05, 1.4))
+        self.assertEqual((material.struct_size, material.subsurface_exit, material.roughness), (128, 0, 0.5))
         self.assertEqual(_library.DisplayOptions().gamma, 1.0)
 
 
@@ -232,6 +233,17 @@ class SceneTest(unittest.TestCase):
         self.assertEqual(m.subsurface_scale, 0.25)
         self.assertEqual(m.subsurface_color, (0.75, 0.25, 0.0))
         self.assertEqual(dwivedi.Material.from_blender_3x((1, 1, 1), 0.0, (0, 0, 0), (1, 1, 1)).subsurface_weight, 0.0)
+        # Blender 3.x's Principled exit (retro-reflection by Roughness, weighted exit).
+        self.assertEqual((m.subsurface_exit, m.roughness), ("principled_v1", 0.5))
+        c = dwivedi.Material.from_blender_3x((1, 1, 1), 0.5, (1, 1, 1), (1, 1, 1), roughness=0.2)._to_c()
+        self.assertEqual((c.subsurface_exit, c.roughness), (1, 0.2))
+        with dwivedi.Scene() as scene:
+            with self.assertRaises(dwivedi.Error) as caught:
+                scene.add_material(dwivedi.Material(subsurface_exit="fresnel"))
+            self.assertEqual(caught.exception.code, _library.DWV_ERROR_UNKNOWN_NAME)
+            with self.assertRaises(dwivedi.Error) as caught:
+                scene.add_material(dwivedi.Material(subsurface_exit="principled_v1", roughness=1.5))
+            self.assertEqual(caught.exception.code, _library.DWV_ERROR_OUT_OF_RANGE)
 
 
 class ImageTest(unittest.TestCase):

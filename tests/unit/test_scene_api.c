@@ -1,6 +1,7 @@
 /* The scene-building calls: every refused input gets its own code and a message, arrays are
  * copied (the caller may free them), and a committed scene refuses changes. */
 #include <math.h>
+#include <stddef.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -101,6 +102,25 @@ static void test_materials(dwv_scene_t *scene)
     m = (dwv_material_t)DWV_MATERIAL_INIT;
     m.subsurface_scale = -0.1;
     EXPECT(dwv_scene_add_material(scene, &m, &id), DWV_ERROR_OUT_OF_RANGE, "subsurface_scale");
+    m = (dwv_material_t)DWV_MATERIAL_INIT;
+    m.subsurface_exit = 2;
+    EXPECT(dwv_scene_add_material(scene, &m, &id), DWV_ERROR_INVALID_ARGUMENT, "subsurface_exit");
+    m = (dwv_material_t)DWV_MATERIAL_INIT;
+    m.roughness = NAN;
+    EXPECT(dwv_scene_add_material(scene, &m, &id), DWV_ERROR_INVALID_ARGUMENT, "roughness");
+    m.roughness = 1.5;
+    EXPECT(dwv_scene_add_material(scene, &m, &id), DWV_ERROR_OUT_OF_RANGE, "roughness");
+    /* A 0.1.0 caller's struct ends at subsurface_ior: accepted, and what lies beyond its
+     * struct_size (here garbage) is never read. */
+    m = (dwv_material_t)DWV_MATERIAL_INIT;
+    m.struct_size = (uint32_t)offsetof(dwv_material_t, subsurface_exit);
+    m.subsurface_exit = 99;
+    m.roughness = NAN;
+    uint32_t old_id = 12345u;
+    CHECK(dwv_scene_add_material(scene, &m, &old_id) == DWV_SUCCESS && old_id != 12345u, "a 0.1.0-sized material: %s",
+          dwv_last_error_message());
+    m.struct_size = (uint32_t)offsetof(dwv_material_t, subsurface_exit) - 8u;
+    EXPECT(dwv_scene_add_material(scene, &m, &id), DWV_ERROR_STRUCT_SIZE, "material");
 }
 
 static void test_meshes(dwv_scene_t *scene)

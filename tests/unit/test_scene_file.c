@@ -308,6 +308,16 @@ static void test_schema(void)
     expect_failure("ior out of range",
                    "{\"version\": 1, \"materials\": {\"m\": {\"subsurface_ior\": 9}}, \"meshes\": []}",
                    DWV_ERROR_OUT_OF_RANGE, "materials.m: dwv_scene_add_material", "subsurface_ior");
+    expect_failure("subsurface exit",
+                   "{\"version\": 1, \"materials\": {\"m\": {\"subsurface_exit\": \"fresnel\"}}, \"meshes\": []}",
+                   DWV_ERROR_UNKNOWN_NAME, "materials.m.subsurface_exit", "'fresnel'");
+    expect_failure("roughness out of range",
+                   "{\"version\": 1, \"materials\": {\"m\": {\"roughness\": 2}}, \"meshes\": []}",
+                   DWV_ERROR_OUT_OF_RANGE, "materials.m: dwv_scene_add_material", "roughness");
+    CHECK(load_text("{\"version\": 1, \"materials\": {\"m\": {\"subsurface_exit\": \"principled_v1\", "
+                    "\"roughness\": 0.25}}, \"meshes\": []}",
+                    NULL) == DWV_SUCCESS,
+          "a Blender 3.x Principled material: %s", dwv_last_error_message());
     expect_failure("unknown material",
                    "{\"version\": 1, " MATERIAL ", \"meshes\": [{\"material\": \"m\", " TETRA "}, "
                    "{\"material\": \"m\", " TETRA "}, {\"material\": \"wax\", " TETRA "}]}",
