@@ -177,6 +177,35 @@ static void test_case(const fast_case *c)
           (unsigned long long)r.differing_ends);
     CHECK(r.worst_weight_gap <= WEIGHT_TOLERANCE, "%s: weights differ by %.3g relative", c->label, r.worst_weight_gap);
 
+    /* Lock-step lanes (guided walker, axis along x, y or z: every guided case here) against the
+     * same walks one at a time: the same ends and weights to the last bit. */
+    if (walker == DWVW_WALKER_GUIDED) {
+        static dwvw_walk_end lanes[WALKS];
+        CHECK(dwvw_estimate_walks_lanes(&setup, 0, setup.walks, lanes) == 1, "%s: no lanes", c->label);
+        uint64_t differing = 0;
+        for (uint64_t i = 0; i < setup.walks; ++i) {
+            dwvw_walk_end one;
+            dwvw_estimate_walk(&setup, walker, i, &one);
+            const dwvw_walk_end *l = &lanes[i];
+            int same = one.status == l->status && one.events == l->events &&
+                       memcmp(&one.weight[0], &l->weight[0], sizeof(double)) == 0 &&
+                       (one.status != DWVW_EXITED ||
+                        (one.exit_normal.x == l->exit_normal.x && one.exit_normal.y == l->exit_normal.y &&
+                         one.exit_normal.z == l->exit_normal.z));
+            differing += !same;
+        }
+        printf("  %-34s lanes of %d: %llu of %llu walks differ from one at a time\n", c->label, DWVW_LANES,
+               (unsigned long long)differing, (unsigned long long)setup.walks);
+        CHECK(differing == 0, "%s: %llu walks differ in lanes", c->label, (unsigned long long)differing);
+        dwvw_estimate_setup single = setup;
+        single.single_lane = 1;
+        CHECK(dwvw_estimate_walks_lanes(&single, 0, setup.walks, lanes) == 0, "%s: single_lane still takes lanes",
+              c->label);
+    } else {
+        dwvw_walk_end unused[1];
+        CHECK(dwvw_estimate_walks_lanes(&setup, 0, 1, unused) == 0, "%s: lanes for walker %d", c->label, (int)walker);
+    }
+
     /* Whole runs: fast (1, 2, 3 threads) against general. */
     dwvw_estimate_totals general, fast[3];
     CHECK(dwvw_estimate_run(&forced, &general) == 0, "%s: general run failed", c->label);
@@ -189,6 +218,18 @@ static void test_case(const fast_case *c)
               fast[0].truncated_walks == general.truncated_walks,
           "%s: run sums %.17g vs %.17g, events %llu vs %llu", c->label, fast[0].sum[0], general.sum[0],
           (unsigned long long)fast[0].events, (unsigned long long)general.events);
+    /* Lanes or not, a run's totals are the same to the last bit (ends added in walk order). */
+    dwvw_estimate_setup single = setup;
+    single.single_lane = 1;
+    single.threads = 2;
+    dwvw_estimate_totals one_at_a_time;
+    CHECK(dwvw_estimate_run(&single, &one_at_a_time) == 0, "%s: single-lane run failed", c->label);
+    CHECK(memcmp(one_at_a_time.sum, fast[0].sum, sizeof fast[0].sum) == 0 &&
+              memcmp(one_at_a_time.sum_squares, fast[0].sum_squares, sizeof fast[0].sum_squares) == 0 &&
+              memcmp(one_at_a_time.m2, fast[0].m2, sizeof fast[0].m2) == 0 &&
+              memcmp(one_at_a_time.truncated_weight, fast[0].truncated_weight, sizeof fast[0].truncated_weight) == 0 &&
+              one_at_a_time.events == fast[0].events && one_at_a_time.truncated_walks == fast[0].truncated_walks,
+          "%s: one walk at a time sums %.17g, the default run %.17g", c->label, one_at_a_time.sum[0], fast[0].sum[0]);
     for (int t = 1; t < 3; ++t)
         CHECK(memcmp(&fast[t].sum[0], &fast[0].sum[0], sizeof(double)) == 0 &&
                   memcmp(&fast[t].sum_squares[0], &fast[0].sum_squares[0], sizeof(double)) == 0 &&
