@@ -485,7 +485,10 @@ static void make_plan(const dwvw_estimate_setup *setup, dwvw_walker walker, fast
      * lanes_step_in writes out: t = (1, 0, 0), s = (0, +-1, 0), n = (0, 0, +-1). */
     int z_frame = plan->aligned && plan->axis_index == 2 && plan->index[0][0] == 0 && plan->index[0][1] == 1 &&
                   plan->index[0][2] == 2 && plan->sign[0][0] == 1.0;
-    plan->lanes = walker == DWVW_WALKER_GUIDED && z_frame && !setup->single_lane;
+    /* The mixture in lanes for an isotropic medium (mixture_lanes_step_in); anisotropic media
+     * take it one walk at a time. */
+    int lane_walker = walker == DWVW_WALKER_GUIDED || (walker == DWVW_WALKER_MIXTURE && m->g == 0.0);
+    plan->lanes = lane_walker && z_frame && !setup->single_lane;
 }
 
 static void walk_with_plan(const dwvw_estimate_setup *setup, const fast_plan *plan, uint64_t index,
@@ -562,6 +565,7 @@ typedef struct guided_lanes {
     uint64_t key[DWVW_LANES], counter[DWVW_LANES];
     uint32_t events[DWVW_LANES];
     int exited[DWVW_LANES], flagged[DWVW_LANES];
+    double weight[DWVW_LANES];         /* the mixture's throughput (mixture_lanes_step_in) */
 } guided_lanes;
 
 /* Puts walk `index` into lane l at its entry, as guided_walk_in starts it. */
@@ -571,7 +575,9 @@ static void lane_begin(guided_lanes *L, int l, const dwvw_estimate_setup *setup,
     uint64_t key = dwvk_rng_key(setup->seed, index, 0);
     dwvw_vec3 direction = entry_direction(setup, key);
     L->key[l] = key;
-    L->counter[l] = dwvk_rng_counter(key, dwvw_event_dim(0) + DWVW_DIM_DIRECTION);
+    /* The guided walk steps the counter of an event's direction dimension, the mixture that of its
+     * first (channel) dimension. */
+    L->counter[l] = dwvk_rng_counter(key, dwvw_event_dim(0) + (plan->walker == DWVW_WALKER_MIXTURE ? 0u : DWVW_DIM_DIRECTION));
     L->px[l] = ENTRY_POINT.x;
     L->py[l] = ENTRY_POINT.y;
     L->pz[l] = ENTRY_POINT.z;
@@ -580,6 +586,7 @@ static void lane_begin(guided_lanes *L, int l, const dwvw_estimate_setup *setup,
     L->dz[l] = L->entry_z[l] = direction.z;
     L->events[l] = 0;
     L->log_constants[l] = L->exponent[l] = L->log_weight[l] = 0.0;
+    L->weight[l] = 1.0;
     if (plan->first_known) {
         L->first_constant[l] = plan->log_first;
     } else {
@@ -714,17 +721,6 @@ static int lanes_step_sphere(guided_lanes *L, const dwvw_estimate_setup *setup, 
     return lanes_step_in(L, setup, plan, DWVW_SPHERE);
 }
 
-static inline int lanes_step(guided_lanes *L, const dwvw_estimate_setup *setup, const fast_plan *plan,
-                             dwvw_shape_kind kind)
-{
-    switch (kind) {
-    case DWVW_HALFSPACE: return lanes_step_halfspace(L, setup, plan);
-    case DWVW_SLAB: return lanes_step_slab(L, setup, plan);
-    case DWVW_SPHERE: return lanes_step_sphere(L, setup, plan);
-    }
-    return 0;
-}
-
 /* The branches of guided_walk_in after a flagged step of lane l: 1 and *end filled if its walk
  * ended, else 0 (the walk goes on, its weight perhaps raised by the roulette). */
 static int lane_end(guided_lanes *L, int l, const dwvw_estimate_setup *setup, const fast_plan *plan,
@@ -837,6 +833,175 @@ static void feed_done(lane_feed *feed, const dwvw_estimate_setup *setup, uint64_
 }
 
 /* Runs every walk of the feed in lanes. */
+/* One event of every lane of mixture_walk_in (isotropic medium: phase 1/(4 pi) for both
+ * components), in the same arithmetic. The guided direction is formed in every lane; the lanes
+ * that picked the classical component (a share q0 of 0.01 or less for auto) have theirs replaced
+ * one by one. The weight is a product of ratios, as there: the mixture's denominator does not
+ * cancel, so each event keeps its exponential. */
+static DWVW_ALWAYS_INLINE int mixture_lanes_step_in(guided_lanes *L, const dwvw_estimate_setup *setup,
+                                                    const fast_plan *plan, dwvw_shape_kind kind)
+{
+    const dwvw_medium *m = &setup->medium;
+    const dwvk_dwivedi_event_f *d = &m->dwivedi_event;
+    const double sigma = m->sigma_t[0], albedo = m->albedo[0], thickness = setup->shape.thickness;
+    const double q0 = setup->guide.q_classical, q1 = plan->q_guided, total = q0 + q1;
+    const double phase = DWVK_INV_FOUR_PI, pdf_scale = m->guided_pdf_scale;
+    const uint32_t max_events = setup->max_events;
+    const uint64_t gamma = DWVK_GOLDEN_GAMMA, event_step = (uint64_t)DWVW_DIMS_PER_EVENT * DWVK_GOLDEN_GAMMA;
+    const double sy = plan->sign[0][1], sz = plan->sign[0][2], axis_sign = plan->axis_sign;
+    const double kappa = m->dwivedi.kappa, one_minus_kappa = m->dwivedi.one_minus_kappa;
+    float ua[DWVW_LANES], ub[DWVW_LANES], udist[DWVW_LANES];
+    int guided[DWVW_LANES];
+    /* The counter is that of the event's channel dimension (+0); component +1, direction +2,
+     * distance +4. */
+    for (int l = 0; l < DWVW_LANES; ++l) {
+        uint64_t c = L->counter[l];
+        double u_component = (double)(dwvk_mix64(c + gamma * DWVW_DIM_COMPONENT) >> 11) * 0x1.0p-53;
+        guided[l] = !(u_component * total < q0);
+        uint64_t bits = dwvk_mix64(c + gamma * DWVW_DIM_DIRECTION);
+        ua[l] = dwvk_uniform_f_from_bits(bits);
+        ub[l] = (float)(int32_t)((bits >> 16) & 0xffffffu) * 0x1.0p-24f;
+        udist[l] = dwvk_uniform_f_from_bits(dwvk_mix64(c + gamma * DWVW_DIM_DISTANCE));
+        L->counter[l] = c + event_step;
+    }
+    double wx[DWVW_LANES], wy[DWVW_LANES], wz[DWVW_LANES];
+    for (int l = 0; l < DWVW_LANES; ++l) {
+        dwvk_dwivedi_event_cosine_f s = dwvk_dwivedi_event_sample_select_f(d, ua[l]);
+        dwvk_unit2_f azimuth = dwvk_azimuth_f(ub[l]);
+        double x = (double)azimuth.c * (double)s.sin_theta, y = sy * ((double)azimuth.s * (double)s.sin_theta);
+        double z = sz * (double)s.cos_theta;
+        double scale = 1.5 - 0.5 * (x * x + y * y + z * z);
+        wx[l] = x * scale;
+        wy[l] = y * scale;
+        wz[l] = z * scale;
+    }
+    for (int l = 0; l < DWVW_LANES; ++l) {
+        if (L->events[l] == 0) { /* the first step keeps the entry direction */
+            wx[l] = L->dx[l];
+            wy[l] = L->dy[l];
+            wz[l] = L->dz[l];
+        } else if (!guided[l]) {
+            dwvk_uniform_pair_f u = {ua[l], ub[l]};
+            dwvw_vec3 w = dwvw_classical_direction(dwvw_v(L->dx[l], L->dy[l], L->dz[l]), 0.0f, u);
+            wx[l] = w.x;
+            wy[l] = w.y;
+            wz[l] = w.z;
+        }
+    }
+    int any = 0;
+    for (int l = 0; l < DWVW_LANES; ++l) {
+        double px = L->px[l], py = L->py[l], pz = L->pz[l], x = wx[l], y = wy[l], z = wz[l];
+        int first = L->events[l] == 0;
+        double mu = axis_sign * z;
+        mu = mu < -1.0 ? -1.0 : mu > 1.0 ? 1.0 : mu;
+        double stretch_above = one_minus_kappa + kappa * (1.0 - mu), stretch_below = 1.0 - kappa * mu;
+        double stretch = mu >= 0.0 ? stretch_above : stretch_below;
+        double step_phase = first ? 1.0 : phase, pdf_guided = first ? 1.0 : pdf_scale / stretch;
+        double t = dwvw_flight(sigma * (guided[l] ? stretch : 1.0), udist[l]);
+        double hit;
+        if (kind == DWVW_HALFSPACE) hit = lane_halfspace_exit(pz, z);
+        else if (kind == DWVW_SLAB) hit = lane_slab_exit(thickness, pz, z);
+        else {
+            dwvw_vec3 normal;
+            hit = dwvw_shape_exit_inline(&setup->shape, kind, dwvw_v(px, py, pz), dwvw_v(x, y, z), &normal);
+        }
+        int exited = hit <= t;
+        t = exited ? hit : t;
+        /* mixture_walk_in's denominator, term by term. */
+        double qp0 = q0 * step_phase, qp1 = q1 * pdf_guided, denominator = 0.0;
+        if (qp0 > 0.0) denominator += qp0 * 1.0 * 1.0;
+        if (qp1 > 0.0) {
+            double decay = stretch == 1.0 ? 1.0 : dwvk_exp_fast(sigma * (1.0 - stretch) * t);
+            denominator += qp1 * (exited ? 1.0 : stretch) * decay;
+        }
+        double ratio = step_phase * (exited ? 1.0 : albedo) / denominator;
+        double weight = L->weight[l] * (isfinite(ratio) ? ratio : 0.0);
+        uint32_t events = L->events[l] + (uint32_t)!exited;
+        double flight = exited ? 0.0 : t; /* an exited lane keeps its position (lane_end) */
+        L->px[l] = px + x * flight;
+        L->py[l] = py + y * flight;
+        L->pz[l] = pz + z * flight;
+        L->dx[l] = x;
+        L->dy[l] = y;
+        L->dz[l] = z;
+        L->weight[l] = weight;
+        L->events[l] = events;
+        L->exited[l] = exited;
+        int flagged = exited | !(weight >= DWVW_ROULETTE_THRESHOLD) | (events >= max_events);
+        L->flagged[l] = flagged;
+        any |= flagged;
+    }
+    return any;
+}
+
+static int mixture_lanes_step_halfspace(guided_lanes *L, const dwvw_estimate_setup *setup, const fast_plan *plan)
+{
+    return mixture_lanes_step_in(L, setup, plan, DWVW_HALFSPACE);
+}
+
+static int mixture_lanes_step_slab(guided_lanes *L, const dwvw_estimate_setup *setup, const fast_plan *plan)
+{
+    return mixture_lanes_step_in(L, setup, plan, DWVW_SLAB);
+}
+
+static int mixture_lanes_step_sphere(guided_lanes *L, const dwvw_estimate_setup *setup, const fast_plan *plan)
+{
+    return mixture_lanes_step_in(L, setup, plan, DWVW_SPHERE);
+}
+
+/* The branches of mixture_walk_in after a flagged step of lane l, as lane_end for the guided walk. */
+static int mixture_lane_end(guided_lanes *L, int l, const dwvw_estimate_setup *setup, dwvw_shape_kind kind,
+                            dwvw_walk_end *end)
+{
+    uint32_t events = L->events[l];
+    double weight = L->weight[l];
+    end->exit_normal = dwvw_v(0.0, 0.0, 0.0);
+    if (L->exited[l]) {
+        dwvw_vec3 normal;
+        (void)dwvw_shape_exit_inline(&setup->shape, kind, dwvw_v(L->px[l], L->py[l], L->pz[l]),
+                                     dwvw_v(L->dx[l], L->dy[l], L->dz[l]), &normal);
+        end->status = DWVW_EXITED;
+        end->exit_normal = normal;
+    } else if (!(weight > 0.0)) {
+        end->status = DWVW_ABSORBED;
+    } else {
+        if (weight < DWVW_ROULETTE_THRESHOLD) {
+            double survive = weight / DWVW_ROULETTE_THRESHOLD;
+            if (dwvk_rng_uniform_d(L->key[l], dwvw_event_dim(events - 1u) + DWVW_DIM_ROULETTE) >= survive) {
+                end->status = DWVW_ABSORBED;
+                goto done;
+            }
+            L->weight[l] = weight /= survive;
+        }
+        if (events < setup->max_events) return 0;
+        end->status = DWVW_TRUNCATED;
+    }
+done:
+    end->events = events;
+    end->weight[0] = end->status == DWVW_ABSORBED ? 0.0 : weight;
+    end->weight[1] = end->weight[2] = 0.0;
+    return 1;
+}
+
+static inline int lanes_step(guided_lanes *L, const dwvw_estimate_setup *setup, const fast_plan *plan,
+                             dwvw_shape_kind kind)
+{
+    if (plan->walker == DWVW_WALKER_MIXTURE) {
+        switch (kind) {
+        case DWVW_HALFSPACE: return mixture_lanes_step_halfspace(L, setup, plan);
+        case DWVW_SLAB: return mixture_lanes_step_slab(L, setup, plan);
+        case DWVW_SPHERE: return mixture_lanes_step_sphere(L, setup, plan);
+        }
+        return 0;
+    }
+    switch (kind) {
+    case DWVW_HALFSPACE: return lanes_step_halfspace(L, setup, plan);
+    case DWVW_SLAB: return lanes_step_slab(L, setup, plan);
+    case DWVW_SPHERE: return lanes_step_sphere(L, setup, plan);
+    }
+    return 0;
+}
+
 static inline void lanes_run_in(const dwvw_estimate_setup *setup, const fast_plan *plan, dwvw_shape_kind kind,
                                 lane_feed *feed)
 {
@@ -856,7 +1021,9 @@ static inline void lanes_run_in(const dwvw_estimate_setup *setup, const fast_pla
         for (int l = 0; l < DWVW_LANES; ++l) {
             if (!L.flagged[l] || !live[l]) continue;
             dwvw_walk_end end;
-            if (!lane_end(&L, l, setup, plan, kind, &end)) continue;
+            int ended = plan->walker == DWVW_WALKER_MIXTURE ? mixture_lane_end(&L, l, setup, kind, &end)
+                                                            : lane_end(&L, l, setup, plan, kind, &end);
+            if (!ended) continue;
             feed_done(feed, setup, sequence[l], &end);
             live[l] = 0;
             --live_count;

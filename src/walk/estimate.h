@@ -59,11 +59,12 @@ dwvw_walker dwvw_estimate_walker(const dwvw_estimate_setup *setup);
  * the general one). */
 void dwvw_estimate_walk(const dwvw_estimate_setup *setup, dwvw_walker walker, uint64_t index, dwvw_walk_end *end);
 
-/* How many guided walks the estimator advances in lock-step (estimate.c, "lock-step"). */
+/* How many walks the guided and mixture walkers advance in lock-step (estimate.c, "lock-step"). */
 #define DWVW_LANES 8
 /* Walks first .. first + count - 1 of a setup in lock-step lanes, their ends into ends[0 ..
  * count - 1], as dwvw_estimate_run takes them; returns 1, or 0 (nothing written) where the run
- * takes no lanes (any walker but GUIDED, an axis not along z, or setup->single_lane). */
+ * takes no lanes (the general and classical walkers, the mixture in an anisotropic medium, an axis
+ * not along z, or setup->single_lane). */
 int dwvw_estimate_walks_lanes(const dwvw_estimate_setup *setup, uint64_t first, uint64_t count, dwvw_walk_end *ends);
 
 /* Runs setup->walks walks; 0 on success, -1 if threads could not be started. */

@@ -75,6 +75,8 @@ static const fast_case CASES[] = {
     {"halfspace auto 0.1 (classical)", DWVW_HALFSPACE, 0.0, DWVW_AUTO, 0.1, 0.0, DWVW_LIGHT_FRONT, 0,
      DWVW_WALKER_CLASSICAL, 0},
     {"halfspace cycles 0.9", DWVW_HALFSPACE, 0.0, DWVW_CYCLES, 0.9, 0.0, DWVW_LIGHT_FRONT, 0, DWVW_WALKER_MIXTURE, 0},
+    {"halfspace cycles 1, cap 100", DWVW_HALFSPACE, 0.0, DWVW_CYCLES, 1.0, 0.0, DWVW_LIGHT_FRONT, 0, DWVW_WALKER_MIXTURE,
+     100},
     {"slab 16 auto 0.99 back-lit", DWVW_SLAB, 16.0, DWVW_AUTO, 0.99, 0.0, DWVW_LIGHT_BACK, 0, DWVW_WALKER_MIXTURE, 0},
     {"slab 1 auto 0.9 g 0.5 back-lit", DWVW_SLAB, 1.0, DWVW_AUTO, 0.9, 0.5, DWVW_LIGHT_BACK, 1, DWVW_WALKER_MIXTURE,
      0},
@@ -177,9 +179,9 @@ static void test_case(const fast_case *c)
           (unsigned long long)r.differing_ends);
     CHECK(r.worst_weight_gap <= WEIGHT_TOLERANCE, "%s: weights differ by %.3g relative", c->label, r.worst_weight_gap);
 
-    /* Lock-step lanes (guided walker, axis along x, y or z: every guided case here) against the
-     * same walks one at a time: the same ends and weights to the last bit. */
-    if (walker == DWVW_WALKER_GUIDED) {
+    /* Lock-step lanes (the guided walker, and the mixture in an isotropic medium; every axis here is
+     * along z) against the same walks one at a time: the same ends and weights to the last bit. */
+    if (walker == DWVW_WALKER_GUIDED || (walker == DWVW_WALKER_MIXTURE && c->g == 0.0)) {
         static dwvw_walk_end lanes[WALKS];
         CHECK(dwvw_estimate_walks_lanes(&setup, 0, setup.walks, lanes) == 1, "%s: no lanes", c->label);
         uint64_t differing = 0;
