@@ -888,32 +888,42 @@ static DWVW_ALWAYS_INLINE int mixture_lanes_step_in(guided_lanes *L, const dwvw_
             wz[l] = w.z;
         }
     }
-    int any = 0;
+    /* Three loops, not one: each lane's chain from the flight's log through the exponential to
+     * the weight is long, and short loops let the core run the lanes' chains side by side. */
+    double stretch_of[DWVW_LANES], t_of[DWVW_LANES], decay_of[DWVW_LANES];
+    int exited_of[DWVW_LANES];
     for (int l = 0; l < DWVW_LANES; ++l) {
-        double px = L->px[l], py = L->py[l], pz = L->pz[l], x = wx[l], y = wy[l], z = wz[l];
-        int first = L->events[l] == 0;
+        double pz = L->pz[l], z = wz[l];
         double mu = axis_sign * z;
         mu = mu < -1.0 ? -1.0 : mu > 1.0 ? 1.0 : mu;
         double stretch_above = one_minus_kappa + kappa * (1.0 - mu), stretch_below = 1.0 - kappa * mu;
         double stretch = mu >= 0.0 ? stretch_above : stretch_below;
-        double step_phase = first ? 1.0 : phase, pdf_guided = first ? 1.0 : pdf_scale / stretch;
         double t = dwvw_flight(sigma * (guided[l] ? stretch : 1.0), udist[l]);
         double hit;
         if (kind == DWVW_HALFSPACE) hit = lane_halfspace_exit(pz, z);
         else if (kind == DWVW_SLAB) hit = lane_slab_exit(thickness, pz, z);
         else {
             dwvw_vec3 normal;
-            hit = dwvw_shape_exit_inline(&setup->shape, kind, dwvw_v(px, py, pz), dwvw_v(x, y, z), &normal);
+            hit = dwvw_shape_exit_inline(&setup->shape, kind, dwvw_v(L->px[l], L->py[l], pz), dwvw_v(wx[l], wy[l], z),
+                                         &normal);
         }
         int exited = hit <= t;
-        t = exited ? hit : t;
+        stretch_of[l] = stretch;
+        t_of[l] = exited ? hit : t;
+        exited_of[l] = exited;
+    }
+    for (int l = 0; l < DWVW_LANES; ++l)
+        decay_of[l] = stretch_of[l] == 1.0 ? 1.0 : dwvk_exp_fast(sigma * (1.0 - stretch_of[l]) * t_of[l]);
+    int any = 0;
+    for (int l = 0; l < DWVW_LANES; ++l) {
+        double px = L->px[l], py = L->py[l], pz = L->pz[l], x = wx[l], y = wy[l], z = wz[l];
+        int first = L->events[l] == 0, exited = exited_of[l];
+        double stretch = stretch_of[l], t = t_of[l];
+        double step_phase = first ? 1.0 : phase, pdf_guided = first ? 1.0 : pdf_scale / stretch;
         /* mixture_walk_in's denominator, term by term. */
         double qp0 = q0 * step_phase, qp1 = q1 * pdf_guided, denominator = 0.0;
         if (qp0 > 0.0) denominator += qp0 * 1.0 * 1.0;
-        if (qp1 > 0.0) {
-            double decay = stretch == 1.0 ? 1.0 : dwvk_exp_fast(sigma * (1.0 - stretch) * t);
-            denominator += qp1 * (exited ? 1.0 : stretch) * decay;
-        }
+        if (qp1 > 0.0) denominator += qp1 * (exited ? 1.0 : stretch) * decay_of[l];
         double ratio = step_phase * (exited ? 1.0 : albedo) / denominator;
         double weight = L->weight[l] * (isfinite(ratio) ? ratio : 0.0);
         uint32_t events = L->events[l] + (uint32_t)!exited;
