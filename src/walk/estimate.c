@@ -541,21 +541,23 @@ typedef struct run_state {
     block_totals *blocks;
 } run_state;
 
-/* ---- lock-step: several guided walks advanced together ------------------------------------
+/* ---- lock-step: several walks advanced together ---------------------------------------------
  * One event of guided_walk_in is a long chain of dependent operations (hash, expm1, square root,
  * direction, stretch, log, two divisions): a core that runs one walk waits on it. DWVW_LANES walks
  * in lanes (structure of arrays) take their events together, one loop over the lanes per stage,
  * so that the lanes' chains interleave (and a compiler may vectorise a stage). Each lane does
- * exactly what guided_walk_in does for its walk, with the same random numbers (the walk's key and
- * dimensions), the same kernels and the same double arithmetic in the same order, so each walk
- * ends as it does there, weight for weight to the last bit (tests/internal/test_walk_fast_path.c
- * compares them walk by walk). What changes is only which walks run at the same time: the branches
- * that end a walk (exit, Russian roulette, event cap) are taken for a lane after the step, and a
- * lane whose walk ended takes the next walk of its thread's blocks. Results are added to their
- * block in walk order (see lane_worker), so the totals equal the one-walk-at-a-time path's. */
+ * exactly what guided_walk_in (or mixture_walk_in, for the mixture walker in an isotropic medium)
+ * does for its walk, with the same random numbers (the walk's key and dimensions), the same
+ * kernels and the same double arithmetic in the same order, so each walk ends as it does there,
+ * weight for weight to the last bit (tests/internal/test_walk_fast_path.c compares them walk by
+ * walk). What changes is only which walks run at the same time: the branches that end a walk
+ * (exit, Russian roulette, event cap) are taken for a lane after the step, and a lane whose walk
+ * ended takes the next walk of its thread's blocks. Results are added to their block in walk
+ * order (lane_feed), so the totals equal the one-walk-at-a-time path's. */
 
 /* The lanes' state. p: position; d: the direction of the step being taken (for a lane at
- * events = 0, its entry direction). log_constants and exponent as in guided_walk_in. */
+ * events = 0, its entry direction). log_constants and exponent as in guided_walk_in, weight as in
+ * mixture_walk_in. */
 typedef struct guided_lanes {
     double px[DWVW_LANES], py[DWVW_LANES], pz[DWVW_LANES];
     double dx[DWVW_LANES], dy[DWVW_LANES], dz[DWVW_LANES];
@@ -577,7 +579,8 @@ static void lane_begin(guided_lanes *L, int l, const dwvw_estimate_setup *setup,
     L->key[l] = key;
     /* The guided walk steps the counter of an event's direction dimension, the mixture that of its
      * first (channel) dimension. */
-    L->counter[l] = dwvk_rng_counter(key, dwvw_event_dim(0) + (plan->walker == DWVW_WALKER_MIXTURE ? 0u : DWVW_DIM_DIRECTION));
+    uint32_t dimension = plan->walker == DWVW_WALKER_MIXTURE ? DWVW_DIM_CHANNEL : DWVW_DIM_DIRECTION;
+    L->counter[l] = dwvk_rng_counter(key, dwvw_event_dim(0) + dimension);
     L->px[l] = ENTRY_POINT.x;
     L->py[l] = ENTRY_POINT.y;
     L->pz[l] = ENTRY_POINT.z;
@@ -653,7 +656,8 @@ static DWVW_ALWAYS_INLINE int lanes_step_in(guided_lanes *L, const dwvw_estimate
         azimuth_s[l] = azimuth.s;
     }
     for (int l = 0; l < DWVW_LANES; ++l) {
-        double wx = (double)azimuth_c[l] * (double)sin_theta[l], wy = sy * ((double)azimuth_s[l] * (double)sin_theta[l]);
+        double wx = (double)azimuth_c[l] * (double)sin_theta[l];
+        double wy = sy * ((double)azimuth_s[l] * (double)sin_theta[l]);
         double wz = sz * (double)cos_theta[l];
         double scale = 1.5 - 0.5 * (wx * wx + wy * wy + wz * wz);
         int fresh = L->events[l] == 0; /* the first step keeps the entry direction */

@@ -13,6 +13,9 @@
  *     step's factor is off by far more than this;
  *   - dwvw_estimate_run gives the same mean (to WEIGHT_TOLERANCE) and the same event and truncation
  *     counts either way, and the fast path is bit-identical for 1, 2 and 3 threads;
+ *   - the lock-step lanes (dwvw_estimate_walks_lanes: the guided walker, and the mixture in an
+ *     isotropic medium) end every walk exactly as the same walker one walk at a time, weight
+ *     bit for bit, and a run's totals are bit-identical with and without lanes;
  *   - planted: a fast-path weight without the first step's 1/s0 (a plausible slip when cancelling
  *     terms) is caught by the walk-by-walk comparison.
  * The estimates themselves are judged against references by tests/unit/test_walk_*.c, which now
@@ -250,5 +253,20 @@ int main(void)
     comparison planted = compare_walks(&setup, DWVW_WALKER_GUIDED, 1);
     printf("  planted (first step's 1/s0 dropped): worst weight gap %.2e, rejected\n", planted.worst_weight_gap);
     CHECK(planted.worst_weight_gap > WEIGHT_TOLERANCE, "the planted weight passes: %.3g", planted.worst_weight_gap);
+    /* Planted: lanes' ends compared with the walks one further on (a lane that took the wrong walk,
+     * or ends filed under the wrong index) must differ almost everywhere. */
+    static dwvw_walk_end lanes[WALKS];
+    CHECK(dwvw_estimate_walks_lanes(&setup, 0, setup.walks, lanes) == 1, "planted: no lanes");
+    uint64_t shifted_differ = 0;
+    for (uint64_t i = 0; i + 1 < setup.walks; ++i) {
+        dwvw_walk_end next;
+        dwvw_estimate_walk(&setup, DWVW_WALKER_GUIDED, i + 1, &next);
+        shifted_differ +=
+            memcmp(&next.weight[0], &lanes[i].weight[0], sizeof(double)) != 0 || next.events != lanes[i].events;
+    }
+    printf("  planted (lanes against the next walk): %llu of %llu differ, rejected\n",
+           (unsigned long long)shifted_differ, (unsigned long long)setup.walks - 1);
+    CHECK(shifted_differ > setup.walks / 2, "the shifted lanes pass: only %llu differ",
+          (unsigned long long)shifted_differ);
     return check_report("test_walk_fast_path");
 }
