@@ -131,4 +131,26 @@ static inline dwvk_dwivedi_event_cosine_f dwvk_dwivedi_event_sample_f(const dwvk
     return s;
 }
 
+/* dwvk_dwivedi_event_sample_f with the branch's constants picked by selects instead of an index:
+ * the same arithmetic and the same values, bit for bit, in a form a compiler can vectorise over a
+ * loop of independent samples (the estimator's lock-step lanes, src/walk/estimate.c). */
+static inline dwvk_dwivedi_event_cosine_f dwvk_dwivedi_event_sample_select_f(const dwvk_dwivedi_event_f *d, float u)
+{
+    /* Both branches' constants loaded unconditionally, then selected (a conditional load would
+     * keep the loop from being vectorised). */
+    const float offset0 = d->offset[0], offset1 = d->offset[1], v_pm_one0 = d->v_pm_one[0], v_pm_one1 = d->v_pm_one[1];
+    const float kappa0 = d->one_mp_kappa[0], kappa1 = d->one_mp_kappa[1], sign0 = d->sign[0], sign1 = d->sign[1];
+    int low = u <= d->u_split;
+    float offset = low ? offset1 : offset0, v_pm_one = low ? v_pm_one1 : v_pm_one0;
+    float one_mp_kappa = low ? kappa1 : kappa0, sign = low ? sign1 : sign0;
+    float e = dwvk_expm1_fast_f((offset - u) * d->log_ratio);
+    float small = v_pm_one * fabsf(e);
+    dwvk_dwivedi_event_cosine_f s;
+    s.cos_theta = sign * (small - 1.0f);
+    s.sin_theta = sqrtf(small * (2.0f - small));
+    s.nearer = small;
+    s.stretch = one_mp_kappa * (1.0f + e);
+    return s;
+}
+
 #endif

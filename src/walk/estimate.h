@@ -19,6 +19,7 @@ typedef struct dwvw_estimate_setup {
     uint64_t walks, seed;
     uint32_t threads, max_events;
     int general_path;        /* 1: every walk through dwvw_walk_*, never the fast path (for tests) */
+    int single_lane;         /* 1: the fast paths one walk at a time, never in lanes (for tests) */
 } dwvw_estimate_setup;
 
 typedef struct dwvw_estimate_totals {
@@ -57,6 +58,14 @@ dwvw_walker dwvw_estimate_walker(const dwvw_estimate_setup *setup);
 /* Walk number `index` of a setup, by the given walker (one that dwvw_estimate_walker allows, or
  * the general one). */
 void dwvw_estimate_walk(const dwvw_estimate_setup *setup, dwvw_walker walker, uint64_t index, dwvw_walk_end *end);
+
+/* How many walks the guided and mixture walkers advance in lock-step (estimate.c, "lock-step"). */
+#define DWVW_LANES 8
+/* Walks first .. first + count - 1 of a setup in lock-step lanes, their ends into ends[0 ..
+ * count - 1], as dwvw_estimate_run takes them; returns 1, or 0 (nothing written) where the run
+ * takes no lanes (the general and classical walkers, the mixture in an anisotropic medium, an axis
+ * not along z, or setup->single_lane). */
+int dwvw_estimate_walks_lanes(const dwvw_estimate_setup *setup, uint64_t first, uint64_t count, dwvw_walk_end *ends);
 
 /* Runs setup->walks walks; 0 on success, -1 if threads could not be started. */
 int dwvw_estimate_run(const dwvw_estimate_setup *setup, dwvw_estimate_totals *totals);

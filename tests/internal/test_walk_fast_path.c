@@ -13,6 +13,9 @@
  *     step's factor is off by far more than this;
  *   - dwvw_estimate_run gives the same mean (to WEIGHT_TOLERANCE) and the same event and truncation
  *     counts either way, and the fast path is bit-identical for 1, 2 and 3 threads;
+ *   - the lock-step lanes (dwvw_estimate_walks_lanes: the guided walker, and the mixture in an
+ *     isotropic medium) end every walk exactly as the same walker one walk at a time, weight
+ *     bit for bit, and a run's totals are bit-identical with and without lanes;
  *   - planted: a fast-path weight without the first step's 1/s0 (a plausible slip when cancelling
  *     terms) is caught by the walk-by-walk comparison.
  * The estimates themselves are judged against references by tests/unit/test_walk_*.c, which now
@@ -75,6 +78,8 @@ static const fast_case CASES[] = {
     {"halfspace auto 0.1 (classical)", DWVW_HALFSPACE, 0.0, DWVW_AUTO, 0.1, 0.0, DWVW_LIGHT_FRONT, 0,
      DWVW_WALKER_CLASSICAL, 0},
     {"halfspace cycles 0.9", DWVW_HALFSPACE, 0.0, DWVW_CYCLES, 0.9, 0.0, DWVW_LIGHT_FRONT, 0, DWVW_WALKER_MIXTURE, 0},
+    {"halfspace cycles 1, cap 100", DWVW_HALFSPACE, 0.0, DWVW_CYCLES, 1.0, 0.0, DWVW_LIGHT_FRONT, 0, DWVW_WALKER_MIXTURE,
+     100},
     {"slab 16 auto 0.99 back-lit", DWVW_SLAB, 16.0, DWVW_AUTO, 0.99, 0.0, DWVW_LIGHT_BACK, 0, DWVW_WALKER_MIXTURE, 0},
     {"slab 1 auto 0.9 g 0.5 back-lit", DWVW_SLAB, 1.0, DWVW_AUTO, 0.9, 0.5, DWVW_LIGHT_BACK, 1, DWVW_WALKER_MIXTURE,
      0},
@@ -177,6 +182,35 @@ static void test_case(const fast_case *c)
           (unsigned long long)r.differing_ends);
     CHECK(r.worst_weight_gap <= WEIGHT_TOLERANCE, "%s: weights differ by %.3g relative", c->label, r.worst_weight_gap);
 
+    /* Lock-step lanes (the guided walker, and the mixture in an isotropic medium; every axis here is
+     * along z) against the same walks one at a time: the same ends and weights to the last bit. */
+    if (walker == DWVW_WALKER_GUIDED || (walker == DWVW_WALKER_MIXTURE && c->g == 0.0)) {
+        static dwvw_walk_end lanes[WALKS];
+        CHECK(dwvw_estimate_walks_lanes(&setup, 0, setup.walks, lanes) == 1, "%s: no lanes", c->label);
+        uint64_t differing = 0;
+        for (uint64_t i = 0; i < setup.walks; ++i) {
+            dwvw_walk_end one;
+            dwvw_estimate_walk(&setup, walker, i, &one);
+            const dwvw_walk_end *l = &lanes[i];
+            int same = one.status == l->status && one.events == l->events &&
+                       memcmp(&one.weight[0], &l->weight[0], sizeof(double)) == 0 &&
+                       (one.status != DWVW_EXITED ||
+                        (one.exit_normal.x == l->exit_normal.x && one.exit_normal.y == l->exit_normal.y &&
+                         one.exit_normal.z == l->exit_normal.z));
+            differing += !same;
+        }
+        printf("  %-34s lanes of %d: %llu of %llu walks differ from one at a time\n", c->label, DWVW_LANES,
+               (unsigned long long)differing, (unsigned long long)setup.walks);
+        CHECK(differing == 0, "%s: %llu walks differ in lanes", c->label, (unsigned long long)differing);
+        dwvw_estimate_setup single = setup;
+        single.single_lane = 1;
+        CHECK(dwvw_estimate_walks_lanes(&single, 0, setup.walks, lanes) == 0, "%s: single_lane still takes lanes",
+              c->label);
+    } else {
+        dwvw_walk_end unused[1];
+        CHECK(dwvw_estimate_walks_lanes(&setup, 0, 1, unused) == 0, "%s: lanes for walker %d", c->label, (int)walker);
+    }
+
     /* Whole runs: fast (1, 2, 3 threads) against general. */
     dwvw_estimate_totals general, fast[3];
     CHECK(dwvw_estimate_run(&forced, &general) == 0, "%s: general run failed", c->label);
@@ -189,6 +223,18 @@ static void test_case(const fast_case *c)
               fast[0].truncated_walks == general.truncated_walks,
           "%s: run sums %.17g vs %.17g, events %llu vs %llu", c->label, fast[0].sum[0], general.sum[0],
           (unsigned long long)fast[0].events, (unsigned long long)general.events);
+    /* Lanes or not, a run's totals are the same to the last bit (ends added in walk order). */
+    dwvw_estimate_setup single = setup;
+    single.single_lane = 1;
+    single.threads = 2;
+    dwvw_estimate_totals one_at_a_time;
+    CHECK(dwvw_estimate_run(&single, &one_at_a_time) == 0, "%s: single-lane run failed", c->label);
+    CHECK(memcmp(one_at_a_time.sum, fast[0].sum, sizeof fast[0].sum) == 0 &&
+              memcmp(one_at_a_time.sum_squares, fast[0].sum_squares, sizeof fast[0].sum_squares) == 0 &&
+              memcmp(one_at_a_time.m2, fast[0].m2, sizeof fast[0].m2) == 0 &&
+              memcmp(one_at_a_time.truncated_weight, fast[0].truncated_weight, sizeof fast[0].truncated_weight) == 0 &&
+              one_at_a_time.events == fast[0].events && one_at_a_time.truncated_walks == fast[0].truncated_walks,
+          "%s: one walk at a time sums %.17g, the default run %.17g", c->label, one_at_a_time.sum[0], fast[0].sum[0]);
     for (int t = 1; t < 3; ++t)
         CHECK(memcmp(&fast[t].sum[0], &fast[0].sum[0], sizeof(double)) == 0 &&
                   memcmp(&fast[t].sum_squares[0], &fast[0].sum_squares[0], sizeof(double)) == 0 &&
@@ -207,5 +253,20 @@ int main(void)
     comparison planted = compare_walks(&setup, DWVW_WALKER_GUIDED, 1);
     printf("  planted (first step's 1/s0 dropped): worst weight gap %.2e, rejected\n", planted.worst_weight_gap);
     CHECK(planted.worst_weight_gap > WEIGHT_TOLERANCE, "the planted weight passes: %.3g", planted.worst_weight_gap);
+    /* Planted: lanes' ends compared with the walks one further on (a lane that took the wrong walk,
+     * or ends filed under the wrong index) must differ almost everywhere. */
+    static dwvw_walk_end lanes[WALKS];
+    CHECK(dwvw_estimate_walks_lanes(&setup, 0, setup.walks, lanes) == 1, "planted: no lanes");
+    uint64_t shifted_differ = 0;
+    for (uint64_t i = 0; i + 1 < setup.walks; ++i) {
+        dwvw_walk_end next;
+        dwvw_estimate_walk(&setup, DWVW_WALKER_GUIDED, i + 1, &next);
+        shifted_differ +=
+            memcmp(&next.weight[0], &lanes[i].weight[0], sizeof(double)) != 0 || next.events != lanes[i].events;
+    }
+    printf("  planted (lanes against the next walk): %llu of %llu differ, rejected\n",
+           (unsigned long long)shifted_differ, (unsigned long long)setup.walks - 1);
+    CHECK(shifted_differ > setup.walks / 2, "the shifted lanes pass: only %llu differ",
+          (unsigned long long)shifted_differ);
     return check_report("test_walk_fast_path");
 }
