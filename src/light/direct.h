@@ -6,6 +6,7 @@
 #include <stdint.h>
 
 #include "geom/embree.h"
+#include "kernel/sampler.h"
 #include "light.h"
 
 typedef struct dwvl_environment {
@@ -16,16 +17,16 @@ typedef struct dwvl_environment {
     const dwvg_world *geometry;
 } dwvl_environment;
 
-/* Random dimensions one call uses: 2 per light and 2 for the world. */
-static inline uint32_t dwvl_direct_dimensions(const dwvl_environment *env)
+/* Pairs of random dimensions one call uses: one per light and one for the world. */
+static inline uint32_t dwvl_direct_pairs(const dwvl_environment *env)
 {
-    return 2u * env->light_count + 2u;
+    return env->light_count + 1u;
 }
 
 /* (1/pi) integral of L_in cos over the hemisphere of the shading normal `n` at x, estimated with
- * uniform numbers from `key` starting at `dimension`; `ng` is the unit geometric normal on the
- * same side (shadow rays leave from x + epsilon ng and never below the geometric surface). */
-void dwvl_direct(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng, uint64_t key,
-                 uint32_t dimension, double out[3]);
+ * the uniform pairs of `sampler` starting at pair `pair`; `ng` is the unit geometric normal on
+ * the same side (shadow rays leave from x + epsilon ng and never below the geometric surface). */
+void dwvl_direct(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng, const dwvk_sampler *sampler,
+                 uint32_t pair, double out[3]);
 
 #endif
