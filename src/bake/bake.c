@@ -509,9 +509,11 @@ static void setup_guides(dwvb_bake *bake)
 /* ---- auto: the technique that pays, per mesh --------------------------------------------------
  * Guiding lowers a walk's variance but costs work per event (a mixture of components, each with
  * a pdf and an exponential per channel pair); where the image's variance hardly moves (front-lit
- * thick objects) that work is wasted. Before the first pass, a pilot shades the same pixel
- * samples with classical sampling and with auto's mixture and keeps, per mesh, the one with the
- * larger efficiency 1 / (variance x cost) (Veach 1997, Sec. 2.4: the efficiency of an estimator;
+ * thick objects) that work is wasted, and auto's small defensive classical share doubles the
+ * mixture's terms where guiding alone would do (thin back-lit sheets). Before the first pass, a
+ * pilot shades the same pixel samples with each candidate (classical sampling, auto's mixture,
+ * and the mixture's guided part alone) and keeps, per mesh, the one with the largest efficiency
+ * 1 / (variance x cost) (Veach 1997, Sec. 2.4: the efficiency of an estimator;
  * Hammersley and Handscomb 1964). Both are unbiased, so the choice moves noise, never the mean.
  * The cost is counted, not timed, so that the choice (and the image) depends on the seed only:
  * nanoseconds per sample (camera ray, shading, exit lighting), per walk event (an Embree ray and
@@ -527,6 +529,22 @@ static void setup_guides(dwvb_bake *bake)
 #define PILOT_MAX 4096u
 #define PILOT_MIN 256u
 #define PILOT_MESH_MIN 64.0
+
+/* The candidates, in the order of the pilot (a tie keeps the earlier, cheaper one). */
+#define PILOT_CANDIDATES 3
+enum { PILOT_CLASSICAL = 0, PILOT_GUIDED = 1, PILOT_MIXTURE = 2 };
+
+/* Candidate `candidate` for mesh m, whose guide auto made (bake->guides[m]). */
+static void pilot_guide(const dwvb_bake *bake, uint32_t m, int candidate, dwvw_guide *guide)
+{
+    const dwvb_scene *scene = bake->scene;
+    const dwvw_medium *medium = &scene->shading[scene->meshes[m].material_id].medium;
+    *guide = bake->guides[m];
+    if (candidate == PILOT_CLASSICAL) dwvw_guide_init(guide, DWVW_CLASSICAL, medium, NULL, 0);
+    else if (candidate == PILOT_GUIDED && guide->q_incident > 0.0)
+        dwvw_guide_init(guide, DWVW_INCIDENT, medium, scene->patches[m], scene->patch_count[m]);
+    else if (candidate == PILOT_GUIDED) dwvw_guide_init(guide, DWVW_CLOSEST, medium, NULL, 0);
+}
 
 typedef struct pilot_sums {
     double count, sum, sum_squares, cost;
@@ -552,7 +570,7 @@ static int choose_auto(dwvb_bake *bake)
     uint32_t n = budget < PILOT_MAX ? (uint32_t)budget : PILOT_MAX;
     dwvw_guide *trial = malloc(meshes * sizeof *trial);
     int *trial_closest = malloc(meshes * sizeof *trial_closest);
-    pilot_sums *sums = calloc(2u * (size_t)meshes, sizeof *sums); /* [candidate][mesh] */
+    pilot_sums *sums = calloc(PILOT_CANDIDATES * (size_t)meshes, sizeof *sums); /* [candidate][mesh] */
     if (!trial || !trial_closest || !sums) {
         free(trial);
         free(trial_closest);
@@ -561,14 +579,11 @@ static int choose_auto(dwvb_bake *bake)
     }
     uint64_t pixels = (uint64_t)bake->width * bake->height;
     int stopped = 0;
-    /* Candidate 0: classical sampling; 1: auto's mixture. The same pixel samples for both. */
-    for (int candidate = 0; candidate < 2 && !stopped; ++candidate) {
+    /* The same pixel samples for every candidate. */
+    for (int candidate = 0; candidate < PILOT_CANDIDATES && !stopped; ++candidate) {
         for (uint32_t m = 0; m < meshes; ++m) {
-            trial[m] = bake->guides[m];
-            if (candidate == 0 && bake->auto_choice[m]) {
-                const dwvb_material *material = &scene->shading[scene->meshes[m].material_id];
-                dwvw_guide_init(&trial[m], DWVW_CLASSICAL, &material->medium, NULL, 0);
-            }
+            if (bake->auto_choice[m]) pilot_guide(bake, m, candidate, &trial[m]);
+            else trial[m] = bake->guides[m];
             trial_closest[m] = dwvw_guide_needs_closest(&trial[m]);
         }
         dwvb_shader shader = bake->shader;
@@ -593,21 +608,26 @@ static int choose_auto(dwvb_bake *bake)
     }
     if (!stopped) {
         for (uint32_t m = 0; m < meshes; ++m) {
-            const pilot_sums *classical = &sums[m], *mixture = &sums[(size_t)meshes + m];
-            if (!bake->auto_choice[m] || classical->count < PILOT_MESH_MIN || mixture->count < PILOT_MESH_MIN) continue;
-            /* variance x cost per sample, both per sample that saw the mesh */
-            double work[2];
-            for (int c = 0; c < 2; ++c) {
-                const pilot_sums *p = c ? mixture : classical;
+            /* Every candidate traced the same camera rays, so each saw the mesh equally often. */
+            if (!bake->auto_choice[m] || sums[m].count < PILOT_MESH_MIN) continue;
+            /* variance x cost, per sample that saw the mesh */
+            int best = PILOT_MIXTURE;
+            double best_work = INFINITY;
+            for (int c = 0; c < PILOT_CANDIDATES; ++c) {
+                const pilot_sums *p = &sums[(size_t)c * meshes + m];
                 double mean = p->sum / p->count;
                 double variance = fmax(p->sum_squares / p->count - mean * mean, 0.0) * p->count / (p->count - 1.0);
-                work[c] = variance * (p->cost / p->count);
+                double work = variance * (p->cost / p->count);
+                if (work < best_work) {
+                    best_work = work;
+                    best = c;
+                }
             }
-            if (work[0] < work[1]) {
-                const dwvb_material *material = &scene->shading[scene->meshes[m].material_id];
-                dwvw_guide_init(&bake->guides[m], DWVW_CLASSICAL, &material->medium, NULL, 0);
-                bake->needs_closest[m] = 0;
-            }
+            if (best == PILOT_MIXTURE) continue; /* bake->guides[m] is the mixture already */
+            dwvw_guide chosen;
+            pilot_guide(bake, m, best, &chosen);
+            bake->guides[m] = chosen;
+            bake->needs_closest[m] = dwvw_guide_needs_closest(&chosen);
         }
         update_features(bake);
     }
