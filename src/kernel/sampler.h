@@ -12,11 +12,10 @@
  * for a fixed x, seed -> s(x) is itself a bijection of 32-bit values (hash below), so with a
  * uniformly random seed every sample's coordinate is uniform on the 2^-32 grid, and coordinates
  * with independent seeds are independent: each sample has the distribution of an independent
- * one, only the samples of a pixel are negatively correlated (Owen 1997, "Scrambled net
- * variance for integrals of smooth functions"). Pairs share the sequence but not the scramble,
- * so across pairs the points form a scrambled Latin hypercube (variance at most N/(N-1) times
- * independent sampling, Owen 1997, "Monte Carlo variance of scrambled net quadrature"), as in
- * the "padding" of Kollig and Keller 2002.
+ * one, only the samples of a pixel are correlated (negatively, for smooth integrands: Owen 1997,
+ * "Scrambled net variance for integrals of smooth functions"). Pairs share the sequence; each
+ * pair shuffles the sample index with a seed of its own (Burley 2020), as in the "padding" of
+ * Kollig and Keller 2002, so that pairs do not reuse the same points in the same order.
  *
  * Prefixes: the sample indices of a pixel are 0, 1, 2, ... in order, so each power-of-two
  * prefix is a (0,m,2)-net in every pair; a bake cut by its time budget keeps an unbiased prefix.
@@ -73,8 +72,11 @@ static inline uint32_t dwvk_owen_scramble(uint32_t x, uint32_t seed)
 static inline void dwvk_sampler_pair(const dwvk_sampler *sampler, uint32_t pair, double u[2])
 {
     if (sampler->stratified && sampler->index < 0x100000000ull) {
-        uint32_t i = (uint32_t)sampler->index;
         uint64_t seeds = dwvk_rng_u64(sampler->key, pair); /* two 32-bit scramble seeds */
+        /* The index itself is shuffled per pair by the same nested scramble (Burley 2020, Sec. 4):
+         * the first 2^m indices go to one aligned block of 2^m points of the sequence, still a
+         * net, but to a different block and order for each pair. */
+        uint32_t i = dwvk_owen_scramble((uint32_t)sampler->index, (uint32_t)dwvk_mix64(seeds));
         uint32_t first = dwvk_owen_scramble(dwvk_reverse_bits32(i), (uint32_t)seeds);
         uint32_t second = dwvk_owen_scramble(dwvk_sobol_second(i), (uint32_t)(seeds >> 32));
         u[0] = (double)first * 0x1.0p-32;
