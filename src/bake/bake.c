@@ -13,8 +13,12 @@
 #include "bake/uv_raster.h"
 #include "kernel/rng.h"
 
-/* The walk's random numbers come from a stream of their own: bit 63 of the stream marks it. */
+/* The walk's random numbers come from a stream of their own: bit 63 of the stream marks it. The
+ * per-pixel scrambles of the stratified pairs (kernel/sampler.h) come from bit 62's stream. */
 #define WALK_STREAM 0x8000000000000000ull
+#define PIXEL_STREAM 0x4000000000000000ull
+/* The pilot that chooses auto's technique per mesh draws from bit 61's streams. */
+#define PILOT_STREAM 0x2000000000000000ull
 #define PROGRESS_PERIOD 0.1 /* seconds between progress callbacks */
 
 typedef struct pixel_sums {
@@ -29,6 +33,7 @@ struct dwvb_bake {
     dwvb_shader shader;
     dwvw_guide *guides;
     int *needs_closest;
+    int *auto_choice; /* per mesh: auto's technique is chosen by the pilot (choose_auto) */
     uint32_t features;
     /* camera */
     dwvw_vec3 eye, right, up, forward; /* right/up scaled to the image's half extents */
@@ -79,13 +84,18 @@ static double luminance(const double rgb[3])
     return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
 }
 
+/* The uniform pair of a sample that places it in its pixel (camera bakes); shading takes the next. */
+#define PIXEL_PAIR 0u
+
 /* One camera sample through pixel (x, row). Blender's camera: local -z forward, +y up, the
  * sensor (or ortho_scale) across the larger image side; a box filter over the pixel. */
-static void camera_sample(const dwvb_bake *bake, uint32_t x, uint32_t row, uint64_t key, dwvw_vec3 *origin,
-                          dwvw_vec3 *direction)
+static void camera_sample(const dwvb_bake *bake, uint32_t x, uint32_t row, const dwvk_sampler *sampler,
+                          dwvw_vec3 *origin, dwvw_vec3 *direction)
 {
-    double sx = 2.0 * ((double)x + dwvk_rng_uniform_d(key, 0)) / bake->width - 1.0;
-    double sy = 1.0 - 2.0 * ((double)row + dwvk_rng_uniform_d(key, 1)) / bake->height;
+    double u[2];
+    dwvk_sampler_pair(sampler, PIXEL_PAIR, u);
+    double sx = 2.0 * ((double)x + u[0]) / bake->width - 1.0;
+    double sy = 1.0 - 2.0 * ((double)row + u[1]) / bake->height;
     dwvw_vec3 offset = dwvw_add(dwvw_scale(bake->right, sx), dwvw_scale(bake->up, sy));
     if (bake->scene->camera.kind == DWV_CAMERA_PERSPECTIVE) {
         *origin = bake->eye;
@@ -96,19 +106,24 @@ static void camera_sample(const dwvb_bake *bake, uint32_t x, uint32_t row, uint6
     }
 }
 
-/* The dimensions of the shading key used before shading: camera jitter. */
-#define PIXEL_DIMS 2u
 
-static void sample_pixel(dwvb_bake *bake, uint32_t index, uint64_t s, double rgb[3], double *alpha, dwvb_tally *tally)
+/* Sample s of pixel `index` shaded by `shader`, with the random streams `stream` (pixel
+ * position, entry and lights) and `stream | WALK_STREAM` (the walk); the mesh it saw (or
+ * UINT32_MAX) in *mesh_seen. */
+static void sample_with(const dwvb_bake *bake, const dwvb_shader *shader, uint64_t stream, uint32_t index, uint64_t s,
+                        double rgb[3], double *alpha, uint32_t *mesh_seen, dwvb_tally *tally)
 {
-    uint64_t key = dwvk_rng_key(bake->options.seed, index, s);
-    uint64_t key_walk = dwvk_rng_key(bake->options.seed, WALK_STREAM | index, s);
+    /* Pixel position, entry direction and light points: stratified per pixel (kernel/sampler.h). */
+    dwvk_sampler sampler = {.key = dwvk_rng_key(bake->options.seed, stream | PIXEL_STREAM | index, 0u), .index = s,
+                            .stratified = 1};
+    uint64_t key_walk = dwvk_rng_key(bake->options.seed, stream | WALK_STREAM | index, s);
+    *mesh_seen = UINT32_MAX;
     uint32_t x = index % bake->width, row = index / bake->width;
     dwvg_hit hit;
     dwvw_vec3 view;
     if (bake->options.target == DWV_BAKE_CAMERA) {
         dwvw_vec3 origin;
-        camera_sample(bake, x, row, key, &origin, &view);
+        camera_sample(bake, x, row, &sampler, &origin, &view);
         if (!(bake->scene->mesh_count > 0 && dwvg_intersect(&bake->scene->geometry, origin, view, 0.0, INFINITY, &hit))) {
             for (int c = 0; c < 3; ++c) rgb[c] = bake->scene->world[c];
             *alpha = 0.0;
@@ -125,12 +140,19 @@ static void sample_pixel(dwvb_bake *bake, uint32_t index, uint64_t s, double rgb
         const dwvg_mesh *mesh = &bake->scene->meshes[hit.mesh];
         view = dwvw_scale(dwvg_geometric_normal(mesh, hit.prim), -1.0);
     }
-    dwvb_shade(&bake->shader, &hit, view, key, PIXEL_DIMS, key_walk, rgb, tally);
+    *mesh_seen = hit.mesh;
+    dwvb_shade(shader, &hit, view, &sampler, PIXEL_PAIR + 1u, key_walk, rgb, tally);
     *alpha = 1.0;
     if (!(isfinite(rgb[0]) && isfinite(rgb[1]) && isfinite(rgb[2]))) {
         ++tally->warnings;
         rgb[0] = rgb[1] = rgb[2] = 0.0;
     }
+}
+
+static void sample_pixel(dwvb_bake *bake, uint32_t index, uint64_t s, double rgb[3], double *alpha, dwvb_tally *tally)
+{
+    uint32_t mesh_seen;
+    sample_with(bake, &bake->shader, 0u, index, s, rgb, alpha, &mesh_seen, tally);
 }
 
 static int pixel_active(const dwvb_bake *bake, uint32_t index)
@@ -380,6 +402,7 @@ static dwv_result_t make_image(dwvb_bake *bake, double seconds)
         total.events += bake->tile_tallies[t].events;
         total.walks += bake->tile_tallies[t].walks;
         total.warnings += bake->tile_tallies[t].warnings;
+        total.mixture_terms += bake->tile_tallies[t].mixture_terms;
         for (int c = 0; c < 3; ++c) total.truncated[c] += bake->tile_tallies[t].truncated[c];
     }
     st->technique = bake->options.technique;
@@ -403,9 +426,14 @@ static dwv_result_t make_image(dwvb_bake *bake, double seconds)
     return DWV_SUCCESS;
 }
 
+static int choose_auto(dwvb_bake *bake);
+
 static dwv_result_t run(dwvb_bake *bake)
 {
     uint64_t samples = bake->options.samples;
+    int pilot = choose_auto(bake);
+    if (pilot < 0) return fail(bake, DWV_ERROR_OUT_OF_MEMORY, "no memory for auto's pilot");
+    if (atomic_load(&bake->cancelled)) return fail(bake, DWV_ERROR_CANCELLED, "the bake was cancelled");
     while (bake->spp_done < samples) {
         uint64_t pass = bake->spp_done == 0 ? 2u : bake->spp_done;
         if (pass > samples - bake->spp_done) pass = samples - bake->spp_done;
@@ -446,6 +474,7 @@ static void release_parts(dwvb_bake *bake)
 {
     free(bake->guides);
     free(bake->needs_closest);
+    free(bake->auto_choice);
     free(bake->sums);
     free(bake->counts);
     free(bake->tile_tallies);
@@ -482,10 +511,24 @@ static int mesh_used(const dwvb_bake *bake, uint32_t m)
     return bake->options.target == DWV_BAKE_CAMERA || m == bake->options.uv_mesh;
 }
 
-static void setup_guides(dwvb_bake *bake)
+/* The features the bake's guides use, from those of the scene. */
+static void update_features(dwvb_bake *bake)
 {
     const dwvb_scene *scene = bake->scene;
     uint32_t features = scene->features & ~(uint32_t)(DWV_FEATURE_INCIDENT_PATCHES | DWV_FEATURE_CLOSEST_POINT);
+    for (uint32_t m = 0; m < scene->mesh_count; ++m) {
+        const dwvb_material *material = &scene->shading[scene->meshes[m].material_id];
+        if (!material->subsurface || !mesh_used(bake, m)) continue;
+        if (bake->needs_closest[m]) features |= DWV_FEATURE_CLOSEST_POINT;
+        if (bake->guides[m].q_incident > 0.0 && bake->guides[m].patch_count > 0) features |= DWV_FEATURE_INCIDENT_PATCHES;
+        if (bake->guides[m].q_classical < 1.0) features |= DWV_FEATURE_GUIDED;
+    }
+    bake->features = features;
+}
+
+static void setup_guides(dwvb_bake *bake)
+{
+    const dwvb_scene *scene = bake->scene;
     for (uint32_t m = 0; m < scene->mesh_count; ++m) {
         const dwvb_material *material = &scene->shading[scene->meshes[m].material_id];
         if (!material->subsurface) continue;
@@ -500,12 +543,141 @@ static void setup_guides(dwvb_bake *bake)
             technique = DWVW_CLASSICAL;
         dwvw_guide_init(&bake->guides[m], technique, &material->medium, scene->patches[m], scene->patch_count[m]);
         bake->needs_closest[m] = dwvw_guide_needs_closest(&bake->guides[m]);
-        if (!mesh_used(bake, m)) continue;
-        if (bake->needs_closest[m]) features |= DWV_FEATURE_CLOSEST_POINT;
-        if (bake->guides[m].q_incident > 0.0 && bake->guides[m].patch_count > 0) features |= DWV_FEATURE_INCIDENT_PATCHES;
-        if (bake->guides[m].q_classical < 1.0) features |= DWV_FEATURE_GUIDED;
+        /* Above that albedo auto's mixture competes with classical sampling in the pilot. */
+        bake->auto_choice[m] = technique == DWVW_AUTO && mesh_used(bake, m);
     }
-    bake->features = features;
+    update_features(bake);
+}
+
+/* ---- auto: the technique that pays, per mesh --------------------------------------------------
+ * Guiding lowers a walk's variance but costs work per event (a mixture of components, each with
+ * a pdf and an exponential per channel pair); where the image's variance hardly moves (front-lit
+ * thick objects) that work is wasted, and auto's small defensive classical share doubles the
+ * mixture's terms where guiding alone would do (thin back-lit sheets). Before the first pass, a
+ * pilot shades the same pixel samples with each candidate (classical sampling, auto's mixture,
+ * and the mixture's guided part alone) and keeps, per mesh, the one with the largest efficiency
+ * 1 / (variance x cost) (Veach 1997, Sec. 2.4: the efficiency of an estimator;
+ * Hammersley and Handscomb 1964). Both are unbiased, so the choice moves noise, never the mean.
+ * The cost is counted, not timed, so that the choice (and the image) depends on the seed only:
+ * nanoseconds per sample (camera ray, shading, exit lighting), per walk event (an Embree ray and
+ * the event's sampling) and per mixture term (see dwvb_tally), fitted by least squares to bakes
+ * of the report's sphere, slab and default scene with every technique (one thread, x86-64,
+ * docs/speed.md); only their ratios matter. */
+#define PILOT_COST_SAMPLE 606.0
+#define PILOT_COST_EVENT 415.0
+#define PILOT_COST_TERM 18.4
+/* Pilot samples per candidate: a sixteenth of the bake's samples, at most PILOT_MAX; below
+ * PILOT_MIN the estimate is too noisy to act on and auto keeps its mixture. A mesh needs
+ * PILOT_MESH_MIN of them to be decided. */
+#define PILOT_MAX 4096u
+#define PILOT_MIN 256u
+#define PILOT_MESH_MIN 64.0
+
+/* The candidates, in the order of the pilot (a tie keeps the earlier, cheaper one). */
+#define PILOT_CANDIDATES 3
+enum { PILOT_CLASSICAL = 0, PILOT_GUIDED = 1, PILOT_MIXTURE = 2 };
+
+/* Candidate `candidate` for mesh m, whose guide auto made (bake->guides[m]). */
+static void pilot_guide(const dwvb_bake *bake, uint32_t m, int candidate, dwvw_guide *guide)
+{
+    const dwvb_scene *scene = bake->scene;
+    const dwvw_medium *medium = &scene->shading[scene->meshes[m].material_id].medium;
+    *guide = bake->guides[m];
+    if (candidate == PILOT_CLASSICAL) dwvw_guide_init(guide, DWVW_CLASSICAL, medium, NULL, 0);
+    else if (candidate == PILOT_GUIDED && guide->q_incident > 0.0)
+        dwvw_guide_init(guide, DWVW_INCIDENT, medium, scene->patches[m], scene->patch_count[m]);
+    else if (candidate == PILOT_GUIDED) dwvw_guide_init(guide, DWVW_CLOSEST, medium, NULL, 0);
+}
+
+typedef struct pilot_sums {
+    double count, sum, sum_squares, cost;
+} pilot_sums;
+
+static uint64_t active_pixels(const dwvb_bake *bake)
+{
+    uint64_t pixels = (uint64_t)bake->width * bake->height, active = 0;
+    for (uint64_t i = 0; i < pixels; ++i) active += (uint64_t)pixel_active(bake, (uint32_t)i);
+    return active;
+}
+
+/* Runs the pilot and narrows bake->guides; 0 done (or nothing to decide), 1 cancelled or out of
+ * time, -1 out of memory. */
+static int choose_auto(dwvb_bake *bake)
+{
+    const dwvb_scene *scene = bake->scene;
+    uint32_t meshes = scene->mesh_count, candidates = 0;
+    for (uint32_t m = 0; m < meshes; ++m) candidates += (uint32_t)bake->auto_choice[m];
+    if (candidates == 0) return 0;
+    uint64_t budget = active_pixels(bake) * bake->options.samples / 16u;
+    if (budget < PILOT_MIN) return 0;
+    uint32_t n = budget < PILOT_MAX ? (uint32_t)budget : PILOT_MAX;
+    dwvw_guide *trial = malloc(meshes * sizeof *trial);
+    int *trial_closest = malloc(meshes * sizeof *trial_closest);
+    pilot_sums *sums = calloc(PILOT_CANDIDATES * (size_t)meshes, sizeof *sums); /* [candidate][mesh] */
+    if (!trial || !trial_closest || !sums) {
+        free(trial);
+        free(trial_closest);
+        free(sums);
+        return -1;
+    }
+    uint64_t pixels = (uint64_t)bake->width * bake->height;
+    int stopped = 0;
+    /* The same pixel samples for every candidate. */
+    for (int candidate = 0; candidate < PILOT_CANDIDATES && !stopped; ++candidate) {
+        for (uint32_t m = 0; m < meshes; ++m) {
+            if (bake->auto_choice[m]) pilot_guide(bake, m, candidate, &trial[m]);
+            else trial[m] = bake->guides[m];
+            trial_closest[m] = dwvw_guide_needs_closest(&trial[m]);
+        }
+        dwvb_shader shader = bake->shader;
+        shader.guides = trial;
+        shader.needs_closest = trial_closest;
+        for (uint32_t i = 0; i < n; ++i) {
+            if ((stopped = must_stop(bake))) break;
+            uint32_t index = (uint32_t)(dwvk_rng_u64(dwvk_rng_key(bake->options.seed, PILOT_STREAM, i), 0u) % pixels);
+            if (!pixel_active(bake, index)) continue;
+            double rgb[3], alpha;
+            uint32_t mesh;
+            dwvb_tally tally = {0};
+            sample_with(bake, &shader, PILOT_STREAM, index, i, rgb, &alpha, &mesh, &tally);
+            if (mesh == UINT32_MAX || !bake->auto_choice[mesh]) continue;
+            double l = luminance(rgb);
+            pilot_sums *p = &sums[(size_t)candidate * meshes + mesh];
+            p->count += 1.0;
+            p->sum += l;
+            p->sum_squares += l * l;
+            p->cost += PILOT_COST_SAMPLE + PILOT_COST_EVENT * (double)tally.events + PILOT_COST_TERM * (double)tally.mixture_terms;
+        }
+    }
+    if (!stopped) {
+        for (uint32_t m = 0; m < meshes; ++m) {
+            /* Every candidate traced the same camera rays, so each saw the mesh equally often. */
+            if (!bake->auto_choice[m] || sums[m].count < PILOT_MESH_MIN) continue;
+            /* variance x cost, per sample that saw the mesh */
+            int best = PILOT_MIXTURE;
+            double best_work = INFINITY;
+            for (int c = 0; c < PILOT_CANDIDATES; ++c) {
+                const pilot_sums *p = &sums[(size_t)c * meshes + m];
+                double mean = p->sum / p->count;
+                double variance = fmax(p->sum_squares / p->count - mean * mean, 0.0) * p->count / (p->count - 1.0);
+                double work = variance * (p->cost / p->count);
+                if (work < best_work) {
+                    best_work = work;
+                    best = c;
+                }
+            }
+            if (best == PILOT_MIXTURE) continue; /* bake->guides[m] is the mixture already */
+            dwvw_guide chosen;
+            pilot_guide(bake, m, best, &chosen);
+            bake->guides[m] = chosen;
+            bake->needs_closest[m] = dwvw_guide_needs_closest(&chosen);
+        }
+        update_features(bake);
+    }
+    free(trial);
+    free(trial_closest);
+    free(sums);
+    return stopped;
 }
 
 dwv_result_t dwvb_bake_start(dwvb_scene *scene, const dwv_bake_options_t *options, dwvb_bake **out,
@@ -543,6 +715,7 @@ dwv_result_t dwvb_bake_start(dwvb_scene *scene, const dwv_bake_options_t *option
     uint32_t meshes = scene->mesh_count ? scene->mesh_count : 1u;
     bake->guides = calloc(meshes, sizeof *bake->guides);
     bake->needs_closest = calloc(meshes, sizeof *bake->needs_closest);
+    bake->auto_choice = calloc(meshes, sizeof *bake->auto_choice);
     bake->sums = calloc(pixels, sizeof *bake->sums);
     bake->counts = calloc(pixels, sizeof *bake->counts);
     bake->tile_tallies = calloc(bake->tile_count, sizeof *bake->tile_tallies);
@@ -550,8 +723,8 @@ dwv_result_t dwvb_bake_start(dwvb_scene *scene, const dwv_bake_options_t *option
     bake->tile_seconds = calloc(bake->tile_count, sizeof *bake->tile_seconds);
     bake->tile_ranking = malloc(bake->tile_count * sizeof *bake->tile_ranking);
     bake->image = dwvb_image_new(bake->width, bake->height);
-    if (!bake->guides || !bake->needs_closest || !bake->sums || !bake->counts || !bake->tile_tallies || !bake->tile_order ||
-        !bake->tile_seconds || !bake->tile_ranking || !bake->image) {
+    if (!bake->guides || !bake->needs_closest || !bake->auto_choice || !bake->sums || !bake->counts ||
+        !bake->tile_tallies || !bake->tile_order || !bake->tile_seconds || !bake->tile_ranking || !bake->image) {
         release_parts(bake);
         snprintf(message, size, "out of memory for a %u x %u bake", options->width, options->height);
         return DWV_ERROR_OUT_OF_MEMORY;

@@ -117,7 +117,9 @@ static int make_patches(const dwvb_scene *scene, const dwvl_environment *env, ui
             if (ng.x == 0.0 && ng.y == 0.0 && ng.z == 0.0) continue;
             dwvw_vec3 x = dwvg_point(mesh, lo, b1, b2);
             double radiance[3];
-            dwvl_direct(env, x, ng, ng, key, 3u, radiance);
+            /* Independent draws; pairs from 2 on (dimensions 4, 5, ...) leave 0 to 2 to the point. */
+            dwvk_sampler sampler = {.key = key, .index = 0u, .stratified = 0};
+            dwvl_direct(env, x, ng, ng, &sampler, 2u, radiance);
             /* The Lambertian estimate is irradiance / pi. */
             double e = 3.14159265358979323846 * luminance(radiance);
             if (!(e > 0.0)) continue;

@@ -2,7 +2,16 @@
 
 #include <math.h>
 
-#include "kernel/rng.h"
+
+/* The mixture terms of the step just sampled (see dwvb_tally). */
+static uint64_t mixture_terms(const dwvw_walk *walk)
+{
+    uint64_t active = 0;
+    for (int k = 0; k < walk->component_count; ++k) active += walk->component_q[k] > 0.0;
+    uint64_t channels = (uint64_t)walk->medium->channels;
+    uint64_t patches = walk->guide->q_incident > 0.0 && walk->guide->patch_count > 1 ? (uint64_t)walk->guide->patch_count : 0u;
+    return active * channels * channels + patches;
+}
 
 /* Runs one walk from entry point x (on triangle entry_prim of mesh `mesh`) along unit `direction`
  * into the medium; on exit fills the exit hit and returns 1. */
@@ -22,6 +31,7 @@ static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvb_materia
                 dwvw_walk_set_closest(walk, dwvg_geometric_normal(m, closest.prim));
         }
         double distance = dwvw_walk_sample(walk);
+        tally->mixture_terms += mixture_terms(walk);
         /* The first step is the probe: its full distance to the surface locates an opposite
          * interface. A ray leaving a flat triangle inward cannot meet that triangle again, so a
          * hit on the entry triangle is rounding and the ray goes on past it. */
@@ -79,8 +89,8 @@ static double exit_factor(const void *context, dwvw_vec3 light)
     return dwvb_principled_exit_factor(dwvw_dot(*n, light));
 }
 
-void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, uint64_t key_shade,
-                uint32_t dimension, uint64_t key_walk, double rgb[3], dwvb_tally *tally)
+void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, const dwvk_sampler *sampler,
+                uint32_t pair, uint64_t key_walk, double rgb[3], dwvb_tally *tally)
 {
     const dwvb_scene *scene = shader->scene;
     const dwvg_mesh *mesh = &scene->meshes[hit->mesh];
@@ -103,26 +113,26 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, 
     }
     dwvw_vec3 x = dwvg_point(mesh, hit->prim, hit->u, hit->v);
     dwvw_vec3 n = dwvg_shading_normal(mesh, hit->prim, hit->u, hit->v, ng);
-    uint32_t light_dims = dwvl_direct_dimensions(&shader->env);
+    uint32_t light_pairs = dwvl_direct_pairs(&shader->env);
     if (material->principled_v1) {
         /* The Lambertian lobe and the retro-reflection lobe from the same light samples. */
         retro_lobe lobe = {n, dwvw_scale(view, -1.0), -dwvw_dot(n, view), material->roughness};
         double direct[3], retro[3];
-        dwvl_direct_lobe(&shader->env, x, n, ng, key_shade, dimension + DWVB_SHADE_DIMS, retro_factor, &lobe, direct,
-                         retro);
+        dwvl_direct_lobe(&shader->env, x, n, ng, sampler, pair + DWVB_SHADE_PAIRS, retro_factor, &lobe, direct, retro);
         for (int c = 0; c < 3; ++c) rgb[c] += material->diffuse_albedo[c] * direct[c] + material->retro_albedo[c] * retro[c];
     } else if (material->diffuse_albedo[0] > 0.0 || material->diffuse_albedo[1] > 0.0 ||
                material->diffuse_albedo[2] > 0.0) {
         double direct[3];
-        dwvl_direct(&shader->env, x, n, ng, key_shade, dimension + DWVB_SHADE_DIMS, direct);
+        dwvl_direct(&shader->env, x, n, ng, sampler, pair + DWVB_SHADE_PAIRS, direct);
         for (int c = 0; c < 3; ++c) rgb[c] += material->diffuse_albedo[c] * direct[c];
     }
     if (!material->subsurface) return;
     /* Entry: cosine-weighted about -n, rejected (no contribution, as Cycles) where it would not
      * go below the geometric surface. The pdf cos/pi cancels the diffuse transmission f = 1/pi. */
-    double u = dwvk_rng_uniform_d(key_shade, dimension), mu = sqrt(u);
-    dwvw_vec3 inward = dwvw_direction_about(dwvw_scale(n, -1.0), mu, 1.0 - mu, 1.0 + mu,
-                                            dwvk_rng_uniform_d(key_shade, dimension + 1u));
+    double u[2];
+    dwvk_sampler_pair(sampler, pair, u);
+    double mu = sqrt(u[0]);
+    dwvw_vec3 inward = dwvw_direction_about(dwvw_scale(n, -1.0), mu, 1.0 - mu, 1.0 + mu, u[1]);
     if (!(dwvw_dot(inward, ng) < 0.0)) return;
     dwvw_walk walk;
     dwvg_hit exit = {0};
@@ -133,11 +143,10 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, 
     dwvw_vec3 exit_n = dwvg_shading_normal(mesh, exit.prim, exit.u, exit.v, exit_ng);
     double direct[3];
     if (material->principled_v1)
-        dwvl_direct_lobe(&shader->env, walk.position, exit_n, exit_ng, key_shade,
-                         dimension + DWVB_SHADE_DIMS + light_dims, exit_factor, &exit_n, NULL, direct);
+        dwvl_direct_lobe(&shader->env, walk.position, exit_n, exit_ng, sampler, pair + DWVB_SHADE_PAIRS + light_pairs,
+                         exit_factor, &exit_n, NULL, direct);
     else
-        dwvl_direct(&shader->env, walk.position, exit_n, exit_ng, key_shade, dimension + DWVB_SHADE_DIMS + light_dims,
-                    direct);
+        dwvl_direct(&shader->env, walk.position, exit_n, exit_ng, sampler, pair + DWVB_SHADE_PAIRS + light_pairs, direct);
     int grey = material->medium.channels == 1;
     for (int c = 0; c < 3; ++c) rgb[c] += walk.weight[grey ? 0 : c] * material->walk_scale[c] * direct[c];
 }

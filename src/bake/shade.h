@@ -26,16 +26,19 @@ typedef struct dwvb_shader {
 /* What samples met, summed by the caller in a fixed order. */
 typedef struct dwvb_tally {
     uint64_t events, walks, warnings;
+    /* Work the walks' mixtures did: per step, the components with weight > 0 times the channels
+     * squared (the exponentials of the spectral MIS weight), plus the lit patches weighed. */
+    uint64_t mixture_terms;
     double truncated[3];
 } dwvb_tally;
 
-/* Random dimensions of the shading key before direct lighting starts. */
-#define DWVB_SHADE_DIMS 2u
+/* Pairs of random dimensions shading uses before direct lighting starts: the entry direction. */
+#define DWVB_SHADE_PAIRS 1u
 
 /* The radiance leaving hit point `hit` along -view (view: unit direction of the ray that found
- * it, from the viewer). key_shade drives entry and light sampling from dimension `dimension`
- * on; key_walk drives the walk. */
-void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, uint64_t key_shade,
-                uint32_t dimension, uint64_t key_walk, double rgb[3], dwvb_tally *tally);
+ * it, from the viewer). `sampler` drives entry and light sampling from pair `pair` on; key_walk
+ * drives the walk. */
+void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, const dwvk_sampler *sampler,
+                uint32_t pair, uint64_t key_walk, double rgb[3], dwvb_tally *tally);
 
 #endif

@@ -2,21 +2,20 @@
 
 #include <math.h>
 
-#include "kernel/rng.h"
 
 #define INV_PI 0.31830988618379067154
 
-void dwvl_direct_lobe(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng, uint64_t key,
-                      uint32_t dimension, dwvl_lobe_factor factor, const void *context, double lambert[3],
-                      double lobe[3])
+void dwvl_direct_lobe(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng, const dwvk_sampler *sampler,
+                      uint32_t pair, dwvl_lobe_factor factor, const void *context, double lambert[3], double lobe[3])
 {
     double plain[3] = {0.0, 0.0, 0.0}, weighted[3] = {0.0, 0.0, 0.0};
     double eps = env->geometry ? env->geometry->epsilon : 0.0;
     dwvw_vec3 origin = dwvw_madd(x, ng, eps);
     for (uint32_t i = 0; i < env->light_count; ++i) {
         dwvl_sample s;
-        dwvl_light_sample(&env->lights[i], x, dwvk_rng_uniform_d(key, dimension + 2u * i),
-                          dwvk_rng_uniform_d(key, dimension + 2u * i + 1u), &s);
+        double u[2];
+        dwvk_sampler_pair(sampler, pair + i, u);
+        dwvl_light_sample(&env->lights[i], x, u[0], u[1], &s);
         double cos_n = dwvw_dot(n, s.direction);
         if (!(cos_n > 0.0) || !(dwvw_dot(ng, s.direction) > 0.0)) continue;
         if (!(s.value[0] > 0.0 || s.value[1] > 0.0 || s.value[2] > 0.0)) continue;
@@ -32,9 +31,10 @@ void dwvl_direct_lobe(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwv
     if (env->world_lit) {
         /* Cosine-weighted direction about n (pdf cos / pi): the estimate is L_world x visibility
          * (x the factor for the lobe). */
-        uint32_t d = dimension + 2u * env->light_count;
-        double u = dwvk_rng_uniform_d(key, d), mu = sqrt(u);
-        dwvw_vec3 w = dwvw_direction_about(n, mu, 1.0 - mu, 1.0 + mu, dwvk_rng_uniform_d(key, d + 1u));
+        double u[2];
+        dwvk_sampler_pair(sampler, pair + env->light_count, u);
+        double mu = sqrt(u[0]);
+        dwvw_vec3 w = dwvw_direction_about(n, mu, 1.0 - mu, 1.0 + mu, u[1]);
         if (dwvw_dot(ng, w) > 0.0 && !(env->geometry && dwvg_occluded(env->geometry, origin, w, 0.0, INFINITY))) {
             double f = factor ? factor(context, w) : 0.0;
             for (int c = 0; c < 3; ++c) {
@@ -49,8 +49,8 @@ void dwvl_direct_lobe(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwv
     }
 }
 
-void dwvl_direct(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng, uint64_t key,
-                 uint32_t dimension, double out[3])
+void dwvl_direct(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng, const dwvk_sampler *sampler,
+                 uint32_t pair, double out[3])
 {
-    dwvl_direct_lobe(env, x, n, ng, key, dimension, NULL, NULL, out, NULL);
+    dwvl_direct_lobe(env, x, n, ng, sampler, pair, NULL, NULL, out, NULL);
 }

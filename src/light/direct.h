@@ -6,6 +6,7 @@
 #include <stdint.h>
 
 #include "geom/embree.h"
+#include "kernel/sampler.h"
 #include "light.h"
 
 typedef struct dwvl_environment {
@@ -16,27 +17,26 @@ typedef struct dwvl_environment {
     const dwvg_world *geometry;
 } dwvl_environment;
 
-/* Random dimensions one call uses: 2 per light and 2 for the world. */
-static inline uint32_t dwvl_direct_dimensions(const dwvl_environment *env)
+/* Pairs of random dimensions one call uses: one per light and one for the world. */
+static inline uint32_t dwvl_direct_pairs(const dwvl_environment *env)
 {
-    return 2u * env->light_count + 2u;
+    return env->light_count + 1u;
 }
 
 /* (1/pi) integral of L_in cos over the hemisphere of the shading normal `n` at x, estimated with
- * uniform numbers from `key` starting at `dimension`; `ng` is the unit geometric normal on the
- * same side (shadow rays leave from x + epsilon ng and never below the geometric surface). */
-void dwvl_direct(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng, uint64_t key,
-                 uint32_t dimension, double out[3]);
+ * the uniform pairs of `sampler` starting at pair `pair`; `ng` is the unit geometric normal on
+ * the same side (shadow rays leave from x + epsilon ng and never below the geometric surface). */
+void dwvl_direct(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng, const dwvk_sampler *sampler,
+                 uint32_t pair, double out[3]);
 
 /* A BRDF's factor beside the Lambertian 1/pi for light arriving along unit `light` (toward the
  * light): the BRDF is (1/pi) factor(context, light). */
 typedef double (*dwvl_lobe_factor)(const void *context, dwvw_vec3 light);
 
-/* dwvl_direct with the same light samples (the same numbers from `key`) also weighted by
+/* dwvl_direct with the same light samples (the same pairs of `sampler`) also weighted by
  * `factor`: lambert gets what dwvl_direct gives (NULL: not wanted), lobe the same integral with
  * (1/pi) factor(light) cos as the BRDF term. */
-void dwvl_direct_lobe(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng, uint64_t key,
-                      uint32_t dimension, dwvl_lobe_factor factor, const void *context, double lambert[3],
-                      double lobe[3]);
+void dwvl_direct_lobe(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng, const dwvk_sampler *sampler,
+                      uint32_t pair, dwvl_lobe_factor factor, const void *context, double lambert[3], double lobe[3]);
 
 #endif

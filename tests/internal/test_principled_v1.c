@@ -143,8 +143,9 @@ static void test_direct_lobe(void)
     dwvw_vec3 x = dwvw_v(0.0, 0.0, 0.0), n = dwvw_v(0.0, 0.0, 1.0);
     fixed_normal normal = {n};
     double plain[3], lambert[3], lobe[3];
-    dwvl_direct(&env, x, n, n, 99u, 0u, plain);
-    dwvl_direct_lobe(&env, x, n, n, 99u, 0u, exit_lobe, &normal, lambert, lobe);
+    dwvk_sampler sampler = {.key = 99u, .index = 0u, .stratified = 0};
+    dwvl_direct(&env, x, n, n, &sampler, 0u, plain);
+    dwvl_direct_lobe(&env, x, n, n, &sampler, 0u, exit_lobe, &normal, lambert, lobe);
     double f = dwvb_principled_exit_factor(0.8);
     for (int c = 0; c < 3; ++c) {
         CHECK(plain[c] > 0.0 && lambert[c] == plain[c], "channel %d: Lambertian part %g equals dwvl_direct's %g", c,

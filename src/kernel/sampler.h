@@ -1,0 +1,91 @@
+/* Uniform numbers for the low dimensions of a pixel's samples, in pairs: either independent
+ * counter-based draws (rng.h), or a stratified sequence, the first two dimensions of Sobol's
+ * (0,2)-sequence in base 2 with a nested uniform (Owen) scramble per pixel, pair and coordinate.
+ *
+ * Why: a bake's pixel variance is mostly not the walk's. On the report's sphere, the pixel
+ * position (silhouette coverage, shading across the pixel), the entry direction and area-light
+ * points carry most of it (docs/speed.md), and those are low-dimensional integrands that a
+ * stratified sequence integrates at a faster rate than 1/N. Cycles samples them the same way
+ * (progressive multi-jittered or Sobol points per pixel).
+ *
+ * Unbiasedness: the scramble of a coordinate is a bijection x -> s(x) chosen by a 32-bit seed;
+ * for a fixed x, seed -> s(x) is itself a bijection of 32-bit values (hash below), so with a
+ * uniformly random seed every sample's coordinate is uniform on the 2^-32 grid, and coordinates
+ * with independent seeds are independent: each sample has the distribution of an independent
+ * one, only the samples of a pixel are correlated (negatively, for smooth integrands: Owen 1997,
+ * "Scrambled net variance for integrals of smooth functions"). Pairs share the sequence; each
+ * pair shuffles the sample index with a seed of its own (Burley 2020), as in the "padding" of
+ * Kollig and Keller 2002, so that pairs do not reuse the same points in the same order.
+ *
+ * Prefixes: the sample indices of a pixel are 0, 1, 2, ... in order, so each power-of-two
+ * prefix is a (0,m,2)-net in every pair; a bake cut by its time budget keeps an unbiased prefix.
+ * Indices at or above 2^32 (beyond the sequence) fall back to independent draws. */
+#ifndef DWV_KERNEL_SAMPLER_H
+#define DWV_KERNEL_SAMPLER_H
+
+#include <stdint.h>
+
+#include "rng.h"
+
+typedef struct dwvk_sampler {
+    uint64_t key;   /* stratified: the pixel's key (the same for all its samples); else the sample's */
+    uint64_t index; /* the sample's index within its pixel (stratified only) */
+    int stratified;
+} dwvk_sampler;
+
+static inline uint32_t dwvk_reverse_bits32(uint32_t x)
+{
+    x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
+    x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
+    x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
+    x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
+    return (x >> 16) | (x << 16);
+}
+
+/* Sobol's second coordinate: the index's bits times the generator matrix whose columns are
+ * v_1 = 2^31, v_k = v_{k-1} xor (v_{k-1} >> 1) (primitive polynomial x + 1, m_k = 1). */
+static inline uint32_t dwvk_sobol_second(uint32_t index)
+{
+    uint32_t x = 0u;
+    for (uint32_t v = 0x80000000u; index; index >>= 1, v ^= v >> 1)
+        if (index & 1u) x ^= v;
+    return x;
+}
+
+/* A nested uniform scramble of the 32 binary digits of x (read as the fraction 0.x): each digit is
+ * flipped by a hash of the digits before it. Done as Laine and Karras 2011 on the reversed bits,
+ * where "before" becomes "below" and a multiply by an even constant carries only upward; the
+ * constants are Burley's ("Practical Hash-based Owen Scrambling", JCGT 2020). Every step is a
+ * bijection of x, and x + seed is a bijection of the seed. */
+static inline uint32_t dwvk_owen_scramble(uint32_t x, uint32_t seed)
+{
+    x = dwvk_reverse_bits32(x);
+    x += seed;
+    x ^= x * 0x6c50b47cu;
+    x ^= x * 0xb82f1e52u;
+    x ^= x * 0xc7afe638u;
+    x ^= x * 0x8d22f6e6u;
+    return dwvk_reverse_bits32(x);
+}
+
+/* The two uniforms on [0, 1) of pair `pair` (dimensions 2 pair and 2 pair + 1 of the sample). */
+static inline void dwvk_sampler_pair(const dwvk_sampler *sampler, uint32_t pair, double u[2])
+{
+    if (sampler->stratified && sampler->index < 0x100000000ull) {
+        uint64_t seeds = dwvk_rng_u64(sampler->key, pair); /* two 32-bit scramble seeds */
+        /* The index itself is shuffled per pair by the same nested scramble (Burley 2020, Sec. 4):
+         * the first 2^m indices go to one aligned block of 2^m points of the sequence, still a
+         * net, but to a different block and order for each pair. */
+        uint32_t i = dwvk_owen_scramble((uint32_t)sampler->index, (uint32_t)dwvk_mix64(seeds));
+        uint32_t first = dwvk_owen_scramble(dwvk_reverse_bits32(i), (uint32_t)seeds);
+        uint32_t second = dwvk_owen_scramble(dwvk_sobol_second(i), (uint32_t)(seeds >> 32));
+        u[0] = (double)first * 0x1.0p-32;
+        u[1] = (double)second * 0x1.0p-32;
+        return;
+    }
+    uint64_t key = sampler->stratified ? dwvk_rng_key(sampler->key, 0u, sampler->index) : sampler->key;
+    u[0] = dwvk_rng_uniform_d(key, 2u * pair);
+    u[1] = dwvk_rng_uniform_d(key, 2u * pair + 1u);
+}
+
+#endif
