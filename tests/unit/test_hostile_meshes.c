@@ -11,13 +11,11 @@
  *     case took are printed (never asserted: the machine is shared).
  * Public API only. */
 #define _POSIX_C_SOURCE 200809L
-#include <float.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include "api_checks.h"
