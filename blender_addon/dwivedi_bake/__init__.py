@@ -180,8 +180,11 @@ class _Job:
         finally:
             image.close()
             self.close()
+        # Degenerate geometry the library met (zero-area, non-finite or too distant triangles, open
+        # meshes, backs of faces): said in the summary, so that a left-out mesh is not a mystery.
+        degenerate = f", {stats.warnings} geometry warnings" if stats.warnings else ""
         return (f"Dwivedi bake: {self.exported.width} x {self.exported.height}, {stats.samples_per_pixel} spp, "
-                f"{stats.seconds:.2f} s, est. error {stats.estimated_relative_error:.2%} -> {self.exr}")
+                f"{stats.seconds:.2f} s, est. error {stats.estimated_relative_error:.2%}{degenerate} -> {self.exr}")
 
     def close(self):
         if self.bake is not None:

@@ -21,6 +21,17 @@ static void corners(const dwvg_mesh *mesh, uint32_t prim, dwvw_vec3 *a, dwvw_vec
     *c = vertex(mesh, i[2]);
 }
 
+/* Embree takes ray origins and directions up to its FLT_LARGE, 1.844e18, in magnitude, and
+ * asserts on (or ignores) rays beyond: such rays (a walk wandering off an open mesh, a camera far
+ * out) meet nothing here without asking Embree. Triangles are kept far inside that range by
+ * dwvg_mesh_init (DWVG_LARGEST_COORDINATE). */
+#define EMBREE_LARGEST 1.844e18f
+
+static int in_embree_range(float x, float y, float z)
+{
+    return fabsf(x) <= EMBREE_LARGEST && fabsf(y) <= EMBREE_LARGEST && fabsf(z) <= EMBREE_LARGEST;
+}
+
 static dwvw_vec3 cross(dwvw_vec3 a, dwvw_vec3 b)
 {
     return dwvw_v(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
@@ -170,7 +181,8 @@ void dwvg_world_free(dwvg_world *world)
     world->mesh_count = 0;
 }
 
-static void make_ray(struct RTCRayHit *rh, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar)
+/* Fills an Embree ray; 0 if Embree could not trace it (see EMBREE_LARGEST, or a NaN bound). */
+static int make_ray(struct RTCRayHit *rh, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar)
 {
     rh->ray.org_x = (float)o.x;
     rh->ray.org_y = (float)o.y;
@@ -187,6 +199,8 @@ static void make_ray(struct RTCRayHit *rh, dwvw_vec3 o, dwvw_vec3 d, double tnea
     rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh->hit.primID = RTC_INVALID_GEOMETRY_ID;
     rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    return in_embree_range(rh->ray.org_x, rh->ray.org_y, rh->ray.org_z) &&
+           in_embree_range(rh->ray.dir_x, rh->ray.dir_y, rh->ray.dir_z) && !isnan(tnear) && !isnan(tfar);
 }
 
 static int trace(RTCScene scene, int instanced, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar, dwvg_hit *hit)
@@ -194,7 +208,7 @@ static int trace(RTCScene scene, int instanced, dwvw_vec3 o, dwvw_vec3 d, double
     struct RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     struct RTCRayHit rh;
-    make_ray(&rh, o, d, tnear, tfar);
+    if (!make_ray(&rh, o, d, tnear, tfar)) return 0;
     rtcIntersect1(scene, &context, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 0;
     hit->mesh = instanced ? rh.hit.instID[0] : 0u;
@@ -225,7 +239,7 @@ int dwvg_occluded(const dwvg_world *world, dwvw_vec3 o, dwvw_vec3 d, double tnea
     struct RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     struct RTCRayHit rh;
-    make_ray(&rh, o, d, tnear, tfar);
+    if (!make_ray(&rh, o, d, tnear, tfar)) return 0;
     rtcOccluded1(world->top, &context, &rh.ray);
     return rh.ray.tfar < 0.0f; /* Embree marks an occluded ray with tfar = -inf */
 }
@@ -290,6 +304,7 @@ static bool closest_callback(struct RTCPointQueryFunctionArguments *args)
 int dwvg_closest_mesh(const dwvg_world *world, uint32_t mesh, dwvw_vec3 p, dwvg_hit *hit)
 {
     struct RTCPointQuery query;
+    if (!in_embree_range((float)p.x, (float)p.y, (float)p.z)) return 0;
     query.x = (float)p.x;
     query.y = (float)p.y;
     query.z = (float)p.z;

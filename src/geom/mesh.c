@@ -31,9 +31,10 @@ int dwvg_mesh_init(dwvg_mesh *mesh, uint32_t vertex_count, uint32_t triangle_cou
     mesh->positions[3u * nv] = 0.0f;
     for (size_t v = 0; v < nv; ++v) {
         double x = positions[3 * v], y = positions[3 * v + 1], z = positions[3 * v + 2];
-        mesh->positions[3 * v] = (float)(m[0] * x + m[1] * y + m[2] * z + m[3]);
-        mesh->positions[3 * v + 1] = (float)(m[4] * x + m[5] * y + m[6] * z + m[7]);
-        mesh->positions[3 * v + 2] = (float)(m[8] * x + m[9] * y + m[10] * z + m[11]);
+        double world[3] = {m[0] * x + m[1] * y + m[2] * z + m[3], m[4] * x + m[5] * y + m[6] * z + m[7],
+                           m[8] * x + m[9] * y + m[10] * z + m[11]};
+        for (int k = 0; k < 3; ++k)
+            mesh->positions[3 * v + (size_t)k] = fabs(world[k]) <= DWVG_LARGEST_COORDINATE ? (float)world[k] : NAN;
     }
     double det = dwvg_transform_determinant(m);
     /* A mirroring transform (det < 0) turns counter-clockwise into clockwise: swap two corners so

@@ -10,9 +10,17 @@
  * primitive ids and the byte sizes fit comfortably in size_t. */
 #define DWVG_MAX_MESH_ELEMENTS (1u << 28)
 
+/* The largest world coordinate a triangle may have. Embree intersects in float with products of
+ * three coordinate differences (edge x edge . (corner - origin)), which overflow beyond about
+ * 3e12: rays then pass through or meet the wrong face (measured: a box scaled 3e12 bakes wrong,
+ * 1e12 right). A world coordinate beyond 2^40 (1.1e12), or one that overflows, is stored as NaN:
+ * Embree leaves out every triangle touching it, and the scene counts those as warnings. */
+#define DWVG_LARGEST_COORDINATE 0x1p40
+
 typedef struct dwvg_mesh {
     uint32_t vertex_count, triangle_count, material_id;
-    float *positions;  /* 3 x vertex_count, world space (plus one float of padding for Embree) */
+    float *positions;  /* 3 x vertex_count, world space (plus one float of padding for Embree);
+                          NaN beyond DWVG_LARGEST_COORDINATE */
     uint32_t *indices; /* 3 x triangle_count, counter-clockwise seen from outside (Blender's
                           convention), the order reversed when the transform mirrors */
     float *normals;    /* 3 x vertex_count, world space, unit; NULL: flat shading */

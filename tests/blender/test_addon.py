@@ -213,6 +213,112 @@ class AddonTest(harness.unittest.TestCase):
         result, error = harness.call_operator()
         self.assertEqual(result, {'FINISHED'}, error)
 
+    def test_output_dir_is_a_file(self):
+        small_slab()
+        existing = WORK / "not_a_folder.txt"
+        existing.write_text("a file where the output folder should be")
+        self.assertFails("output folder", output_dir=str(existing))
+        self.assertEqual(existing.read_text(), "a file where the output folder should be")
+
+    def test_library_path_not_a_library(self):
+        """A text file, and a folder, given as the library: refused with a message."""
+        small_slab()
+        prefs = bpy.context.preferences.addons["dwivedi_bake"].preferences
+        text = WORK / "libdwivedi.so.1"
+        text.write_text("not a shared object")
+        try:
+            for path in (text, WORK):
+                prefs.library_path = str(path)
+                error = self.assertFails(str(path))
+                self.assertTrue("cannot be loaded" in error or "not a file" in error, error)
+        finally:
+            prefs.library_path = ""
+
+    def test_non_mesh_objects_in_the_scene(self):
+        """Objects that are not geometry (an empty, a lattice, an armature, a speaker, a light
+        probe, a grease pencil, a volume, a curve without bevel, a second camera) are left out,
+        with a warning for those that would render; the bake finishes."""
+        scene = small_slab()
+        collection = scene.collection
+
+        def add(name, data):
+            obj = bpy.data.objects.new(name, data)
+            collection.objects.link(obj)
+            return obj
+
+        add("Empty", None)
+        add("Lattice", bpy.data.lattices.new("Lattice"))
+        add("Armature", bpy.data.armatures.new("Armature"))
+        add("Speaker", bpy.data.speakers.new("Speaker"))
+        add("Probe", bpy.data.lightprobes.new("Probe", 'CUBE'))
+        add("Pencil", bpy.data.grease_pencils.new("Pencil"))
+        add("Volume", bpy.data.volumes.new("Volume"))
+        curve = bpy.data.curves.new("Wire", 'CURVE')
+        spline = curve.splines.new('POLY')
+        spline.points.add(1)
+        spline.points[1].co = (1.0, 0.0, 0.0, 1.0)
+        add("Wire", curve)
+        add("Camera 2", bpy.data.cameras.new("Camera 2"))
+        module = sys.modules["dwivedi_bake"]
+        exported = module.export.export_scene(bpy.context, scene.dwivedi_bake, module.shim())
+        try:
+            self.assertEqual(exported.mesh_count, 1, "only the slab is geometry")
+            left_out = [w for w in exported.warnings if "not geometry" in w]
+            self.assertEqual(len(left_out), 1, exported.warnings)
+            for name in ("Pencil", "Volume"):
+                self.assertIn(name, left_out[0])
+        finally:
+            exported.scene.close()
+        result, error = harness.call_operator()
+        self.assertEqual(result, {'FINISHED'}, error)
+        _, _, pixels = harness.image_pixels("Dwivedi Camera")
+        self.assertTrue(all(math.isfinite(v) for v in pixels))
+
+    def test_non_finite_vertex(self):
+        """A NaN vertex (Python can write one into a mesh) is refused with the library's message;
+        the same scene bakes again once it is fixed: Blender keeps running."""
+        small_slab()
+        mesh = bpy.data.objects["Slab"].data
+        kept = tuple(mesh.vertices[0].co)
+        mesh.vertices[0].co = (float("nan"), 0.0, 0.0)
+        mesh.update()
+        try:
+            self.assertFails("not finite")
+        finally:
+            mesh.vertices[0].co = kept
+            mesh.update()
+        result, error = harness.call_operator()
+        self.assertEqual(result, {'FINISHED'}, error)
+
+    def test_huge_coordinates(self):
+        """A slab scaled beyond what Embree intersects in float (2^40): left out by the library
+        (counted as warnings), the camera sees the world; the bake finishes with finite pixels."""
+        scene = small_slab()
+        slab = bpy.data.objects["Slab"]
+        slab.scale = (1e13, 1e13, 1e13)
+        result, error = harness.call_operator()
+        self.assertEqual(result, {'FINISHED'}, error)
+        _, _, pixels = harness.image_pixels("Dwivedi Camera")
+        self.assertTrue(all(math.isfinite(v) for v in pixels))
+        self.assertIn("geometry warnings", scene.dwivedi_bake.last_result)
+        slab.scale = (1.0, 1.0, 1.0)
+        result, error = harness.call_operator()
+        self.assertEqual(result, {'FINISHED'}, error)
+        self.assertNotIn("geometry warnings", scene.dwivedi_bake.last_result)
+
+    def test_failures_in_a_row_then_a_bake(self):
+        """Every refusal leaves Blender and the add-on usable: after each, a good bake finishes."""
+        scene = small_slab()
+        good = scene.dwivedi_bake.output_dir
+        self.assertFails("at least 1 sample", samples=0)
+        self.assertEqual(harness.call_operator(samples=4)[0], {'FINISHED'})
+        blocker = WORK / "a_file_again"
+        blocker.write_text("x")
+        self.assertFails("output folder", output_dir=str(blocker / "sub"))
+        self.assertEqual(harness.call_operator(output_dir=good)[0], {'FINISHED'})
+        self.assertFails("choose the object", target='UV', uv_object=None)
+        self.assertEqual(harness.call_operator(target='CAMERA')[0], {'FINISHED'})
+
     def test_unregister_and_register(self):
         bpy.ops.preferences.addon_disable(module="dwivedi_bake")
         self.assertFalse(hasattr(bpy.types.Scene, "dwivedi_bake"))

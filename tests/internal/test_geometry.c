@@ -110,14 +110,21 @@ static void test_warnings(void)
     CHECK(scene->warnings == 1, "one degenerate triangle, %llu warnings", (unsigned long long)scene->warnings);
     dwvb_scene_free(scene);
     /* Finite input that overflows float in world space: every triangle touching vertex 7 (the
-     * corner 1e30 x 1e10 away) becomes non-finite and is skipped by Embree, counted here. */
+     * corner 1e30 x 1e10 away) becomes non-finite and is skipped by Embree, counted here. The
+     * other corners stay within 1e10, inside Embree's range (1.844e18). */
     test_mesh_free(&box);
     box = test_box(0, 0, 0, 1, 1, 1);
-    box.positions[21] = box.positions[22] = box.positions[23] = 1e10f;
-    static const double huge[12] = {1e30, 0, 0, 0, 0, 1e30, 0, 0, 0, 0, 1e30, 0};
+    box.positions[21] = box.positions[22] = box.positions[23] = 1e30f;
+    static const double huge[12] = {1e10, 0, 0, 0, 0, 1e10, 0, 0, 0, 0, 1e10, 0};
     scene = commit_meshes(&box, 1, huge);
     CHECK(scene->warnings == 6, "six triangles touch the overflowing corner, %llu warnings",
           (unsigned long long)scene->warnings);
+    dwvb_scene_free(scene);
+    /* Finite in float but beyond Embree's range: a box 1e30 across, all 12 triangles left out. */
+    static const double far[12] = {1e30, 0, 0, 0, 0, 1e30, 0, 0, 0, 0, 1e30, 0};
+    box.positions[21] = box.positions[22] = box.positions[23] = 1.0f;
+    scene = commit_meshes(&box, 1, far);
+    CHECK(scene->warnings == 12, "a box 1e30 across: %llu warnings, expected 12", (unsigned long long)scene->warnings);
     dwvb_scene_free(scene);
     test_mesh_free(&box);
 }
