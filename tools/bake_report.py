@@ -100,7 +100,11 @@ def write_markdown(path, figures, meta):
               "## Relative RMSE against run time", "",
               f"Against a {figures['reference_spp']} spp reference baked by `auto` with another seed "
               "(its own noise is included, so the curves flatten at its level). Efficiency is "
-              "1 / (relative RMSE^2 x seconds) of each technique's largest run.", "",
+              "1 / (relative RMSE^2 x seconds) of each technique's largest run. The relative RMSE is "
+              "over the R, G and B values of every pixel; the estimated error is the bake's own "
+              "estimate from its pixel variances (luminance of the covered pixels, no reference), so "
+              "it runs lower where the noise is coloured. `auto` picks per mesh, by a pilot, the "
+              "candidate of least variance x cost (docs/bake-engine.md).", "",
               "![relative RMSE against seconds](bake_rmse.png)", "",
               "| technique | spp | seconds | relative RMSE | estimated error | efficiency |",
               "|---|---|---|---|---|---|"]
