@@ -285,20 +285,38 @@ dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 h
         double ratio = walk->phase * (exited ? 1.0 : m->albedo[0]) / denominator;
         walk->weight[0] *= isfinite(ratio) ? ratio : 0.0;
     } else {
-        for (int cw = 0; cw < channels; ++cw) {
-            if (walk->weight[cw] == 0.0) continue;
-            double denominator = 0.0;
+        /* exp((sigma_c' - sigma_c s_k) t) = exp((r - sigma_c s_k) t) exp((sigma_c' - r) t): with r the
+         * smallest active sigma_c s_k, the sum D = sum_k,c Q_k p_k P_c pdist_{k,c} exp((r - sigma_c
+         * s_k) t) is shared by every channel c' (its largest term has exp(0) = 1 and nothing
+         * overflows), and each channel's ratio is f_c' exp((r - sigma_c') t) / D, which underflows
+         * to 0 only where the weight is negligible. The classical component (s = 1) reuses those
+         * channel factors, so a classical walk needs `channels` exponentials per event, a mixture
+         * `channels` more per guided component (components x channels^2 without the factoring). */
+        double rate = INFINITY;
+        for (int k = 0; k < components; ++k) {
+            if (!(qp[k] > 0.0)) continue;
+            for (int c = 0; c < channels; ++c)
+                if (walk->channel_p[c] > 0.0) rate = fmin(rate, m->sigma_t[c] * walk->component_stretch[k]);
+        }
+        double channel_factor[DWVW_MAX_CHANNELS], denominator = 0.0;
+        for (int c = 0; c < channels; ++c) channel_factor[c] = dwvk_exp_fast((rate - m->sigma_t[c]) * t);
+        if (rate < INFINITY) {
             for (int k = 0; k < components; ++k) {
                 if (!(qp[k] > 0.0)) continue;
+                double stretch = walk->component_stretch[k];
                 for (int c = 0; c < channels; ++c) {
                     if (!(walk->channel_p[c] > 0.0)) continue;
-                    double sigma = m->sigma_t[c] * walk->component_stretch[k];
+                    double sigma = m->sigma_t[c] * stretch;
                     double density = exited ? 1.0 : sigma;
-                    denominator += qp[k] * walk->channel_p[c] * density * dwvk_exp_fast((m->sigma_t[cw] - sigma) * t);
+                    double decay = stretch == 1.0 ? channel_factor[c] : dwvk_exp_fast((rate - sigma) * t);
+                    denominator += qp[k] * walk->channel_p[c] * density * decay;
                 }
             }
+        }
+        for (int cw = 0; cw < channels; ++cw) {
+            if (walk->weight[cw] == 0.0) continue;
             double f = walk->phase * (exited ? 1.0 : m->sigma_t[cw] * m->albedo[cw]);
-            double ratio = f / denominator;
+            double ratio = f * channel_factor[cw] / denominator;
             walk->weight[cw] *= isfinite(ratio) ? ratio : 0.0;
         }
     }
