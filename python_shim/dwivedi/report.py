@@ -1,4 +1,5 @@
 """The error-against-run-time report: python3 -m dwivedi.report --out DIR [--quick] [--no-cycles]
+[--sections v0,techniques,cycles] [--cycles-scenes slab,leaf,sphere] [--repeats N]
 
 Runs benchmark scenes through the shim and writes DIR/report.md, DIR/report.json and plots
 (matplotlib, Debian python3-matplotlib; without it the report has tables only):
@@ -19,6 +20,9 @@ Runs benchmark scenes through the shim and writes DIR/report.md, DIR/report.json
    two converged images are compared with each other. Scenes: the slab, a leaf-like thin sheet
    (high albedo, back-lit) and the sphere. Cycles' time is its
    render time minus that of a 1-sample render (scene sync), dwivedi's the bake's own seconds.
+   The two take turns over N timing rounds (--repeats, default 3) and each sample count keeps its
+   fastest time; at the counts both ran, the variance ratio per sample is reported apart, since
+   it does not depend on the machine's load.
 
 Timings are measured on whatever else runs on the machine: ratios within one run are fair,
 absolute seconds are not. Exit status 1 with a message on failure.
@@ -119,6 +123,8 @@ def default_scene() -> dwivedi.Scene:
 
 
 SCENES = {"default": default_scene, "slab": slab_scene, "sphere": sphere_scene}
+SECTIONS = ("v0", "techniques", "cycles")
+CYCLES_SCENES = ("slab", "leaf", "sphere")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -222,11 +228,7 @@ for name in args["scenes_list"]:
     ref_seconds = cycles(scene, ref_spp, 1234, f"{work}/{name}_ref.exr")
     ref = pixels_of(f"{work}/{name}_ref.exr")
     entry = {"reference_samples": ref_spp, "reference_seconds": ref_seconds, "sync_seconds": overhead,
-             "cycles": [], "dwivedi": []}
-    for spp in args["cycles_counts"]:
-        seconds = cycles(scene, spp, 7, f"{work}/{name}_c.exr")
-        entry["cycles"].append({"samples": spp, "seconds": max(seconds - overhead, 1e-3),
-                                "rmse": rmse(pixels_of(f"{work}/{name}_c.exr"), ref)})
+             "repeats": args["repeats"], "cycles": [], "dwivedi": []}
     exported = export.export_scene(bpy.context, Props, dwivedi)
     # dwivedi's own converged image (4x its largest count, another seed): its noise is measured
     # against it, as Cycles' is against Cycles' own; the two converged images are compared apart.
@@ -238,14 +240,33 @@ for name in args["scenes_list"]:
     entry["dwivedi_reference_seconds"] = own.stats.seconds
     entry["converged_rmse"] = rmse(own_ref, ref)
     entry["dwivedi_reference_mean_rgb"] = [sum(own_ref[c::4]) / (len(own_ref) // 4) for c in range(3)]
-    for spp in args["dwivedi_counts"]:
-        image = dwivedi.bake(exported.scene, width=exported.width, height=exported.height, samples=spp,
-                             threads=2, seed=7)
-        ours = flip(list(image.pixels()), image.width, image.height)
-        n = len(ours) // 4
-        entry["dwivedi"].append({"samples": spp, "seconds": image.stats.seconds, "rmse": rmse(ours, own_ref),
-                                 "rmse_against_cycles": rmse(ours, ref),
-                                 "mean_rgb": [sum(ours[c::4]) / n for c in range(3)]})
+    # Timings: both renderers take turns, `repeats` rounds, and each count keeps its fastest time
+    # (other load on the machine only ever adds time). Seeds are fixed, so every round makes the
+    # same images: the RMSE is taken from the first.
+    for turn in range(args["repeats"]):
+        if turn > 0:
+            overhead = min(overhead, cycles(scene, 1, 0, f"{work}/{name}_c1.exr"))
+        for i, spp in enumerate(args["cycles_counts"]):
+            seconds = cycles(scene, spp, 7, f"{work}/{name}_c.exr")
+            if turn == 0:
+                entry["cycles"].append({"samples": spp, "render_seconds": seconds,
+                                        "rmse": rmse(pixels_of(f"{work}/{name}_c.exr"), ref)})
+            else:
+                entry["cycles"][i]["render_seconds"] = min(entry["cycles"][i]["render_seconds"], seconds)
+        for i, spp in enumerate(args["dwivedi_counts"]):
+            image = dwivedi.bake(exported.scene, width=exported.width, height=exported.height, samples=spp,
+                                 threads=2, seed=7)
+            if turn == 0:
+                ours = flip(list(image.pixels()), image.width, image.height)
+                n = len(ours) // 4
+                entry["dwivedi"].append({"samples": spp, "seconds": image.stats.seconds, "rmse": rmse(ours, own_ref),
+                                         "rmse_against_cycles": rmse(ours, ref),
+                                         "mean_rgb": [sum(ours[c::4]) / n for c in range(3)]})
+            else:
+                entry["dwivedi"][i]["seconds"] = min(entry["dwivedi"][i]["seconds"], image.stats.seconds)
+    entry["sync_seconds"] = overhead
+    for point in entry["cycles"]:
+        point["seconds"] = max(point["render_seconds"] - overhead, 1e-3)
     n = len(ref) // 4
     entry["cycles_reference_mean_rgb"] = [sum(ref[c::4]) / n for c in range(3)]
     exported.scene.close()
@@ -256,7 +277,7 @@ with open(args["result"], "w") as f:
 '''
 
 
-def cycles_section(quick: bool, blender: str, size: int) -> Dict[str, Any]:
+def cycles_section(quick: bool, blender: str, size: int, scenes: Sequence[str], repeats: int) -> Dict[str, Any]:
     scenes_dir = SOURCE_DIR / "tests" / "blender"
     addon_dir = SOURCE_DIR / "blender_addon"
     if not (scenes_dir / "scenes.py").is_file() or not (addon_dir / "dwivedi_bake").is_dir():
@@ -264,7 +285,7 @@ def cycles_section(quick: bool, blender: str, size: int) -> Dict[str, Any]:
     with tempfile.TemporaryDirectory() as work:
         result_path = Path(work) / "result.json"
         args = {"shim": str(PACKAGE_DIR.parent), "addon": str(addon_dir), "scenes": str(scenes_dir), "work": work,
-                "result": str(result_path), "size": size, "scenes_list": ["slab", "leaf", "sphere"],
+                "result": str(result_path), "size": size, "scenes_list": list(scenes), "repeats": repeats,
                 # Counts large enough that Cycles' render time, not its per-render overhead, is
                 # what is measured.
                 "cycles_counts": [32, 128, 512] if quick else [64, 256, 1024],
@@ -308,20 +329,21 @@ def plots(out: Path, data: Dict[str, Any]) -> List[str]:
     except ImportError:
         return []
     made = []
-    v0 = data["v0"]
-    fig, ax = pyplot.subplots(figsize=(6, 4))
-    for method in dwivedi.methods():
-        if method == "exact":
-            continue
-        ax.loglog([1 - a for a in v0["albedo"]], [max(e, 1e-17) for e in v0[method]], marker=".", label=method)
-    ax.set_xlabel("1 - albedo")
-    ax.set_ylabel("relative error of kappa0")
-    ax.legend()
-    ax.grid(True, which="both", alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(out / "v0_methods.png", dpi=100)
-    pyplot.close(fig)
-    made.append("v0_methods.png")
+    if "v0" in data:
+        v0 = data["v0"]
+        fig, ax = pyplot.subplots(figsize=(6, 4))
+        for method in dwivedi.methods():
+            if method == "exact":
+                continue
+            ax.loglog([1 - a for a in v0["albedo"]], [max(e, 1e-17) for e in v0[method]], marker=".", label=method)
+        ax.set_xlabel("1 - albedo")
+        ax.set_ylabel("relative error of kappa0")
+        ax.legend()
+        ax.grid(True, which="both", alpha=0.3)
+        fig.tight_layout()
+        fig.savefig(out / "v0_methods.png", dpi=100)
+        pyplot.close(fig)
+        made.append("v0_methods.png")
     for name, entry in data.get("techniques", {}).items():
         fig, ax = pyplot.subplots(figsize=(6, 4))
         for technique, points in entry["techniques"].items():
@@ -356,12 +378,13 @@ def markdown(data: Dict[str, Any], made: List[str]) -> str:
              f"Made by `python3 -m dwivedi.report` on {data['date']} ({data['machine']}), library "
              f"{data['version']} ({data['library']}). Timings are ratios within this run; other load on the "
              "machine moves the absolute seconds.", ""]
-    lines += ["## v0 methods", "", "Largest relative error of kappa0 = 1/v0 against the exact root, albedo 0.01 to "
-              "1 - 10^-6:", "", "| method | largest relative error |", "|---|---|"]
-    for method in dwivedi.methods():
-        lines.append(f"| {method} | {max(data['v0'][method]):.3g} |")
-    if "v0_methods.png" in made:
-        lines += ["", "![v0 methods](v0_methods.png)"]
+    if "v0" in data:
+        lines += ["## v0 methods", "", "Largest relative error of kappa0 = 1/v0 against the exact root, albedo 0.01 "
+                  "to 1 - 10^-6:", "", "| method | largest relative error |", "|---|---|"]
+        for method in dwivedi.methods():
+            lines.append(f"| {method} | {max(data['v0'][method]):.3g} |")
+        if "v0_methods.png" in made:
+            lines += ["", "![v0 methods](v0_methods.png)"]
     if data.get("techniques"):
         lines += ["", "## Walk techniques, image RMSE against time", "",
                   "Each technique at growing samples per pixel (2 threads, seed 1); RMSE over the RGB pixels "
@@ -386,8 +409,10 @@ def markdown(data: Dict[str, Any], made: List[str]) -> str:
                   "noise is compared with noise; how far the two converged images lie apart is its own column "
                   "(Cycles stops walks at 256 bounces and loses energy where dwivedi does not, "
                   "docs/cycles_energy_loss.md). Cycles' seconds exclude its scene sync (a 1-sample render's "
-                  "time), dwivedi's are the bake's own (its auto pilot included). Speed-up = Cycles' time / "
-                  "dwivedi's time to reach the RMSE of dwivedi's second-largest bake (log-log interpolation).",
+                  "time), dwivedi's are the bake's own (its auto pilot included); both take turns over "
+                  f"{next(iter(data['cycles'].values())).get('repeats', 1)} timing round(s) and each count keeps "
+                  "its fastest time. Speed-up = Cycles' time / dwivedi's time to reach the RMSE of dwivedi's "
+                  "second-largest bake (log-log interpolation).",
                   "",
                   "| scene | converged Cycles mean RGB | converged dwivedi mean RGB | RMSE between converged | "
                   "target RMSE | Cycles s | dwivedi s | speed-up |", "|---|---|---|---|---|---|---|---|"]
@@ -401,6 +426,18 @@ def markdown(data: Dict[str, Any], made: List[str]) -> str:
                          f" | {entry['converged_rmse']:.3g} | {target:.4g} | {tc or math.nan:.3g} | "
                          f"{td or math.nan:.3g} | {speed} |")
             entry["speedup_at_rmse"] = {"rmse": target, "cycles_seconds": tc, "dwivedi_seconds": td}
+        lines += ["", "At equal samples per pixel the speed-up splits into variance per sample (independent of "
+                  "the machine's load) and time per sample:", "",
+                  "| scene | spp | Cycles RMSE | dwivedi RMSE | variance ratio Cycles / dwivedi | Cycles s | "
+                  "dwivedi s |", "|---|---|---|---|---|---|---|"]
+        for name, entry in data["cycles"].items():
+            ours = {p["samples"]: p for p in entry["dwivedi"]}
+            for theirs in entry["cycles"]:
+                if theirs["samples"] in ours:
+                    mine = ours[theirs["samples"]]
+                    lines.append(f"| {name} | {theirs['samples']} | {theirs['rmse']:.4g} | {mine['rmse']:.4g} | "
+                                 f"{(theirs['rmse'] / mine['rmse']) ** 2:.3g} | {theirs['seconds']:.3g} | "
+                                 f"{mine['seconds']:.3g} |")
         for name in data["cycles"]:
             if f"cycles_{name}.png" in made:
                 lines += ["", f"![{name} against Cycles](cycles_{name}.png)"]
@@ -417,24 +454,45 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
                         help="image width and height (default 32, quick 16; the Cycles part 48, quick 32)")
     parser.add_argument("--no-cycles", action="store_true", help="skip the comparison with Cycles")
     parser.add_argument("--blender", default=shutil.which("blender"), help="the Blender executable")
+    parser.add_argument("--sections", default=",".join(SECTIONS),
+                        help=f"which parts to run, comma-separated (default: {','.join(SECTIONS)})")
+    parser.add_argument("--cycles-scenes", default=",".join(CYCLES_SCENES),
+                        help=f"the scenes compared with Cycles, comma-separated (default: {','.join(CYCLES_SCENES)})")
+    parser.add_argument("--repeats", type=int, default=None,
+                        help="timing rounds against Cycles, each count keeping its fastest time (default 3, quick 1)")
     args = parser.parse_args(argv)
     size = args.size or (16 if args.quick else 32)
+    sections = [part for part in args.sections.split(",") if part]
+    cycles_scenes = [name for name in args.cycles_scenes.split(",") if name]
+    repeats = args.repeats if args.repeats is not None else (1 if args.quick else 3)
+    unknown = [part for part in sections if part not in SECTIONS] + [n for n in cycles_scenes if n not in CYCLES_SCENES]
+    if unknown or not sections or not cycles_scenes or not 1 <= repeats <= 100:
+        problem = (f"unknown section or scene {unknown[0]!r}" if unknown else "no section or scene given"
+                   if not sections or not cycles_scenes else f"--repeats {repeats} is outside 1 to 100")
+        print(f"dwivedi.report: {problem} (sections: {', '.join(SECTIONS)}; scenes: {', '.join(CYCLES_SCENES)})",
+              file=sys.stderr)
+        return 1
     try:
         args.out.mkdir(parents=True, exist_ok=True)
         data: Dict[str, Any] = {"date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
                                 "machine": f"{platform.machine()}, {os.cpu_count()} cores",
                                 "version": dwivedi.version(), "library": dwivedi.library_path(), "size": size}
-        print("v0 methods", file=sys.stderr, flush=True)
-        data["v0"] = v0_section(args.quick)
-        print("walk techniques", file=sys.stderr, flush=True)
-        data["techniques"] = technique_section(args.quick, size)
-        if args.no_cycles:
+        if "v0" in sections:
+            print("v0 methods", file=sys.stderr, flush=True)
+            data["v0"] = v0_section(args.quick)
+        if "techniques" in sections:
+            print("walk techniques", file=sys.stderr, flush=True)
+            data["techniques"] = technique_section(args.quick, size)
+        if "cycles" not in sections:
+            pass
+        elif args.no_cycles:
             data["cycles_skipped"] = "--no-cycles"
         elif not args.blender:
             data["cycles_skipped"] = "Blender was not found"
         else:
             print("Cycles", file=sys.stderr, flush=True)
-            data["cycles"] = cycles_section(args.quick, args.blender, args.size or (32 if args.quick else 48))
+            data["cycles"] = cycles_section(args.quick, args.blender, args.size or (32 if args.quick else 48),
+                                            cycles_scenes, repeats)
         made = plots(args.out, data)
         text = markdown(data, made)
         (args.out / "report.md").write_text(text)

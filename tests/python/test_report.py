@@ -37,6 +37,25 @@ class ReportTest(unittest.TestCase):
                 self.assertTrue((Path(tmp) / "v0_methods.png").is_file())
                 self.assertTrue((Path(tmp) / "rmse_slab.png").is_file())
 
+    def test_sections_alone_and_bad_choices(self):
+        env = {**os.environ, "PYTHONPATH": str(SOURCE_DIR / "python_shim")}
+        with tempfile.TemporaryDirectory() as tmp:
+            result = subprocess.run([sys.executable, "-m", "dwivedi.report", "--quick", "--sections", "v0",
+                                     "--out", tmp], capture_output=True, text=True, env=env, timeout=120)
+            self.assertEqual(result.returncode, 0, result.stderr[-2000:])
+            data = json.loads((Path(tmp) / "report.json").read_text())
+            self.assertIn("v0", data)
+            self.assertNotIn("techniques", data)
+            self.assertNotIn("## Walk techniques", (Path(tmp) / "report.md").read_text())
+            for bad, message in ((["--sections", "v0,walks"], "unknown section or scene 'walks'"),
+                                 (["--cycles-scenes", "cube"], "unknown section or scene 'cube'"),
+                                 (["--sections", ","], "no section or scene given"),
+                                 (["--repeats", "0"], "--repeats 0 is outside 1 to 100")):
+                result = subprocess.run([sys.executable, "-m", "dwivedi.report", "--out", tmp] + bad,
+                                        capture_output=True, text=True, env=env, timeout=60)
+                self.assertEqual(result.returncode, 1, bad)
+                self.assertIn(message, result.stderr)
+
     def test_bad_output_folder(self):
         with tempfile.TemporaryDirectory() as tmp:
             blocker = Path(tmp) / "file"
