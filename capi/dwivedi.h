@@ -421,7 +421,10 @@ enum {
      * subsurface_color, f = (1/pi) R_R (F_L + F_V + F_L F_V (R_R - 1)), with
      * F_x = (1 - cos theta_x)^5 (Schlick's weight; L the light, V the viewer, angles to the
      * shading normal) and R_R = roughness x (1 + L.V) (Burley 2015, "Extending the Disney BRDF
-     * to a BSDF with Integrated Subsurface Scattering", section 5.3). */
+     * to a BSDF with Integrated Subsurface Scattering", section 5.3). On a material without a
+     * walk (kind DWV_MATERIAL_DIFFUSE, or subsurface_weight 0) it selects Blender 3.x's Principled
+     * diffuse instead (Cycles' PRINCIPLED_DIFFUSE_FULL): base_color x (1/pi)
+     * ((1 - F_L/2)(1 - F_V/2) + R_R (F_L + F_V + F_L F_V (R_R - 1))). */
     DWV_SUBSURFACE_EXIT_PRINCIPLED_V1 = 1
 };
 

@@ -174,7 +174,8 @@ class Material:
                         roughness: float = 0.5) -> "Material":
         """The material of Blender 3.x's Principled inputs, mapped as Cycles 3.x does: the walk's
         albedo is mix(Base Color, Subsurface Color, Subsurface), its radius Subsurface Radius x
-        Subsurface, its exit "principled_v1" with Roughness; Subsurface = 0 is diffuse Base Color."""
+        Subsurface, its exit "principled_v1" with Roughness; Subsurface = 0 is Base Color with
+        Blender 3.x's Principled diffuse (Fresnel-weighted Lambertian plus retro-reflection)."""
         s = _real("subsurface", subsurface)
         base = real_tuple(base_color, "base_color", 3)
         sss = real_tuple(subsurface_color, "subsurface_color", 3)

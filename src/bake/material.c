@@ -58,19 +58,32 @@ double dwvb_principled_retro_factor(double cos_light, double cos_view, double li
     return rr * (fl + fv + fl * fv * (rr - 1.0));
 }
 
+double dwvb_principled_diffuse_factor(double cos_light, double cos_view, double light_dot_view, double roughness)
+{
+    double lambert = (1.0 - 0.5 * dwvb_schlick_weight(cos_light)) * (1.0 - 0.5 * dwvb_schlick_weight(cos_view));
+    return lambert + dwvb_principled_retro_factor(cos_light, cos_view, light_dot_view, roughness);
+}
+
 void dwvb_material_init(dwvb_material *out, const dwv_material_t *in)
 {
     out->subsurface = 0;
     out->grey = 0;
     out->principled_v1 = 0;
+    out->principled_diffuse = 0;
     out->roughness = 0.0;
     for (int c = 0; c < 3; ++c) {
         out->diffuse_albedo[c] = in->base_color[c];
         out->walk_scale[c] = 0.0;
         out->retro_albedo[c] = 0.0;
     }
+    double w = in->kind == DWV_MATERIAL_SUBSURFACE ? in->subsurface_weight : 0.0;
+    if (in->subsurface_exit == DWV_SUBSURFACE_EXIT_PRINCIPLED_V1 && !(w > 0.0)) {
+        /* Blender 3.x's Principled with Subsurface = 0: svm_node_closure_bsdf sets up its diffuse
+         * as PRINCIPLED_DIFFUSE_FULL (base colour x (Lambertian with both Fresnel terms + retro)). */
+        out->principled_diffuse = 1;
+        out->roughness = in->roughness;
+    }
     if (in->kind != DWV_MATERIAL_SUBSURFACE) return;
-    double w = in->subsurface_weight;
     if (in->subsurface_exit == DWV_SUBSURFACE_EXIT_PRINCIPLED_V1 && w > 0.0) {
         /* bssrdf_setup adds the retro-reflection BSDF with the BSSRDF's whole weight, before it
          * moves channels of too small a radius to a Lambertian BSDF: every channel has it. */

@@ -36,7 +36,9 @@ typedef struct dwvb_material {
     int principled_v1;         /* DWV_SUBSURFACE_EXIT_PRINCIPLED_V1: exit weighted by
                                   dwvb_principled_exit_factor, plus the retro-reflection lobe */
     double retro_albedo[3];    /* the retro-reflection lobe's weight (0 unless principled_v1) */
-    double roughness;          /* its roughness */
+    double roughness;          /* its roughness (principled_v1 or principled_diffuse) */
+    int principled_diffuse;    /* Blender 3.x Principled without subsurface: the diffuse lobe is
+                                  dwvb_principled_diffuse_factor's, not Lambertian */
     double diffuse_albedo[3];  /* the Lambertian lobe: (1 - w) base colour, plus w x subsurface
                                   colour in channels whose radius is below DWVB_MIN_RADIUS */
     double walk_scale[3];      /* w x Cycles' low-albedo compensation; 0 where a channel does not walk */
@@ -60,6 +62,11 @@ double dwvb_principled_exit_factor(double cos_light);
  * cos^2 of the half angle). Returns f pi for the light and view cosines to the shading normal and
  * L.V. */
 double dwvb_principled_retro_factor(double cos_light, double cos_view, double light_dot_view, double roughness);
+/* Blender 3.x Principled BSDF without subsurface (Subsurface = 0; Cycles'
+ * PRINCIPLED_DIFFUSE_FULL, bsdf_principled_diffuse.h): f = (1/pi) ((1 - F_L/2)(1 - F_V/2) + retro),
+ * the Lambertian part of Burley 2015 section 5.3 with both Fresnel terms, plus the
+ * retro-reflection lobe above. Returns f pi. */
+double dwvb_principled_diffuse_factor(double cos_light, double cos_view, double light_dot_view, double roughness);
 /* Derives the shading of a validated material. */
 void dwvb_material_init(dwvb_material *out, const dwv_material_t *in);
 

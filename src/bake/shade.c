@@ -82,6 +82,14 @@ static double retro_factor(const void *context, dwvw_vec3 light)
                                         lobe->roughness);
 }
 
+/* Blender 3.x Principled's diffuse without subsurface (both Fresnel terms and retro-reflection). */
+static double principled_diffuse_factor(const void *context, dwvw_vec3 light)
+{
+    const retro_lobe *lobe = context;
+    return dwvb_principled_diffuse_factor(dwvw_dot(lobe->n, light), lobe->cos_view, dwvw_dot(light, lobe->to_view),
+                                          lobe->roughness);
+}
+
 /* The exit weight of Blender 3.x's Principled BSDF; the context is the exit's shading normal. */
 static double exit_factor(const void *context, dwvw_vec3 light)
 {
@@ -120,6 +128,12 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, 
         double direct[3], retro[3];
         dwvl_direct_lobe(&shader->env, x, n, ng, sampler, pair + DWVB_SHADE_PAIRS, retro_factor, &lobe, direct, retro);
         for (int c = 0; c < 3; ++c) rgb[c] += material->diffuse_albedo[c] * direct[c] + material->retro_albedo[c] * retro[c];
+    } else if (material->principled_diffuse) {
+        retro_lobe lobe = {n, dwvw_scale(view, -1.0), -dwvw_dot(n, view), material->roughness};
+        double diffuse[3];
+        dwvl_direct_lobe(&shader->env, x, n, ng, sampler, pair + DWVB_SHADE_PAIRS, principled_diffuse_factor, &lobe,
+                         NULL, diffuse);
+        for (int c = 0; c < 3; ++c) rgb[c] += material->diffuse_albedo[c] * diffuse[c];
     } else if (material->diffuse_albedo[0] > 0.0 || material->diffuse_albedo[1] > 0.0 ||
                material->diffuse_albedo[2] > 0.0) {
         double direct[3];

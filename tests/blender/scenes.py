@@ -171,13 +171,16 @@ def sphere_scene(resolution=32, samples=256, shader='PRINCIPLED'):
     """A sphere of radius 1 m, smooth shaded, lit by a sun from the camera's side (45 degrees
     off the view axis), seen by a perspective camera. Radius (0.5, 0.25, 0.1) m (mean free
     paths 0.04, 0.02, 0.008 m), colour (0.9, 0.6, 0.4): thick front-lit wax-like. shader:
-    'PRINCIPLED' (Principled BSDF) or 'SSS' (the Subsurface Scattering node)."""
+    'PRINCIPLED' (Principled BSDF), 'SSS' (the Subsurface Scattering node) or 'DIFFUSE' (a
+    Principled BSDF without subsurface, roughness 1)."""
     scene = _reset()
     scene.render.resolution_x = resolution
     scene.render.resolution_y = resolution
     scene.cycles.samples = samples
     if shader == 'PRINCIPLED':
         material = principled_material("Wax", (0.9, 0.6, 0.4), (0.5, 0.25, 0.1))
+    elif shader == 'DIFFUSE':
+        material = diffuse_material("Clay", (0.9, 0.6, 0.4))
     else:
         material = sss_node_material("Wax", (0.9, 0.6, 0.4), (0.5, 0.25, 0.1))
     bpy.ops.mesh.primitive_uv_sphere_add(segments=48, ring_count=24, radius=1.0)

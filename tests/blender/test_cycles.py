@@ -101,15 +101,16 @@ def compare(name, build):
 
 
 class CyclesTest(harness.unittest.TestCase):
-    def check(self, figures, channels):
+    def check(self, figures, channels, per_pixel=True):
         for c in channels:
             cm = figures["cycles_mean_rgb"][c]
             om = figures["dwivedi_mean_rgb"][c]
             self.assertGreater(cm, 1e-3, f"channel {c} has signal in Cycles")
             self.assertLess(abs(om / cm - 1.0), MEAN_TOLERANCE,
                             f"channel {'RGB'[c]}: dwivedi {om:.5f} vs Cycles {cm:.5f}")
-            self.assertLess(figures["noise_ratio_rgb"][c], NOISE_RATIO_LIMIT,
-                            f"channel {'RGB'[c]}: per-pixel differences exceed the noise")
+            if per_pixel:
+                self.assertLess(figures["noise_ratio_rgb"][c], NOISE_RATIO_LIMIT,
+                                f"channel {'RGB'[c]}: per-pixel differences exceed the noise")
 
     def test_back_lit_slab(self):
         self.check(compare("slab", scenes.slab_scene), (0, 1, 2))
@@ -124,6 +125,16 @@ class CyclesTest(harness.unittest.TestCase):
     # the Principled walk has the plain Lambertian exit, which the add-on exports there).
     def test_front_lit_sphere_principled(self):
         self.check(compare("sphere_principled", scenes.sphere_scene), (0, 1, 2))
+
+    # Its diffuse without subsurface (Subsurface = 0) is Cycles' PRINCIPLED_DIFFUSE_FULL in 3.x:
+    # Fresnel-weighted Lambertian plus retro-reflection; at roughness 1 on this sphere it is 8%
+    # brighter than a plain Lambertian surface, so the 3% test on the means tells them apart.
+    # Means only: a noise-free diffuse surface shows, pixel by pixel, that Cycles also moves the
+    # shadow rays of smooth-shaded triangles near the terminator off the flat triangle (its
+    # "shadow terminator geometry offset"), which dwivedi does not model (docs/cycles-conventions.md).
+    def test_front_lit_sphere_principled_diffuse(self):
+        self.check(compare("sphere_diffuse", lambda r, s: scenes.sphere_scene(r, s, shader='DIFFUSE')), (0, 1, 2),
+                   per_pixel=False)
 
     def display_pngs(self):
         """Our display PNG and Blender's save_render of the same linear pixels (the add-on's float

@@ -120,6 +120,52 @@ static void test_retro_reflection(void)
     CHECK(dwvb_principled_retro_factor(0.2, 0.4, 0.1, 0.0) == 0.0, "0 for roughness 0");
 }
 
+/* The diffuse lobe without subsurface at normal view (F_V = 0, L.V = mu), roughness 1/2. */
+static double full_diffuse_of_mu(double mu)
+{
+    return dwvb_principled_diffuse_factor(mu, 1.0, mu, 0.5);
+}
+
+/* Principled v1 without subsurface: (1 - F_L/2)(1 - F_V/2) + retro against pow(), its albedo at
+ * normal view against the closed form, and which materials get it. */
+static void test_principled_diffuse(void)
+{
+    uint64_t state = 777u;
+    double worst = 0.0;
+    for (int i = 0; i < 10000; ++i) {
+        dwvw_vec3 l = upper(uniform(&state), uniform(&state)), v = upper(uniform(&state), uniform(&state));
+        double roughness = uniform(&state);
+        double fl = pow(1.0 - l.z, 5.0), fv = pow(1.0 - v.z, 5.0);
+        double want = (1.0 - 0.5 * fl) * (1.0 - 0.5 * fv) +
+                      dwvb_principled_retro_factor(l.z, v.z, dwvw_dot(l, v), roughness);
+        worst = fmax(worst, fabs(dwvb_principled_diffuse_factor(l.z, v.z, dwvw_dot(l, v), roughness) - want));
+    }
+    CHECK(worst < 1e-13, "Principled diffuse factor against pow(): off by %.3g", worst);
+    /* At normal view: 2 int mu ((1 - (1 - mu)^5 / 2) + r (1 + mu)(1 - mu)^5) dmu
+     * = 1 - 1/42 + 2 r (B(2, 6) + B(3, 6)) = 41/42 + 2 r (1/42 + 1/168) = 41/42 + 5 r / 84. */
+    double albedo = hemisphere_albedo(full_diffuse_of_mu), want = 41.0 / 42.0 + 5.0 * 0.5 / 84.0;
+    CHECK(fabs(albedo - want) < 1e-13, "Principled diffuse albedo at normal view %.17g, want %.17g", albedo, want);
+
+    dwv_material_t in = DWV_MATERIAL_INIT;
+    dwvb_material out;
+    in.subsurface_exit = DWV_SUBSURFACE_EXIT_PRINCIPLED_V1;
+    in.roughness = 0.25;
+    in.kind = DWV_MATERIAL_DIFFUSE;
+    dwvb_material_init(&out, &in);
+    CHECK(out.principled_diffuse && !out.subsurface && out.roughness == 0.25, "diffuse kind, Principled v1");
+    in.kind = DWV_MATERIAL_SUBSURFACE;
+    in.subsurface_weight = 0.0;
+    dwvb_material_init(&out, &in);
+    CHECK(out.principled_diffuse && !out.subsurface, "subsurface weight 0, Principled v1");
+    in.subsurface_weight = 1.0;
+    dwvb_material_init(&out, &in);
+    CHECK(!out.principled_diffuse && out.principled_v1 && out.subsurface, "a walking Principled v1 material");
+    in.subsurface_exit = DWV_SUBSURFACE_EXIT_LAMBERT;
+    in.kind = DWV_MATERIAL_DIFFUSE;
+    dwvb_material_init(&out, &in);
+    CHECK(!out.principled_diffuse && !out.principled_v1, "a Lambert-exit diffuse material stays Lambertian");
+}
+
 typedef struct fixed_normal {
     dwvw_vec3 n;
 } fixed_normal;
@@ -160,6 +206,7 @@ int main(void)
 {
     test_schlick_and_exit();
     test_retro_reflection();
+    test_principled_diffuse();
     test_direct_lobe();
     return check_report("test_principled_v1");
 }
