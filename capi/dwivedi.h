@@ -683,7 +683,8 @@ DWV_API dwv_result_t dwv_image_write_exr(const dwv_image_t *image, const char *p
 
 /* Blender's colour-management settings, applied through OpenColorIO: exposure (stops) in scene
  * linear, then the display/view/look transform, then gamma (display = display^(1/gamma)).
- * NULL strings mean the config's defaults ("" for look means none). The config comes from
+ * NULL strings mean the config's defaults ("" for look means none; "None", Blender's name for no
+ * look, means what NULL does unless the config has a look of that name). The config comes from
  * `config_path`, else $OCIO, else the small default config dwivedi ships (sRGB display with
  * "Standard" and a filmic view). */
 typedef struct dwv_display_options_t {

@@ -171,14 +171,16 @@ void to_display(const float *rgba, uint32_t width, uint32_t height, const dwv_di
         fail(DWV_ERROR_OUT_OF_RANGE, "exposure " + std::to_string(options->exposure) +
                                          " stops gives a gain outside the float range");
 
-    if (options->look) {
-        // NULL keeps the view's own looks (the config's default); "" means none; else one look.
+    // NULL keeps the view's own looks (the config's default); "" means none; else one look.
+    // "None" is Blender's name for no look (its look menu's first entry, not a look of the
+    // config): unless the config has a look of that name, it means what NULL does, as in Blender.
+    std::vector<std::string> looks;
+    for (int i = 0; i < config->getNumLooks(); ++i) looks.emplace_back(config->getLookNameByIndex(i));
+    const bool blender_none = options->look && std::string(options->look) == "None" &&
+                              std::find(looks.begin(), looks.end(), "None") == looks.end();
+    if (options->look && !blender_none) {
         std::string look = options->look;
-        if (!look.empty()) {
-            std::vector<std::string> looks;
-            for (int i = 0; i < config->getNumLooks(); ++i) looks.emplace_back(config->getLookNameByIndex(i));
-            require_name(looks, look, "look", in_config);
-        }
+        if (!look.empty()) require_name(looks, look, "look", in_config);
         pipeline->setLooksOverrideEnabled(true);
         pipeline->setLooksOverride(look.c_str());
     }

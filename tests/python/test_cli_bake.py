@@ -98,6 +98,18 @@ class BakeCli(unittest.TestCase):
         self.assertIn("No Such View", done.stderr)
         self.assertEqual(os.listdir(self.folder), [])
 
+    def test_look_none_is_blenders_no_look(self):
+        """Blender's look menu calls "no look" None: `--look None` bakes what no --look does."""
+        images = []
+        for extra in ([], ["--look", "None"]):
+            self.bake("--seed", "3", *extra)
+            with open(self.prefix + ".png", "rb") as handle:
+                images.append(handle.read())
+        self.assertEqual(images[0], images[1])
+        done = run_cli("bake", "--out", self.prefix, *SMALL, "--look", "none")  # names are case-sensitive
+        self.assertEqual(done.returncode, 1, done.stderr)
+        self.assertIn("none", done.stderr)
+
     def test_unwritable_folder_fails_cleanly(self):
         done = run_cli("bake", "--out", os.path.join(self.folder, "no", "such", "dir", "x"), *SMALL)
         self.assertEqual(done.returncode, 1, done.stderr)
