@@ -33,7 +33,6 @@ struct dwvb_bake {
     dwvb_shader shader;
     dwvw_guide *guides;
     int *needs_closest;
-    uint32_t *expected_exit; /* per mesh: events whose exit is scored in expectation (auto's pilot) */
     int *auto_choice; /* per mesh: auto's technique is chosen by the pilot (choose_auto) */
     uint32_t features;
     /* camera */
@@ -475,7 +474,6 @@ static void release_parts(dwvb_bake *bake)
 {
     free(bake->guides);
     free(bake->needs_closest);
-    free(bake->expected_exit);
     free(bake->auto_choice);
     free(bake->sums);
     free(bake->counts);
@@ -568,11 +566,6 @@ static void setup_guides(dwvb_bake *bake)
 #define PILOT_COST_SAMPLE 606.0
 #define PILOT_COST_EVENT 415.0
 #define PILOT_COST_TERM 18.4
-/* Per exit light evaluation of the expected-exit walk (dwvb_tally.gathers: the shading normal, a
- * light sample per light and a shadow ray where lit): taken as one event's cost (an event is
- * mostly its Embree ray, a gather mostly its shadow ray), not fitted; docs/speed.md, "Expected
- * exits", gives the timings. */
-#define PILOT_COST_GATHER PILOT_COST_EVENT
 /* Pilot samples per candidate: a sixteenth of the bake's samples, at most PILOT_MAX; below
  * PILOT_MIN the estimate is too noisy to act on and auto keeps its mixture. A mesh needs
  * PILOT_MESH_MIN of them to be decided. */
@@ -580,26 +573,16 @@ static void setup_guides(dwvb_bake *bake)
 #define PILOT_MIN 256u
 #define PILOT_MESH_MIN 64.0
 
-/* The candidates, in the order of the pilot (a tie keeps the earlier, cheaper one): classical,
- * guided and mixed directions scoring the exit the walk makes, then classical and guided
- * directions scoring the exit of the first PILOT_EXPECTED_EVENTS events in expectation
- * (run_walk_expected_exit in shade.c). */
-#define PILOT_CANDIDATES 5
-enum { PILOT_CLASSICAL = 0, PILOT_GUIDED = 1, PILOT_MIXTURE = 2, PILOT_EXIT_CLASSICAL = 3, PILOT_EXIT_GUIDED = 4 };
-#define PILOT_EXPECTED_EVENTS 1u
+/* The candidates, in the order of the pilot (a tie keeps the earlier, cheaper one). */
+#define PILOT_CANDIDATES 3
+enum { PILOT_CLASSICAL = 0, PILOT_GUIDED = 1, PILOT_MIXTURE = 2 };
 
-static uint32_t pilot_expected_exit(int candidate)
-{
-    return candidate >= PILOT_EXIT_CLASSICAL ? PILOT_EXPECTED_EVENTS : 0u;
-}
-
-/* Candidate `candidate`'s directions for mesh m, whose guide auto made (bake->guides[m]). */
+/* Candidate `candidate` for mesh m, whose guide auto made (bake->guides[m]). */
 static void pilot_guide(const dwvb_bake *bake, uint32_t m, int candidate, dwvw_guide *guide)
 {
     const dwvb_scene *scene = bake->scene;
     const dwvw_medium *medium = &scene->shading[scene->meshes[m].material_id].medium;
     *guide = bake->guides[m];
-    if (pilot_expected_exit(candidate)) candidate -= PILOT_EXIT_CLASSICAL;
     if (candidate == PILOT_CLASSICAL) dwvw_guide_init(guide, DWVW_CLASSICAL, medium, NULL, 0);
     else if (candidate == PILOT_GUIDED && guide->q_incident > 0.0)
         dwvw_guide_init(guide, DWVW_INCIDENT, medium, scene->patches[m], scene->patch_count[m]);
@@ -663,7 +646,7 @@ static void *pilot_worker(void *arg)
                 p->sum += l;
                 p->sum_squares += l * l;
                 p->cost += PILOT_COST_SAMPLE + PILOT_COST_EVENT * (double)tally.events +
-                           PILOT_COST_TERM * (double)tally.mixture_terms + PILOT_COST_GATHER * (double)tally.gathers;
+                           PILOT_COST_TERM * (double)tally.mixture_terms;
             }
         }
     }
@@ -711,12 +694,10 @@ static int choose_auto(dwvb_bake *bake)
     uint32_t n = budget < PILOT_MAX ? (uint32_t)budget : PILOT_MAX;
     dwvw_guide *trial = malloc(PILOT_CANDIDATES * (size_t)meshes * sizeof *trial);
     int *trial_closest = malloc(PILOT_CANDIDATES * (size_t)meshes * sizeof *trial_closest);
-    uint32_t *trial_exit = malloc(PILOT_CANDIDATES * (size_t)meshes * sizeof *trial_exit);
     pilot_sums *sums = calloc(PILOT_CANDIDATES * (size_t)meshes, sizeof *sums); /* [candidate][mesh] */
-    if (!trial || !trial_closest || !trial_exit || !sums) {
+    if (!trial || !trial_closest || !sums) {
         free(trial);
         free(trial_closest);
-        free(trial_exit);
         free(sums);
         return -1;
     }
@@ -724,17 +705,14 @@ static int choose_auto(dwvb_bake *bake)
     for (int candidate = 0; candidate < PILOT_CANDIDATES; ++candidate) {
         dwvw_guide *guides = &trial[(size_t)candidate * meshes];
         int *closest = &trial_closest[(size_t)candidate * meshes];
-        uint32_t *expected_exit = &trial_exit[(size_t)candidate * meshes];
         for (uint32_t m = 0; m < meshes; ++m) {
             if (bake->auto_choice[m]) pilot_guide(bake, m, candidate, &guides[m]);
             else guides[m] = bake->guides[m];
             closest[m] = dwvw_guide_needs_closest(&guides[m]);
-            expected_exit[m] = bake->auto_choice[m] ? pilot_expected_exit(candidate) : bake->expected_exit[m];
         }
         shaders[candidate] = bake->shader;
         shaders[candidate].guides = guides;
         shaders[candidate].needs_closest = closest;
-        shaders[candidate].expected_exit = expected_exit;
     }
     int stopped = run_pilot(bake, shaders, n, sums);
     if (stopped == 0) {
@@ -759,13 +737,11 @@ static int choose_auto(dwvb_bake *bake)
             pilot_guide(bake, m, best, &chosen);
             bake->guides[m] = chosen;
             bake->needs_closest[m] = dwvw_guide_needs_closest(&chosen);
-            bake->expected_exit[m] = pilot_expected_exit(best);
         }
         update_features(bake);
     }
     free(trial);
     free(trial_closest);
-    free(trial_exit);
     free(sums);
     return stopped;
 }
@@ -805,7 +781,6 @@ dwv_result_t dwvb_bake_start(dwvb_scene *scene, const dwv_bake_options_t *option
     uint32_t meshes = scene->mesh_count ? scene->mesh_count : 1u;
     bake->guides = calloc(meshes, sizeof *bake->guides);
     bake->needs_closest = calloc(meshes, sizeof *bake->needs_closest);
-    bake->expected_exit = calloc(meshes, sizeof *bake->expected_exit);
     bake->auto_choice = calloc(meshes, sizeof *bake->auto_choice);
     bake->sums = calloc(pixels, sizeof *bake->sums);
     bake->counts = calloc(pixels, sizeof *bake->counts);
@@ -814,7 +789,7 @@ dwv_result_t dwvb_bake_start(dwvb_scene *scene, const dwv_bake_options_t *option
     bake->tile_seconds = calloc(bake->tile_count, sizeof *bake->tile_seconds);
     bake->tile_ranking = malloc(bake->tile_count * sizeof *bake->tile_ranking);
     bake->image = dwvb_image_new(bake->width, bake->height);
-    if (!bake->guides || !bake->needs_closest || !bake->expected_exit || !bake->auto_choice || !bake->sums || !bake->counts ||
+    if (!bake->guides || !bake->needs_closest || !bake->auto_choice || !bake->sums || !bake->counts ||
         !bake->tile_tallies || !bake->tile_order || !bake->tile_seconds || !bake->tile_ranking || !bake->image) {
         release_parts(bake);
         snprintf(message, size, "out of memory for a %u x %u bake", options->width, options->height);
@@ -841,7 +816,6 @@ dwv_result_t dwvb_bake_start(dwvb_scene *scene, const dwv_bake_options_t *option
     bake->shader.env.geometry = scene->mesh_count ? &scene->geometry : NULL;
     bake->shader.guides = bake->guides;
     bake->shader.needs_closest = bake->needs_closest;
-    bake->shader.expected_exit = bake->expected_exit;
     bake->shader.max_events = options->max_events;
     clock_gettime(CLOCK_MONOTONIC, &bake->start);
     if (pthread_create(&bake->control, NULL, control, bake) != 0) {

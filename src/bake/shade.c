@@ -67,156 +67,6 @@ static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvb_materia
     return walk->status == DWVW_EXITED;
 }
 
-/* The exit weight of Blender 3.x's Principled BSDF; the context is the exit's shading normal. */
-static double exit_factor(const void *context, dwvw_vec3 light);
-
-/* What an exit at point y of triangle `prim` (barycentrics u, v; outward geometric normal ng)
- * of mesh `mesh` gathers per unit walk weight: the direct light through a Lambertian exit, or
- * Principled v1's exit weight 1 - F_L/2; the light pairs of `sampler` from `pair` on. */
-static void gather_exit(const dwvb_shader *shader, const dwvg_mesh *mesh, const dwvb_material *material,
-                        uint32_t prim, double u, double v, dwvw_vec3 y, dwvw_vec3 ng, const dwvk_sampler *sampler,
-                        uint32_t pair, double direct[3])
-{
-    dwvw_vec3 n = dwvg_shading_normal(mesh, prim, u, v, ng);
-    if (material->principled_v1)
-        dwvl_direct_lobe(&shader->env, y, n, ng, sampler, pair, exit_factor, &n, NULL, direct);
-    else
-        dwvl_direct(&shader->env, y, n, ng, sampler, pair, direct);
-}
-
-/* Whether any light might reach a surface point with outward geometric normal ng: dwvl_direct
- * takes only directions above the geometric surface, so a sun of angular radius h lights no point
- * whose normal is more than 90 degrees + h from it, and a sphere light none whose tangent plane
- * it lies below. Area lights and a lit world are taken as reaching everywhere. */
-static int may_be_lit(const dwvl_environment *env, dwvw_vec3 y, dwvw_vec3 ng)
-{
-    if (env->world_lit) return 1;
-    for (uint32_t i = 0; i < env->light_count; ++i) {
-        const dwvl_light *light = &env->lights[i];
-        if (light->kind == DWV_LIGHT_SUN) {
-            double omc = light->one_minus_cos_half;
-            if (dwvw_dot(ng, light->direction) > -sqrt(omc * (2.0 - omc))) return 1;
-        } else if (light->kind == DWV_LIGHT_POINT) {
-            if (dwvw_dot(ng, dwvw_sub(light->position, y)) > -light->radius) return 1;
-        } else {
-            return 1;
-        }
-    }
-    return 0;
-}
-
-/* Adds the expected exit of the pending step of `walk` (direction sampled, ray cast: the surface
- * at hit, y) to rgb: factor x walk_scale x C(y), gathered only where light may reach y, and with
- * Russian roulette (uniform u) where the largest channel's factor is below the threshold. */
-static void score_exit(const dwvb_shader *shader, const dwvg_mesh *m, const dwvb_material *material,
-                       const dwvw_walk *walk, const dwvg_hit *hit, dwvw_vec3 normal, double u,
-                       const dwvk_sampler *sampler, uint32_t light_pair, double rgb[3], dwvb_tally *tally)
-{
-    const int grey = material->medium.channels == 1;
-    dwvw_vec3 y = dwvw_madd(walk->position, walk->direction, hit->t);
-    double factor[DWVW_MAX_CHANNELS];
-    dwvw_walk_exit_factor(walk, hit->t, factor);
-    double largest = 0.0;
-    for (int c = 0; c < material->medium.channels; ++c) largest = fmax(largest, factor[c]);
-    if (!(largest > 0.0) || !may_be_lit(&shader->env, y, normal)) return;
-    if (largest < DWVB_EXIT_ROULETTE_THRESHOLD) {
-        double keep = largest / DWVB_EXIT_ROULETTE_THRESHOLD;
-        if (!(u < keep)) return;
-        for (int c = 0; c < material->medium.channels; ++c) factor[c] /= keep;
-    }
-    double direct[3];
-    gather_exit(shader, m, material, hit->prim, hit->u, hit->v, y, normal, sampler, light_pair, direct);
-    ++tally->gathers;
-    for (int c = 0; c < 3; ++c) rgb[c] += factor[grey ? 0 : c] * material->walk_scale[c] * direct[c];
-}
-
-/* The ray along walk->direction to the surface, up to tfar; at the first step a hit on the entry
- * triangle is rounding and the ray goes on past it (as run_walk's probe). 0 where it meets
- * nothing, -1 on a degenerate triangle, else 1 with the hit and its outward geometric normal. */
-static int surface_along(const dwvb_shader *shader, uint32_t mesh, const dwvw_walk *walk, int first,
-                         uint32_t entry_prim, double tfar, dwvg_hit *hit, dwvw_vec3 *normal)
-{
-    const dwvg_world *world = &shader->scene->geometry;
-    double tnear = 0.0;
-    int found;
-    for (;;) {
-        found = dwvg_intersect_mesh(world, mesh, walk->position, walk->direction, tnear, tfar, hit);
-        if (!(found && first && hit->prim == entry_prim)) break;
-        tnear = nextafterf((float)hit->t, INFINITY);
-    }
-    *normal = dwvw_v(0.0, 0.0, 0.0);
-    if (!found) return 0;
-    *normal = dwvg_geometric_normal(&shader->scene->meshes[mesh], hit->prim);
-    return normal->x == 0.0 && normal->y == 0.0 && normal->z == 0.0 ? -1 : 1;
-}
-
-/* The walk of run_walk (the same steps and numbers), its exit scored in expectation at the first
- * `expected_events` events (dwvw_walk_exit_factor): at such an event the ray along the sampled
- * direction runs on to the reach (DWVB_EXIT_REACH mean free paths of the thinnest channel) or
- * the sampled flight if longer; where it meets the surface within the reach, the exit point y
- * adds factor x walk_scale x C(y) to rgb (score_exit) and the flight is drawn again inside
- * (dwvw_walk_stay_inside, the weight cut by the chance of leaving), so no walk leaves there.
- * Elsewhere (later events, or a surface beyond the reach: a choice made from the direction alone,
- * which keeps the expectation) the step is run_walk's and a flight that reaches the surface leaves
- * and gathers as in dwvb_shade. An expected exit's light C(y) uses the exit's light pairs
- * (`light_pair` on) like a sampled exit: each term keeps its expectation; the terms of one walk
- * share those numbers. */
-static void run_walk_expected_exit(const dwvb_shader *shader, uint32_t mesh, const dwvb_material *material,
-                                   uint32_t entry_prim, dwvw_vec3 x, dwvw_vec3 direction, dwvw_vec3 entry_normal,
-                                   uint64_t key, uint32_t expected_events, const dwvk_sampler *sampler,
-                                   uint32_t light_pair, double rgb[3], dwvb_tally *tally)
-{
-    const dwvg_world *world = &shader->scene->geometry;
-    const dwvb_scene *scene = shader->scene;
-    const dwvg_mesh *m = &scene->meshes[mesh];
-    const dwvw_medium *medium = &material->medium;
-    const int grey = medium->channels == 1;
-    dwvw_walk walk;
-    dwvw_walk_begin(&walk, medium, &shader->guides[mesh], key, shader->max_events, x, direction, entry_normal);
-    int needs_closest = shader->needs_closest[mesh];
-    double sigma_min = medium->sigma_t[0];
-    for (int c = 1; c < medium->channels; ++c) sigma_min = fmin(sigma_min, medium->sigma_t[c]);
-    const double reach = DWVB_EXIT_REACH / sigma_min;
-    int first = 1;
-    while (walk.status == DWVW_RUNNING) {
-        if (needs_closest) {
-            dwvg_hit closest;
-            if (dwvg_closest_mesh(world, mesh, walk.position, &closest))
-                dwvw_walk_set_closest(&walk, dwvg_geometric_normal(m, closest.prim));
-        }
-        const uint32_t roulette_dim = dwvw_event_dim(walk.events) + DWVW_DIM_EXIT_ROULETTE;
-        double distance = dwvw_walk_sample(&walk);
-        tally->mixture_terms += mixture_terms(&walk);
-        int forced = walk.events < expected_events;
-        /* The first step's ray is run_walk's probe, uncut; a forced step's runs to the reach. */
-        double tfar = first ? INFINITY : forced ? fmax(distance, reach) : distance;
-        dwvg_hit hit;
-        dwvw_vec3 normal;
-        int found = surface_along(shader, mesh, &walk, first, entry_prim, tfar, &hit, &normal);
-        if (first && !found) ++tally->warnings;
-        first = 0;
-        if (found < 0) {
-            ++tally->warnings;
-            break;
-        }
-        if (found && forced && hit.t <= reach) {
-            score_exit(shader, m, material, &walk, &hit, normal, dwvk_rng_uniform_d(walk.key, roulette_dim), sampler,
-                       light_pair, rgb, tally);
-            dwvw_walk_stay_inside(&walk, hit.t);
-        }
-        dwvw_walk_complete(&walk, found ? hit.t : INFINITY, normal);
-        if (walk.status == DWVW_EXITED) {
-            double direct[3];
-            gather_exit(shader, m, material, hit.prim, hit.u, hit.v, walk.position, normal, sampler, light_pair, direct);
-            for (int c = 0; c < 3; ++c) rgb[c] += walk.weight[grey ? 0 : c] * material->walk_scale[c] * direct[c];
-        }
-    }
-    tally->events += walk.events;
-    ++tally->walks;
-    if (walk.status == DWVW_TRUNCATED)
-        for (int c = 0; c < 3; ++c) tally->truncated[c] += walk.weight[grey ? 0 : c] * material->walk_scale[c];
-}
-
 /* The retro-reflection lobe of Blender 3.x's Principled BSDF at a surface point. */
 typedef struct retro_lobe {
     dwvw_vec3 n;       /* shading normal */
@@ -232,6 +82,7 @@ static double retro_factor(const void *context, dwvw_vec3 light)
                                         lobe->roughness);
 }
 
+/* The exit weight of Blender 3.x's Principled BSDF; the context is the exit's shading normal. */
 static double exit_factor(const void *context, dwvw_vec3 light)
 {
     const dwvw_vec3 *n = context;
@@ -283,20 +134,19 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, 
     double mu = sqrt(u[0]);
     dwvw_vec3 inward = dwvw_direction_about(dwvw_scale(n, -1.0), mu, 1.0 - mu, 1.0 + mu, u[1]);
     if (!(dwvw_dot(inward, ng) < 0.0)) return;
-    if (shader->expected_exit && shader->expected_exit[hit->mesh] > 0u) {
-        run_walk_expected_exit(shader, hit->mesh, material, hit->prim, x, inward, n, key_walk,
-                               shader->expected_exit[hit->mesh], sampler, pair + DWVB_SHADE_PAIRS + light_pairs, rgb,
-                               tally);
-        return;
-    }
     dwvw_walk walk;
     dwvg_hit exit = {0};
     if (!run_walk(shader, hit->mesh, material, hit->prim, x, inward, n, key_walk, &walk, &exit,
                   tally))
         return;
+    dwvw_vec3 exit_ng = walk.exit_normal;
+    dwvw_vec3 exit_n = dwvg_shading_normal(mesh, exit.prim, exit.u, exit.v, exit_ng);
     double direct[3];
-    gather_exit(shader, mesh, material, exit.prim, exit.u, exit.v, walk.position, walk.exit_normal, sampler,
-                pair + DWVB_SHADE_PAIRS + light_pairs, direct);
+    if (material->principled_v1)
+        dwvl_direct_lobe(&shader->env, walk.position, exit_n, exit_ng, sampler, pair + DWVB_SHADE_PAIRS + light_pairs,
+                         exit_factor, &exit_n, NULL, direct);
+    else
+        dwvl_direct(&shader->env, walk.position, exit_n, exit_ng, sampler, pair + DWVB_SHADE_PAIRS + light_pairs, direct);
     int grey = material->medium.channels == 1;
     for (int c = 0; c < 3; ++c) rgb[c] += walk.weight[grey ? 0 : c] * material->walk_scale[c] * direct[c];
 }

@@ -20,9 +20,6 @@ typedef struct dwvb_shader {
     dwvl_environment env;
     const dwvw_guide *guides;     /* per mesh (used where its material scatters) */
     const int *needs_closest;     /* per mesh */
-    /* Per mesh: how many of a walk's first events score its exit in expectation (0: the walk
-     * scores only the exit it makes; see run_walk_expected_exit in shade.c). NULL: all 0. */
-    const uint32_t *expected_exit;
     uint32_t max_events;
 } dwvb_shader;
 
@@ -32,23 +29,11 @@ typedef struct dwvb_tally {
     /* Work the walks' mixtures did: per step, the components with weight > 0 times the channels
      * squared (the exponentials of the spectral MIS weight), plus the lit patches weighed. */
     uint64_t mixture_terms;
-    /* Exit light evaluations (direct lighting at a surface point the walk may leave by) made by
-     * the expected-exit walk at its events; a classical walk's one gather per exit is not
-     * counted here. */
-    uint64_t gathers;
     double truncated[3];
 } dwvb_tally;
 
 /* Pairs of random dimensions shading uses before direct lighting starts: the entry direction. */
 #define DWVB_SHADE_PAIRS 1u
-
-/* The expected-exit walk evaluates an exit's light only where the expected exit weight (largest
- * channel) is at least this, and below it with probability weight / threshold (Russian roulette,
- * reweighted by 1 / probability): an unbiased cap on the shadow rays of events deep inside. */
-#define DWVB_EXIT_ROULETTE_THRESHOLD 0.05
-/* How far (mean free paths of the thinnest channel) an expected-exit event looks for the surface:
- * beyond it the exit's chance is below exp(-8) = 3.4e-4, and the step is left as it was. */
-#define DWVB_EXIT_REACH 8.0
 
 /* The radiance leaving hit point `hit` along -view (view: unit direction of the ray that found
  * it, from the viewer). `sampler` drives entry and light sampling from pair `pair` on; key_walk

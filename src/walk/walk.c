@@ -250,54 +250,6 @@ double dwvw_walk_sample(dwvw_walk *walk)
     return walk->step_distance;
 }
 
-void dwvw_walk_exit_factor(const dwvw_walk *walk, double surface_distance, double factor[DWVW_MAX_CHANNELS])
-{
-    const dwvw_medium *m = walk->medium;
-    double p_dir = 0.0;
-    for (int k = 0; k < walk->component_count; ++k) p_dir += walk->component_q[k] * walk->component_pdf[k];
-    for (int c = 0; c < DWVW_MAX_CHANNELS; ++c) {
-        factor[c] = 0.0;
-        if (c >= m->channels || !(walk->weight[c] > 0.0) || !(p_dir > 0.0)) continue;
-        double f = walk->weight[c] * walk->phase * exp(-m->sigma_t[c] * surface_distance) / p_dir;
-        factor[c] = isfinite(f) ? f : 0.0;
-    }
-}
-
-double dwvw_walk_stay_inside(dwvw_walk *walk, double surface_distance)
-{
-    const dwvw_medium *m = walk->medium;
-    const int components = walk->component_count, channels = m->channels;
-    const uint32_t dim = dwvw_event_dim(walk->events);
-    /* stay[k][c] = r_k P_c (1 - exp(-sigma_c s_k s)), in the same order as pick() walks them. */
-    double stay[DWVW_MAX_COMPONENTS * DWVW_MAX_CHANNELS], p_dir = 0.0, p_stay = 0.0;
-    for (int k = 0; k < components; ++k) p_dir += walk->component_q[k] * walk->component_pdf[k];
-    for (int k = 0; k < components; ++k) {
-        double r = walk->component_q[k] * walk->component_pdf[k] / p_dir;
-        for (int c = 0; c < channels; ++c) {
-            double rate = m->sigma_t[c] * walk->component_stretch[k];
-            double q = r > 0.0 && walk->channel_p[c] > 0.0 ? r * walk->channel_p[c] * -expm1(-rate * surface_distance) : 0.0;
-            stay[k * channels + c] = q;
-            p_stay += q;
-        }
-    }
-    if (!(p_stay > 0.0)) {
-        /* Every flight leaves (the surface at distance 0): nothing stays inside. */
-        for (int c = 0; c < DWVW_MAX_CHANNELS; ++c) walk->weight[c] = 0.0;
-        walk->step_distance = 0.0;
-        return 1.0;
-    }
-    int chosen = pick(stay, components * channels, dwvk_rng_uniform_d(walk->key, dim + DWVW_DIM_CHANNEL));
-    int k = chosen / channels, c = chosen % channels;
-    double rate = m->sigma_t[c] * walk->component_stretch[k];
-    double u = dwvk_rng_uniform_d(walk->key, dim + DWVW_DIM_DISTANCE);
-    double t = -log1p(u * expm1(-rate * surface_distance)) / rate;
-    /* Rounding must not carry the flight onto the surface, where dwvw_walk_complete would exit. */
-    walk->step_distance = t < surface_distance ? t : nextafter(surface_distance, 0.0);
-    double p_exit = p_stay < 1.0 ? 1.0 - p_stay : 0.0;
-    for (int cw = 0; cw < channels; ++cw) walk->weight[cw] *= p_stay < 1.0 ? p_stay : 1.0;
-    return p_exit;
-}
-
 dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 hit_normal)
 {
     const dwvw_medium *m = walk->medium;

@@ -34,14 +34,13 @@
 /* Random-number dimensions of event e start at 2 + 6e (0 and 1 are the entry's): +0 the channel,
  * +1 the component (each drawn only where there is a choice), +2 the cosine and the azimuth (one
  * 64-bit draw, two 24-bit uniforms), +4 the distance, +5 the Russian roulette after the event;
- * +3 the expected-exit walk's roulette on the exit's light (src/bake/shade.c). */
+ * +3 is unused. */
 #define DWVW_DIMS_PER_EVENT 6
 #define DWVW_DIM_CHANNEL 0u
 #define DWVW_DIM_COMPONENT 1u
 #define DWVW_DIM_DIRECTION 2u
 #define DWVW_DIM_DISTANCE 4u
 #define DWVW_DIM_ROULETTE 5u
-#define DWVW_DIM_EXIT_ROULETTE 3u
 #define DWVW_ROULETTE_THRESHOLD 0.05
 
 typedef enum dwvw_technique {
@@ -138,41 +137,6 @@ double dwvw_walk_sample(dwvw_walk *walk);
  * answer (not cut at the sampled distance), which locates the opposite interface. Returns the
  * new status. */
 dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 hit_normal);
-
-/* The expected exit of the pending step (between dwvw_walk_sample and dwvw_walk_complete) whose
- * ray along walk->direction meets the surface at `surface_distance` (+INFINITY for none): per
- * channel c', the weight the walk would carry out through that point times the probability that
- * it leaves there, given the sampled direction w. factor[c'] = 0 beyond medium->channels.
- *
- * Derivation (Rao-Blackwellisation of the exit, Kahn 1954 "conditional Monte Carlo"): the step
- * draws w with pdf p_dir(w) = sum_k Q_k p_k(w) (the first step keeps the entry direction: every
- * p_k is 1, so p_dir = 1), then a channel c with probability P_c and a flight from the component
- * k that drew w. Given w the component is k with probability Q_k p_k(w) / p_dir(w), so the walk
- * leaves at s = surface_distance (flight >= s) with probability
- *     P(exit | w) = sum_k Q_k p_k(w) sum_c P_c exp(-sigma_c s_k s) / p_dir(w) = p / p_dir(w),
- * where p is the exit's pdf of dwvw_walk_complete, which multiplies the weight by f_c' / p with
- * f_c' = phase exp(-sigma_c' s). Hence
- *     E[weight on exit x 1{exit} | w] = weight_c' f_c' / p x p / p_dir(w)
- *                                     = weight_c' phase exp(-sigma_c' s) / p_dir(w),
- * which no longer depends on the mixture's distance pdfs. Scoring this at every step and
- * ending (without a score) the walks whose flight reaches the surface keeps every expectation:
- * the exit's light C(y) depends on w and y only, so E[score | w] = factor x C(y). */
-void dwvw_walk_exit_factor(const dwvw_walk *walk, double surface_distance, double factor[DWVW_MAX_CHANNELS]);
-
-/* Makes the pending step stay inside (survival biasing of the exit, the "no-leakage" walk of
- * neutron transport): given the sampled direction w whose ray meets the surface at
- * `surface_distance`, the flight is drawn again from its distribution given w cut to
- * [0, surface_distance), and every channel's weight is multiplied by 1 - P(exit | w) (see
- * dwvw_walk_exit_factor). Then dwvw_walk_complete(walk, surface_distance, ...) scatters with its
- * usual weight f / p. Why this keeps the expectation: given w the unmodified step scatters at t
- * with density g(t | w) = sum_k r_k sum_c P_c sigma_c s_k exp(-sigma_c s_k t), r_k = Q_k p_k(w) /
- * p_dir(w), and carries weight x f / p on; the cut flight has density g(t | w) / (1 - P(exit | w))
- * for t < s, so weight x (1 - P(exit | w)) x f / p has the same expectation over t, while the
- * exit is scored by its expectation (dwvw_walk_exit_factor). The cut flight picks (k, c) with
- * probability proportional to r_k P_c (1 - exp(-sigma_c s_k s)) (the channel's uniform, unused
- * otherwise: the channel drew no flight) and t from that exponential cut at s by inversion (the
- * distance's uniform). Returns P(exit | w). */
-double dwvw_walk_stay_inside(dwvw_walk *walk, double surface_distance);
 
 /* ---- the per-event pieces, shared by dwvw_walk_sample and the estimator's fast path ----------- */
 
