@@ -403,12 +403,20 @@ static dwv_result_t make_image(dwvb_bake *bake, double seconds)
         total.walks += bake->tile_tallies[t].walks;
         total.warnings += bake->tile_tallies[t].warnings;
         total.mixture_terms += bake->tile_tallies[t].mixture_terms;
+        total.rays += bake->tile_tallies[t].rays;
+        total.point_queries += bake->tile_tallies[t].point_queries;
+        total.ray_free_steps += bake->tile_tallies[t].ray_free_steps;
+        total.ray_free_misses += bake->tile_tallies[t].ray_free_misses;
         for (int c = 0; c < 3; ++c) total.truncated[c] += bake->tile_tallies[t].truncated[c];
     }
     st->technique = bake->options.technique;
     st->samples_per_pixel = largest;
     st->samples = samples;
     st->events = total.events;
+    image->rays = total.rays;
+    image->point_queries = total.point_queries;
+    image->ray_free_steps = total.ray_free_steps;
+    image->ray_free_misses = total.ray_free_misses;
     st->walks = total.walks;
     st->seconds = seconds;
     st->estimated_relative_error = bake->error;
