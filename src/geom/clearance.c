@@ -140,6 +140,55 @@ static void distance_line(double *values, size_t stride, uint32_t n, double *f, 
     }
 }
 
+/* Cell visits of marking every triangle's bounding box grown by `grow`. */
+static double cell_visits(const dwvg_clearance *grid, const dwvg_mesh *mesh, double grow)
+{
+    double visits = 0.0;
+    for (uint32_t t = 0; t < mesh->triangle_count; ++t) {
+        double tlo[3], thi[3];
+        if (!finite_triangle(mesh, t, tlo, thi)) continue;
+        double span = 1.0;
+        for (int a = 0; a < 3; ++a) {
+            uint32_t first, last;
+            cell_range(grid, a, tlo[a] - grow, thi[a] + grow, &first, &last);
+            span *= (double)(last - first + 1u);
+        }
+        visits += span;
+    }
+    return visits;
+}
+
+/* Lowers grid->lower to the centres' distances to triangle t, over its bounding box grown by
+ * `band`. */
+static void exact_near(dwvg_clearance *grid, const dwvg_mesh *mesh, uint32_t t, double band)
+{
+    double tlo[3], thi[3];
+    if (!finite_triangle(mesh, t, tlo, thi)) return;
+    const uint32_t *corner = mesh->indices + 3u * (size_t)t;
+    dwvw_vec3 p[3];
+    for (int k = 0; k < 3; ++k) {
+        const float *q = mesh->positions + 3u * (size_t)corner[k];
+        p[k] = dwvw_v(q[0], q[1], q[2]);
+    }
+    /* The distance to a triangle is at least that to its plane: a cheap test first. */
+    dwvw_vec3 e1 = dwvw_sub(p[1], p[0]), e2 = dwvw_sub(p[2], p[0]);
+    dwvw_vec3 n = dwvw_v(e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x);
+    double length = dwvw_length(n);
+    int flat = length > 0.0 && isfinite(length);
+    n = flat ? dwvw_scale(n, 1.0 / length) : dwvw_v(0.0, 0.0, 0.0);
+    uint32_t first[3], last[3];
+    for (int a = 0; a < 3; ++a) cell_range(grid, a, tlo[a] - band, thi[a] + band, &first[a], &last[a]);
+    for (uint32_t iz = first[2]; iz <= last[2]; ++iz)
+        for (uint32_t iy = first[1]; iy <= last[1]; ++iy)
+            for (uint32_t ix = first[0]; ix <= last[0]; ++ix) {
+                float *cell = &grid->lower[((size_t)iz * grid->n[1] + iy) * grid->n[0] + ix];
+                dwvw_vec3 centre = dwvg_clearance_centre(grid, ix, iy, iz);
+                if (flat && fabs(dwvw_dot(dwvw_sub(centre, p[0]), n)) >= *cell) continue;
+                double d = dwvg_triangle_distance(centre, p[0], p[1], p[2]);
+                if (d < *cell) *cell = float_below(d);
+            }
+}
+
 int dwvg_clearance_build(dwvg_clearance *grid, const dwvg_mesh *mesh, double cell_size)
 {
     memset(grid, 0, sizeof *grid);
@@ -159,7 +208,7 @@ int dwvg_clearance_build(dwvg_clearance *grid, const dwvg_mesh *mesh, double cel
         cells = 1.0;
         for (int a = 0; a < 3; ++a) cells *= floor((hi[a] - lo[a]) / h) + 3.0;
         if (cells <= DWVG_CLEARANCE_MAX_CELLS) break;
-        h *= 1.2599210498948732; /* 2^(1/3): halves the cells */
+        h *= 1.0594630943592953; /* 2^(1/12): a twelfth of the way to half the cells */
     }
     grid->cell = h;
     for (int a = 0; a < 3; ++a) {
@@ -167,19 +216,9 @@ int dwvg_clearance_build(dwvg_clearance *grid, const dwvg_mesh *mesh, double cel
         grid->origin[a] = lo[a] - h;
     }
     size_t count = (size_t)grid->n[0] * grid->n[1] * grid->n[2];
-    double visits = 0.0;
-    for (uint32_t t = 0; t < mesh->triangle_count; ++t) {
-        double tlo[3], thi[3];
-        if (!finite_triangle(mesh, t, tlo, thi)) continue;
-        double span = 1.0;
-        for (int a = 0; a < 3; ++a) {
-            uint32_t first, last;
-            cell_range(grid, a, tlo[a], thi[a], &first, &last);
-            span *= (double)(last - first + 1u);
-        }
-        visits += span;
-    }
-    if (visits > MARK_VISITS_PER_CELL * (double)count) {
+    double band = BAND_CELLS * h;
+    int near_exact = cell_visits(grid, mesh, band) <= BAND_VISITS_PER_CELL * (double)count;
+    if (!near_exact && cell_visits(grid, mesh, 0.0) > MARK_VISITS_PER_CELL * (double)count) {
         memset(grid, 0, sizeof *grid);
         return 1;
     }
@@ -198,16 +237,30 @@ int dwvg_clearance_build(dwvg_clearance *grid, const dwvg_mesh *mesh, double cel
         return -1;
     }
     const uint32_t nx = grid->n[0], ny = grid->n[1], nz = grid->n[2];
-    for (size_t i = 0; i < count; ++i) squared[i] = INFINITY;
-    /* Every point of a triangle lies in its bounding box, whose cells are all marked. */
-    for (uint32_t t = 0; t < mesh->triangle_count; ++t) {
-        double tlo[3], thi[3];
-        if (!finite_triangle(mesh, t, tlo, thi)) continue;
-        uint32_t first[3], last[3];
-        for (int a = 0; a < 3; ++a) cell_range(grid, a, tlo[a], thi[a], &first[a], &last[a]);
-        for (uint32_t iz = first[2]; iz <= last[2]; ++iz)
-            for (uint32_t iy = first[1]; iy <= last[1]; ++iy)
-                for (uint32_t ix = first[0]; ix <= last[0]; ++ix) squared[((size_t)iz * ny + iy) * nx + ix] = 0.0;
+    /* A cell that meets a triangle has its centre within h sqrt(3)/2 of it. */
+    double half_diagonal = h * (0.8660254037844387 + 2.0 * CELL_SLACK);
+    if (near_exact) {
+        /* The centres' exact distances near the surface: min(band, the distance to each triangle
+         * whose bounding box grown by the band holds the centre; the others are farther). Cells
+         * whose centre lies within half a diagonal of the surface are the marked ones. */
+        for (size_t i = 0; i < count; ++i) grid->lower[i] = float_below(band);
+        for (uint32_t t = 0; t < mesh->triangle_count; ++t) exact_near(grid, mesh, t, band);
+        for (size_t i = 0; i < count; ++i) squared[i] = grid->lower[i] <= half_diagonal ? 0.0 : INFINITY;
+    } else {
+        /* Every point of a triangle lies in its bounding box, whose cells are all marked. */
+        for (size_t i = 0; i < count; ++i) {
+            squared[i] = INFINITY;
+            grid->lower[i] = 0.0f;
+        }
+        for (uint32_t t = 0; t < mesh->triangle_count; ++t) {
+            double tlo[3], thi[3];
+            if (!finite_triangle(mesh, t, tlo, thi)) continue;
+            uint32_t first[3], last[3];
+            for (int a = 0; a < 3; ++a) cell_range(grid, a, tlo[a], thi[a], &first[a], &last[a]);
+            for (uint32_t iz = first[2]; iz <= last[2]; ++iz)
+                for (uint32_t iy = first[1]; iy <= last[1]; ++iy)
+                    for (uint32_t ix = first[0]; ix <= last[0]; ++ix) squared[((size_t)iz * ny + iy) * nx + ix] = 0.0;
+        }
     }
     for (uint32_t iz = 0; iz < nz; ++iz)
         for (uint32_t iy = 0; iy < ny; ++iy) distance_line(&squared[((size_t)iz * ny + iy) * nx], 1u, nx, f, v, z);
@@ -215,60 +268,12 @@ int dwvg_clearance_build(dwvg_clearance *grid, const dwvg_mesh *mesh, double cel
         for (uint32_t ix = 0; ix < nx; ++ix) distance_line(&squared[(size_t)iz * ny * nx + ix], nx, ny, f, v, z);
     for (uint32_t iy = 0; iy < ny; ++iy)
         for (uint32_t ix = 0; ix < nx; ++ix) distance_line(&squared[(size_t)iy * nx + ix], (size_t)nx * ny, nz, f, v, z);
-    /* The bound at a cell centre from the transform: D - h sqrt(3)/2 (the farthest a surface point
-     * in a marked cell is from that cell's centre), less the slack. */
-    double half_diagonal = h * (0.8660254037844387 + 2.0 * CELL_SLACK);
-    for (size_t i = 0; i < count; ++i) squared[i] = sqrt(squared[i]) * h - half_diagonal;
-    /* Near the surface that loses a cell or more, where steps are short: there the centres' exact
-     * distances, min(BAND, distance to each triangle whose box grown by BAND holds the centre)
-     * (a triangle whose grown box misses the centre is farther than BAND), where that work is
-     * bounded. */
-    double band = BAND_CELLS * h;
-    visits = 0.0;
-    for (uint32_t t = 0; t < mesh->triangle_count; ++t) {
-        double tlo[3], thi[3];
-        if (!finite_triangle(mesh, t, tlo, thi)) continue;
-        double span = 1.0;
-        for (int a = 0; a < 3; ++a) {
-            uint32_t first, last;
-            cell_range(grid, a, tlo[a] - band, thi[a] + band, &first, &last);
-            span *= (double)(last - first + 1u);
-        }
-        visits += span;
-    }
-    int near_exact = visits <= BAND_VISITS_PER_CELL * (double)count;
-    for (size_t i = 0; i < count; ++i) grid->lower[i] = near_exact ? float_below(band) : 0.0f;
-    for (uint32_t t = 0; near_exact && t < mesh->triangle_count; ++t) {
-        double tlo[3], thi[3];
-        if (!finite_triangle(mesh, t, tlo, thi)) continue;
-        const uint32_t *corner = mesh->indices + 3u * (size_t)t;
-        dwvw_vec3 p[3];
-        for (int k = 0; k < 3; ++k) {
-            const float *q = mesh->positions + 3u * (size_t)corner[k];
-            p[k] = dwvw_v(q[0], q[1], q[2]);
-        }
-        /* The distance to a triangle is at least that to its plane: a cheap test first. */
-        dwvw_vec3 e1 = dwvw_sub(p[1], p[0]), e2 = dwvw_sub(p[2], p[0]);
-        dwvw_vec3 n = dwvw_v(e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x);
-        double length = dwvw_length(n);
-        int flat = length > 0.0 && isfinite(length);
-        n = flat ? dwvw_scale(n, 1.0 / length) : dwvw_v(0.0, 0.0, 0.0);
-        uint32_t first[3], last[3];
-        for (int a = 0; a < 3; ++a) cell_range(grid, a, tlo[a] - band, thi[a] + band, &first[a], &last[a]);
-        for (uint32_t iz = first[2]; iz <= last[2]; ++iz)
-            for (uint32_t iy = first[1]; iy <= last[1]; ++iy)
-                for (uint32_t ix = first[0]; ix <= last[0]; ++ix) {
-                    float *cell = &grid->lower[((size_t)iz * ny + iy) * nx + ix];
-                    dwvw_vec3 centre = dwvg_clearance_centre(grid, ix, iy, iz);
-                    if (flat && fabs(dwvw_dot(dwvw_sub(centre, p[0]), n)) >= *cell) continue;
-                    double d = dwvg_triangle_distance(centre, p[0], p[1], p[2]);
-                    if (d < *cell) *cell = float_below(d);
-                }
-    }
-    /* The centre's distance is exact to rounding: the slack covers the centre's own. */
+    /* The bound at a centre: the larger of the transform's, D - h sqrt(3)/2 (the farthest a surface
+     * point in a marked cell is from that cell's centre), and the exact distance (to rounding: the
+     * slack covers the centre's own), rounded down to float. */
     double slack = CELL_SLACK * h;
     for (size_t i = 0; i < count; ++i)
-        grid->lower[i] = fmaxf(float_below(squared[i]), float_below((double)grid->lower[i] - slack));
+        grid->lower[i] = fmaxf(float_below(sqrt(squared[i]) * h - half_diagonal), float_below((double)grid->lower[i] - slack));
     free(squared);
     free(f);
     free(z);
