@@ -417,6 +417,7 @@ static dwv_result_t make_image(dwvb_bake *bake, double seconds)
     image->point_queries = total.point_queries;
     image->ray_free_steps = total.ray_free_steps;
     image->ray_free_misses = total.ray_free_misses;
+    image->mixture_terms = total.mixture_terms;
     st->walks = total.walks;
     st->seconds = seconds;
     st->estimated_relative_error = bake->error;

@@ -18,8 +18,9 @@ typedef struct dwvb_image {
     dwv_error_point_t *error_vs_time;  /* one point per completed pass; may be NULL if count is 0 */
     uint32_t error_vs_time_capacity;
     /* The walks' work beyond the public stats (dwvb_tally): rays, closest-point queries, ray-free
-     * steps and, in checked ball mode, ray-free steps whose ray met the surface. */
-    uint64_t rays, point_queries, ray_free_steps, ray_free_misses;
+     * steps, in checked ball mode the ray-free steps whose ray met the surface, and mixture terms
+     * (what the auto pilot's cost model counts). */
+    uint64_t rays, point_queries, ray_free_steps, ray_free_misses, mixture_terms;
 } dwvb_image;
 
 /* A zeroed image of the given size with reference count 1 (stats zeroed but struct_size set),

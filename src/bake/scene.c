@@ -198,10 +198,11 @@ dwv_result_t dwvb_scene_commit(dwvb_scene *scene, char *message, size_t size)
         if (!material->subsurface) continue;
         features |= DWV_FEATURE_SUBSURFACE;
         /* Ray-free walk steps (shade.c run_walk): cells of a quarter of the longest mean free
-         * path, or coarser within the grid's size limit. */
+         * path, or coarser within the grid's size limit, but no grid where its cells would exceed
+         * that path (a medium too thin for the grid to vouch for a step: the leaf). */
         double sigma_min = material->medium.sigma_t[0];
         for (int c = 1; c < material->medium.channels; ++c) sigma_min = fmin(sigma_min, material->medium.sigma_t[c]);
-        if (dwvg_world_build_clearance(&scene->geometry, m, 0.25 / sigma_min)) {
+        if (dwvg_world_build_clearance(&scene->geometry, m, 0.25 / sigma_min, 1.0 / sigma_min)) {
             snprintf(message, size, "out of memory while making the clearance grid of mesh %u", m);
             return uncommit(scene, DWV_ERROR_OUT_OF_MEMORY);
         }

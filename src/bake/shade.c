@@ -46,7 +46,7 @@ static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvb_materia
         double distance = dwvw_walk_sample(walk);
         tally->mixture_terms += mixture_terms(walk);
         int ray_free = 0;
-        if (!first && ball_mode != DWVB_BALL_OFF) {
+        if (!first && ball_mode != DWVB_BALL_OFF && (needs_closest || grid->lower)) {
             if (!needs_closest) clearance = dwvg_clearance_at(grid, walk->position);
             ray_free = distance < dwvg_clear_radius(world, walk->position, clearance);
         }

@@ -189,7 +189,7 @@ static void exact_near(dwvg_clearance *grid, const dwvg_mesh *mesh, uint32_t t, 
             }
 }
 
-int dwvg_clearance_build(dwvg_clearance *grid, const dwvg_mesh *mesh, double cell_size)
+int dwvg_clearance_build(dwvg_clearance *grid, const dwvg_mesh *mesh, double cell_size, double largest_cell)
 {
     memset(grid, 0, sizeof *grid);
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -210,6 +210,7 @@ int dwvg_clearance_build(dwvg_clearance *grid, const dwvg_mesh *mesh, double cel
         if (cells <= DWVG_CLEARANCE_MAX_CELLS) break;
         h *= 1.0594630943592953; /* 2^(1/12): a twelfth of the way to half the cells */
     }
+    if (!(h <= largest_cell)) return 1;
     grid->cell = h;
     for (int a = 0; a < 3; ++a) {
         grid->n[a] = (uint32_t)(floor((hi[a] - lo[a]) / h) + 3.0);

@@ -32,10 +32,10 @@ typedef struct dwvg_clearance {
 } dwvg_clearance;
 
 /* Builds the grid of `mesh` with cells of at least `cell_size` (finite, > 0), coarser where
- * DWVG_CLEARANCE_MAX_CELLS would be exceeded. 0 on success, 1 when there is no grid to build
- * (no finite triangle, or the marking would take more than 64 cell visits per cell: *grid is
- * then empty and every lookup returns 0), -1 out of memory. */
-int dwvg_clearance_build(dwvg_clearance *grid, const dwvg_mesh *mesh, double cell_size);
+ * DWVG_CLEARANCE_MAX_CELLS would be exceeded. 0 on success, 1 when no grid is made (no finite
+ * triangle; cells would have to be larger than `largest_cell`; or the marking would take more than
+ * 64 cell visits per cell): *grid is then empty and every lookup returns 0. -1 out of memory. */
+int dwvg_clearance_build(dwvg_clearance *grid, const dwvg_mesh *mesh, double cell_size, double largest_cell);
 void dwvg_clearance_free(dwvg_clearance *grid);
 
 /* The barycentrics (u, v) of the point of triangle abc closest to p (Ericson, Real-Time Collision

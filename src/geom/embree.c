@@ -308,9 +308,9 @@ int dwvg_closest_mesh(const dwvg_world *world, uint32_t mesh, dwvw_vec3 p, dwvg_
     return dwvg_closest_mesh_clearance(world, mesh, p, hit, &clearance);
 }
 
-int dwvg_world_build_clearance(dwvg_world *world, uint32_t mesh, double cell_size)
+int dwvg_world_build_clearance(dwvg_world *world, uint32_t mesh, double cell_size, double largest_cell)
 {
-    return dwvg_clearance_build(&world->clearance[mesh], &world->meshes[mesh], cell_size) < 0 ? -1 : 0;
+    return dwvg_clearance_build(&world->clearance[mesh], &world->meshes[mesh], cell_size, largest_cell) < 0 ? -1 : 0;
 }
 
 double dwvg_clear_radius(const dwvg_world *world, dwvw_vec3 center, double clearance)

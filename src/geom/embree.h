@@ -52,10 +52,10 @@ int dwvg_closest_mesh(const dwvg_world *world, uint32_t mesh, dwvw_vec3 p, dwvg_
 /* The same, with the distance from p to the nearest triangle a ray could hit (zero-area ones
  * included) in *clearance (0 if none found). */
 int dwvg_closest_mesh_clearance(const dwvg_world *world, uint32_t mesh, dwvw_vec3 p, dwvg_hit *hit, double *clearance);
-/* Builds the clearance grid of one mesh (clearance.h) with cells of at least `cell_size`: for the
- * meshes whose walks may take ray-free steps. 0 on success or where no grid is made (its lookups
- * then give 0), -1 out of memory. */
-int dwvg_world_build_clearance(dwvg_world *world, uint32_t mesh, double cell_size);
+/* Builds the clearance grid of one mesh (clearance.h, dwvg_clearance_build) with cells of at least
+ * `cell_size` and at most `largest_cell`: for the meshes whose walks may take ray-free steps. 0 on
+ * success or where no grid is made (its lookups then give 0), -1 out of memory. */
+int dwvg_world_build_clearance(dwvg_world *world, uint32_t mesh, double cell_size, double largest_cell);
 /* The radius of a ball about `center` that no ray of dwvg_intersect_mesh can find a hit in, from
  * a lower bound on the distance to the mesh there (the clearance: dwvg_clearance_at, or a
  * closest point's distance): the clearance less a margin for float
