@@ -3,15 +3,17 @@
  * could hit, zero-area ones included), so that a walk step shorter than the bound cannot meet the
  * surface and needs no ray (src/bake/shade.c run_walk).
  *
- * Construction: every cell that a triangle's bounding box touches is marked (the triangle lies in
- * the union of its marked cells); an exact Euclidean distance transform (Felzenszwalb and
- * Huttenlocher 2012, squared distances by lower envelopes of parabolas, one axis at a time) gives
- * each cell centre c its distance D(c) to the nearest marked cell centre. For a point x in cell C
- * and a surface point y in marked cell M, the triangle inequality gives
- *     |x - y| >= |c_C - c_M| - |x - c_C| - |y - c_M| >= D(c_C) - h sqrt(3)/2 - |x - c_C|,
- * h the cell size. Within a few cells of the surface, where that loses much, the centre's exact
- * distance to the triangles d(c_C) is computed instead: |x - y| >= d(c_C) - |x - c_C|. The table
- * keeps the larger bound at each centre (rounded down to float); a lookup subtracts |x - c_C|. A lookup is a few dozen instructions, against some 500 for an
+ * Construction: a cell is marked where it may hold a surface point: its centre lies within half a
+ * cell diagonal h sqrt(3)/2 of a triangle (exact distances from the centres near the surface),
+ * or, where computing those would take too long, a triangle's bounding box touches it. An exact
+ * Euclidean distance transform (Felzenszwalb and Huttenlocher 2012, squared distances by lower
+ * envelopes of parabolas, one axis at a time) gives each cell centre c its distance D(c) to the
+ * nearest marked cell centre. For a point x, any cell centre c and a surface point y in marked
+ * cell M, the triangle inequality gives
+ *     |x - y| >= |c - c_M| - |x - c| - |y - c_M| >= D(c) - h sqrt(3)/2 - |x - c|,
+ * and likewise |x - y| >= d(c) - |x - c| with d(c) the centre's exact distance where it is known.
+ * The table keeps the larger bound at each centre (rounded down to float); a lookup subtracts
+ * |x - c| for the centre of x's cell. A lookup is a few dozen instructions, against some 500 for an
  * Embree ray and some 6000 for an Embree closest-point query on the report's sphere. */
 #ifndef DWV_GEOM_CLEARANCE_H
 #define DWV_GEOM_CLEARANCE_H
