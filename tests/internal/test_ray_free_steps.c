@@ -11,7 +11,8 @@
  *    closest, backward, auto on the report-like sphere), and the tallies add up: the same events,
  *    rays with + ray-free steps = rays without, the same closest-point queries.
  * 3. In checked mode (every ray-free step's ray cast anyway) no ray-free step's ray meets the
- *    surface, on the sphere, the open mesh and the tiny-feature mesh. */
+ *    surface, on the sphere, the open mesh and the tiny-feature mesh.
+ * 4. A scene's grids stop at 2^24 cells, in mesh order. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -358,10 +359,53 @@ static void check_checked_mode(int kind)
     dwv_scene_release(scene);
 }
 
+/* 4. A scene's grids stop at 2^24 cells (64 MiB): 76 unit spheres of the report's medium, each
+ * with a grid of 62^3 cells (the medium asks for finer, the limit of 2^18 per mesh says no), get
+ * grids in mesh order up to the 71st only. */
+static void check_scene_limit(void)
+{
+    dwv_scene_t *handle;
+    dwv_scene_create(&handle);
+    dwv_material_t material = DWV_MATERIAL_INIT;
+    material.subsurface_radius[0] = 0.5;
+    material.subsurface_scale = 1.0;
+    uint32_t material_id;
+    dwv_scene_add_material(handle, &material, &material_id);
+    enum { SPHERES = 76 };
+    for (int i = 0; i < SPHERES; ++i) {
+        test_mesh m = test_sphere(3.0 * i, 0.0, 0.0, 1.0, 6, 12);
+        dwv_mesh_t mesh = DWV_MESH_INIT;
+        mesh.vertex_count = m.vertex_count;
+        mesh.triangle_count = m.triangle_count;
+        mesh.positions = m.positions;
+        mesh.indices = m.indices;
+        mesh.material_id = material_id;
+        uint32_t id;
+        CHECK(dwv_scene_add_mesh(handle, &mesh, &id) == DWV_SUCCESS, "add: %s", dwv_last_error_message());
+        test_mesh_free(&m);
+    }
+    CHECK(dwv_scene_commit(handle) == DWV_SUCCESS, "commit: %s", dwv_last_error_message());
+    const dwvg_world *world = &dwv_scene_object(handle)->geometry;
+    int with = 0, ordered = 1;
+    uint64_t cells = 0;
+    for (int i = 0; i < SPHERES; ++i) {
+        const dwvg_clearance *grid = &world->clearance[i];
+        if (grid->lower) {
+            ordered &= with == i;
+            ++with;
+            cells += (uint64_t)grid->n[0] * grid->n[1] * grid->n[2];
+        }
+    }
+    CHECK(ordered && with >= 64 && with < SPHERES && cells >= (1u << 24) && cells < (1u << 24) + (1u << 18),
+          "%d grids (in mesh order: %d) of %llu cells in all", with, ordered, (unsigned long long)cells);
+    dwv_scene_release(handle);
+}
+
 int main(void)
 {
     for (int kind = 0; kind < MESH_KINDS; ++kind) check_bound(kind);
     check_same_bakes();
     for (int kind = 0; kind < MESH_KINDS; ++kind) check_checked_mode(kind);
+    check_scene_limit();
     return check_report("test_ray_free_steps");
 }
