@@ -403,12 +403,21 @@ static dwv_result_t make_image(dwvb_bake *bake, double seconds)
         total.walks += bake->tile_tallies[t].walks;
         total.warnings += bake->tile_tallies[t].warnings;
         total.mixture_terms += bake->tile_tallies[t].mixture_terms;
+        total.rays += bake->tile_tallies[t].rays;
+        total.point_queries += bake->tile_tallies[t].point_queries;
+        total.ray_free_steps += bake->tile_tallies[t].ray_free_steps;
+        total.ray_free_misses += bake->tile_tallies[t].ray_free_misses;
         for (int c = 0; c < 3; ++c) total.truncated[c] += bake->tile_tallies[t].truncated[c];
     }
     st->technique = bake->options.technique;
     st->samples_per_pixel = largest;
     st->samples = samples;
     st->events = total.events;
+    image->rays = total.rays;
+    image->point_queries = total.point_queries;
+    image->ray_free_steps = total.ray_free_steps;
+    image->ray_free_misses = total.ray_free_misses;
+    image->mixture_terms = total.mixture_terms;
     st->walks = total.walks;
     st->seconds = seconds;
     st->estimated_relative_error = bake->error;
@@ -559,12 +568,19 @@ static void setup_guides(dwvb_bake *bake)
  * 1 / (variance x cost) (Veach 1997, Sec. 2.4: the efficiency of an estimator;
  * Hammersley and Handscomb 1964). Both are unbiased, so the choice moves noise, never the mean.
  * The cost is counted, not timed, so that the choice (and the image) depends on the seed only:
- * nanoseconds per sample (camera ray, shading, exit lighting), per walk event (an Embree ray and
- * the event's sampling) and per mixture term (see dwvb_tally), fitted by least squares to bakes
- * of the report's sphere, slab and default scene with every technique (one thread, x86-64,
- * docs/speed.md); only their ratios matter. */
+ * nanoseconds per sample (camera ray, shading, exit lighting), per walk event (the event's
+ * sampling and weight), per Embree ray the walk casts (steps inside a ball clear of the mesh cast
+ * none: shade.c run_walk), per closest-point query and per mixture term (see dwvb_tally). The
+ * sample, term and event-with-its-ray costs are a least-squares fit of one-thread bake times of
+ * the report's sphere, slab and default scene with every technique; the event's 415 ns are split
+ * between the event and its ray, and the query priced, by a least-squares fit of instruction
+ * counts (callgrind) over the sphere, slab, leaf and default scene, every technique, with and
+ * without ray-free steps: 726 per event, 566 per ray, 6677 per query (x86-64, docs/speed.md).
+ * Only their ratios matter. */
 #define PILOT_COST_SAMPLE 606.0
-#define PILOT_COST_EVENT 415.0
+#define PILOT_COST_EVENT 233.0
+#define PILOT_COST_RAY 182.0
+#define PILOT_COST_QUERY 2145.0
 #define PILOT_COST_TERM 18.4
 /* Pilot samples per candidate: a sixteenth of the bake's samples, at most PILOT_MAX; below
  * PILOT_MIN the estimate is too noisy to act on and auto keeps its mixture. A mesh needs
@@ -646,6 +662,7 @@ static void *pilot_worker(void *arg)
                 p->sum += l;
                 p->sum_squares += l * l;
                 p->cost += PILOT_COST_SAMPLE + PILOT_COST_EVENT * (double)tally.events +
+                           PILOT_COST_RAY * (double)tally.rays + PILOT_COST_QUERY * (double)tally.point_queries +
                            PILOT_COST_TERM * (double)tally.mixture_terms;
             }
         }

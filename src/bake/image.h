@@ -17,6 +17,10 @@ typedef struct dwvb_image {
     dwv_bake_stats_t stats;            /* error_vs_time_count = the length of error_vs_time */
     dwv_error_point_t *error_vs_time;  /* one point per completed pass; may be NULL if count is 0 */
     uint32_t error_vs_time_capacity;
+    /* The walks' work beyond the public stats (dwvb_tally): rays, closest-point queries, ray-free
+     * steps, in checked ball mode the ray-free steps whose ray met the surface, and mixture terms
+     * (what the auto pilot's cost model counts). */
+    uint64_t rays, point_queries, ray_free_steps, ray_free_misses, mixture_terms;
 } dwvb_image;
 
 /* A zeroed image of the given size with reference count 1 (stats zeroed but struct_size set),

@@ -10,6 +10,11 @@
 
 static dwv_result_t uncommit(dwvb_scene *scene, dwv_result_t result);
 
+/* The clearance grids of a scene stop once they hold this many cells (64 MiB): a scene of many
+ * large subsurface meshes keeps rays at every step in the later ones (in mesh order, so the same
+ * scene always gets the same grids). */
+#define CLEARANCE_SCENE_CELLS (1u << 24)
+
 dwvb_scene *dwvb_scene_new(void)
 {
     dwvb_scene *scene = calloc(1, sizeof *scene);
@@ -191,12 +196,26 @@ dwv_result_t dwvb_scene_commit(dwvb_scene *scene, char *message, size_t size)
     dwvl_environment env = {.lights = scene->emitters, .light_count = nl, .world_lit = world_lit,
                             .geometry = nmesh > 0 ? &scene->geometry : NULL};
     for (int c = 0; c < 3; ++c) env.world[c] = scene->world[c];
+    uint64_t grid_cells = 0; /* of the clearance grids made so far */
     for (uint32_t m = 0; m < nmesh; ++m) {
         const dwvb_material *material = &scene->shading[scene->meshes[m].material_id];
         if (material->diffuse_albedo[0] > 0.0 || material->diffuse_albedo[1] > 0.0 || material->diffuse_albedo[2] > 0.0)
             features |= DWV_FEATURE_DIFFUSE_SURFACES;
         if (!material->subsurface) continue;
         features |= DWV_FEATURE_SUBSURFACE;
+        /* Ray-free walk steps (shade.c run_walk): cells of a quarter of the longest mean free
+         * path, or coarser within the grid's size limit, but no grid where its cells would exceed
+         * that path (a medium too thin for the grid to vouch for a step: the leaf). */
+        double sigma_min = material->medium.sigma_t[0];
+        for (int c = 1; c < material->medium.channels; ++c) sigma_min = fmin(sigma_min, material->medium.sigma_t[c]);
+        if (grid_cells < CLEARANCE_SCENE_CELLS) {
+            if (dwvg_world_build_clearance(&scene->geometry, m, 0.25 / sigma_min, 1.0 / sigma_min)) {
+                snprintf(message, size, "out of memory while making the clearance grid of mesh %u", m);
+                return uncommit(scene, DWV_ERROR_OUT_OF_MEMORY);
+            }
+            const dwvg_clearance *grid = &scene->geometry.clearance[m];
+            if (grid->lower) grid_cells += (uint64_t)grid->n[0] * grid->n[1] * grid->n[2];
+        }
         if (!material->grey) features |= DWV_FEATURE_RGB_WALKS;
         if (!lights_lit && !world_lit) continue;
         int count = make_patches(scene, &env, m, scene->patches[m]);

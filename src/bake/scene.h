@@ -19,6 +19,11 @@
 #define DWVB_MAX_MESHES (1u << 16)
 #define DWVB_MAX_LIGHTS (1u << 16)
 
+/* Whether walks take ray-free steps inside balls clear of their mesh (run_walk in shade.c): on
+ * (the default), off (a ray at every step), or checked (the ray is cast anyway and a hit on a
+ * ray-free step counted: tests prove the balls never skip a hit). Only tests change it. */
+typedef enum dwvb_ball_mode { DWVB_BALL_ON = 0, DWVB_BALL_OFF = 1, DWVB_BALL_CHECKED = 2 } dwvb_ball_mode;
+
 typedef struct dwvb_scene {
     atomic_uint references;
     int committed;
@@ -40,6 +45,7 @@ typedef struct dwvb_scene {
     int *patch_count;          /* per mesh */
     uint32_t features;         /* DWV_FEATURE_* the scene can use (bakes narrow it by technique) */
     uint64_t warnings;         /* degenerate or non-finite triangles */
+    dwvb_ball_mode ball_mode;
 } dwvb_scene;
 
 dwvb_scene *dwvb_scene_new(void);

@@ -14,34 +14,58 @@ static uint64_t mixture_terms(const dwvw_walk *walk)
 }
 
 /* Runs one walk from entry point x (on triangle entry_prim of mesh `mesh`) along unit `direction`
- * into the medium; on exit fills the exit hit and returns 1. */
+ * into the medium; on exit fills the exit hit and returns 1.
+ *
+ * Ray-free steps: where a lower bound L on the distance from the walk's position x to its mesh is
+ * known (the mesh's clearance grid, or the closest point that the closest technique finds at every
+ * event anyway), the open ball B(x, L) holds no surface of the mesh; less a margin for Embree's
+ * float rounding (dwvg_clear_radius) no hit Embree would report lies in it either. A step of
+ * length t < that radius stays in the ball: the walk scatters at its end without a ray, exactly as
+ * after a ray that met nothing (the same walk and image, bit for bit). Walks meet only their own
+ * mesh, so this holds for open meshes too. The first step (the probe, which the backward
+ * technique needs in full) is always a ray. */
 static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvb_material *material, uint32_t entry_prim, dwvw_vec3 x, dwvw_vec3 direction, dwvw_vec3 entry_normal, uint64_t key,
                     dwvw_walk *walk, dwvg_hit *exit, dwvb_tally *tally)
 {
     const dwvg_world *world = &shader->scene->geometry;
     const dwvg_mesh *m = &shader->scene->meshes[mesh];
+    const dwvg_clearance *grid = &world->clearance[mesh];
     dwvw_walk_begin(walk, &material->medium, &shader->guides[mesh], key, shader->max_events, x, direction,
                     entry_normal);
     int needs_closest = shader->needs_closest[mesh];
+    dwvb_ball_mode ball_mode = shader->scene->ball_mode;
     int first = 1;
     while (walk->status == DWVW_RUNNING) {
+        double clearance = 0.0;
         if (needs_closest) {
             dwvg_hit closest;
-            if (dwvg_closest_mesh(world, mesh, walk->position, &closest))
+            ++tally->point_queries;
+            if (dwvg_closest_mesh_clearance(world, mesh, walk->position, &closest, &clearance))
                 dwvw_walk_set_closest(walk, dwvg_geometric_normal(m, closest.prim));
         }
         double distance = dwvw_walk_sample(walk);
         tally->mixture_terms += mixture_terms(walk);
-        /* The first step is the probe: its full distance to the surface locates an opposite
-         * interface. A ray leaving a flat triangle inward cannot meet that triangle again, so a
-         * hit on the entry triangle is rounding and the ray goes on past it. */
-        double tnear = 0.0, tfar = first ? INFINITY : distance;
+        int ray_free = 0;
+        if (!first && ball_mode != DWVB_BALL_OFF && (needs_closest || grid->lower)) {
+            if (!needs_closest) clearance = dwvg_clearance_at(grid, walk->position);
+            ray_free = distance < dwvg_clear_radius(world, walk->position, clearance);
+        }
         dwvg_hit hit;
-        int found;
-        for (;;) {
-            found = dwvg_intersect_mesh(world, mesh, walk->position, walk->direction, tnear, tfar, &hit);
-            if (!(found && first && hit.prim == entry_prim)) break;
-            tnear = nextafterf((float)hit.t, INFINITY);
+        int found = 0;
+        tally->ray_free_steps += (uint64_t)ray_free;
+        if (!ray_free || ball_mode == DWVB_BALL_CHECKED) {
+            /* The first step is the probe: its full distance to the surface locates an opposite
+             * interface. A ray leaving a flat triangle inward cannot meet that triangle again, so a
+             * hit on the entry triangle is rounding and the ray goes on past it. */
+            double tnear = 0.0, tfar = first ? INFINITY : distance;
+            for (;;) {
+                ++tally->rays;
+                found = dwvg_intersect_mesh(world, mesh, walk->position, walk->direction, tnear, tfar, &hit);
+                if (!(found && first && hit.prim == entry_prim)) break;
+                tnear = nextafterf((float)hit.t, INFINITY);
+            }
+            /* Checked mode: a ray-free step whose ray meets the surface would be a wrong walk. */
+            if (ray_free && found) ++tally->ray_free_misses;
         }
         /* A closed mesh surrounds every point inside: a probe that meets nothing means the
          * mesh is open there (or the ray slipped through), and the walk may wander off. */

@@ -128,7 +128,8 @@ int dwvg_world_build(dwvg_world *world, const dwvg_mesh *meshes, uint32_t count,
     rtcSetDeviceErrorFunction(device, embree_error, world);
     rtcSetDeviceMemoryMonitorFunction(device, embree_memory, world);
     world->mesh_scenes = calloc(count ? count : 1u, sizeof *world->mesh_scenes);
-    if (!world->mesh_scenes) return failed(world, message, size, "listing the meshes");
+    world->clearance = calloc(count ? count : 1u, sizeof *world->clearance);
+    if (!world->mesh_scenes || !world->clearance) return failed(world, message, size, "listing the meshes");
     world->mesh_count = count;
     RTCScene top = rtcNewScene(device);
     if (!top) return failed(world, message, size, "creating the top-level scene");
@@ -174,6 +175,10 @@ void dwvg_world_free(dwvg_world *world)
         for (uint32_t m = 0; m < world->mesh_count; ++m)
             if (world->mesh_scenes[m]) rtcReleaseScene(world->mesh_scenes[m]);
     free(world->mesh_scenes);
+    if (world->clearance)
+        for (uint32_t m = 0; m < world->mesh_count; ++m) dwvg_clearance_free(&world->clearance[m]);
+    free(world->clearance);
+    world->clearance = NULL;
     if (world->top) rtcReleaseScene(world->top);
     if (world->device) rtcReleaseDevice(world->device);
     world->mesh_scenes = NULL;
@@ -244,51 +249,26 @@ int dwvg_occluded(const dwvg_world *world, dwvw_vec3 o, dwvw_vec3 d, double tnea
     return rh.ray.tfar < 0.0f; /* Embree marks an occluded ray with tfar = -inf */
 }
 
-/* The barycentrics (u, v) of the point of triangle abc closest to p (Ericson, Real-Time
- * Collision Detection, Sec. 5.1.5: Voronoi regions of the vertices, edges and face in turn). */
-static void closest_on_triangle(dwvw_vec3 p, dwvw_vec3 a, dwvw_vec3 b, dwvw_vec3 c, double *u, double *v)
-{
-    dwvw_vec3 ab = dwvw_sub(b, a), ac = dwvw_sub(c, a), ap = dwvw_sub(p, a);
-    double d1 = dwvw_dot(ab, ap), d2 = dwvw_dot(ac, ap);
-    if (d1 <= 0.0 && d2 <= 0.0) { *u = 0.0; *v = 0.0; return; }
-    dwvw_vec3 bp = dwvw_sub(p, b);
-    double d3 = dwvw_dot(ab, bp), d4 = dwvw_dot(ac, bp);
-    if (d3 >= 0.0 && d4 <= d3) { *u = 1.0; *v = 0.0; return; }
-    double vc = d1 * d4 - d3 * d2;
-    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) { *u = d1 / (d1 - d3); *v = 0.0; return; }
-    dwvw_vec3 cp = dwvw_sub(p, c);
-    double d5 = dwvw_dot(ab, cp), d6 = dwvw_dot(ac, cp);
-    if (d6 >= 0.0 && d5 <= d6) { *u = 0.0; *v = 1.0; return; }
-    double vb = d5 * d2 - d1 * d6;
-    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) { *u = 0.0; *v = d2 / (d2 - d6); return; }
-    double va = d3 * d6 - d5 * d4;
-    if (va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0) {
-        double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        *u = 1.0 - w;
-        *v = w;
-        return;
-    }
-    double inv = 1.0 / (va + vb + vc);
-    *u = vb * inv;
-    *v = vc * inv;
-}
-
 typedef struct closest_query {
     const dwvg_mesh *mesh;
     dwvw_vec3 p;
     dwvg_hit best;
     int found;
+    double degenerate; /* the distance to the nearest zero-area triangle seen */
 } closest_query;
 
 static bool closest_callback(struct RTCPointQueryFunctionArguments *args)
 {
     closest_query *q = args->userPtr;
     uint32_t prim = args->primID;
-    if (!(dwvg_triangle_area(q->mesh, prim) > 0.0)) return false;
     dwvw_vec3 a, b, c;
     corners(q->mesh, prim, &a, &b, &c);
+    if (!(dwvg_triangle_area(q->mesh, prim) > 0.0)) {
+        q->degenerate = fmin(q->degenerate, dwvg_triangle_distance(q->p, a, b, c));
+        return false;
+    }
     double u, v;
-    closest_on_triangle(q->p, a, b, c, &u, &v);
+    dwvg_closest_on_triangle(q->p, a, b, c, &u, &v);
     dwvw_vec3 x = dwvg_point(q->mesh, prim, u, v);
     double distance = dwvw_length(dwvw_sub(x, q->p));
     if (!(distance < args->query->radius) && q->found) return false;
@@ -301,8 +281,9 @@ static bool closest_callback(struct RTCPointQueryFunctionArguments *args)
     return true;
 }
 
-int dwvg_closest_mesh(const dwvg_world *world, uint32_t mesh, dwvw_vec3 p, dwvg_hit *hit)
+int dwvg_closest_mesh_clearance(const dwvg_world *world, uint32_t mesh, dwvw_vec3 p, dwvg_hit *hit, double *clearance)
 {
+    *clearance = 0.0;
     struct RTCPointQuery query;
     if (!in_embree_range((float)p.x, (float)p.y, (float)p.z)) return 0;
     query.x = (float)p.x;
@@ -312,10 +293,30 @@ int dwvg_closest_mesh(const dwvg_world *world, uint32_t mesh, dwvw_vec3 p, dwvg_
     query.radius = INFINITY;
     struct RTCPointQueryContext context;
     rtcInitPointQueryContext(&context);
-    closest_query q = {.mesh = &world->meshes[mesh], .p = p, .found = 0};
+    closest_query q = {.mesh = &world->meshes[mesh], .p = p, .found = 0, .degenerate = INFINITY};
     rtcPointQuery(world->mesh_scenes[mesh], &query, &context, closest_callback, &q);
     if (!q.found) return 0;
     *hit = q.best;
     hit->mesh = mesh;
+    *clearance = fmin(q.best.t, q.degenerate);
     return 1;
+}
+
+int dwvg_closest_mesh(const dwvg_world *world, uint32_t mesh, dwvw_vec3 p, dwvg_hit *hit)
+{
+    double clearance;
+    return dwvg_closest_mesh_clearance(world, mesh, p, hit, &clearance);
+}
+
+int dwvg_world_build_clearance(dwvg_world *world, uint32_t mesh, double cell_size, double largest_cell)
+{
+    return dwvg_clearance_build(&world->clearance[mesh], &world->meshes[mesh], cell_size, largest_cell) < 0 ? -1 : 0;
+}
+
+double dwvg_clear_radius(const dwvg_world *world, dwvw_vec3 center, double clearance)
+{
+    double largest = fmax(fabs(center.x), fmax(fabs(center.y), fabs(center.z))) + clearance;
+    double margin = world->epsilon + 0x1p-17 * largest;
+    double radius = clearance - margin;
+    return radius > 0.0 && radius < INFINITY ? radius : 0.0;
 }

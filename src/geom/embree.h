@@ -9,6 +9,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "clearance.h"
 #include "mesh.h"
 #include "walk/vec3.h"
 
@@ -16,6 +17,7 @@ typedef struct dwvg_world {
     void *device;         /* RTCDevice */
     void *top;            /* RTCScene of instances, instance id = mesh index */
     void **mesh_scenes;   /* RTCScene per mesh */
+    dwvg_clearance *clearance; /* per mesh: empty unless dwvg_world_build_clearance made it */
     const dwvg_mesh *meshes;
     uint32_t mesh_count;
     double epsilon;       /* ray offset: 2^-17 of the scene's largest coordinate (about 64 float
@@ -47,6 +49,23 @@ int dwvg_intersect_mesh(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwv
 /* The point of `mesh` closest to p (rtcPointQuery with our own point-triangle distance): 1 and
  * *hit (t = the distance), or 0 if the mesh has no valid triangle. */
 int dwvg_closest_mesh(const dwvg_world *world, uint32_t mesh, dwvw_vec3 p, dwvg_hit *hit);
+/* The same, with the distance from p to the nearest triangle a ray could hit (zero-area ones
+ * included) in *clearance (0 if none found). */
+int dwvg_closest_mesh_clearance(const dwvg_world *world, uint32_t mesh, dwvw_vec3 p, dwvg_hit *hit, double *clearance);
+/* Builds the clearance grid of one mesh (clearance.h, dwvg_clearance_build) with cells of at least
+ * `cell_size` and at most `largest_cell`: for the meshes whose walks may take ray-free steps. 0 on
+ * success or where no grid is made (its lookups then give 0), -1 out of memory. */
+int dwvg_world_build_clearance(dwvg_world *world, uint32_t mesh, double cell_size, double largest_cell);
+/* The radius of a ball about `center` that no ray of dwvg_intersect_mesh can find a hit in, from
+ * a lower bound on the distance to the mesh there (the clearance: dwvg_clearance_at, or a
+ * closest point's distance): the clearance less a margin for float
+ * rounding. Embree traces the ray rounded to float (origin, direction and tfar, each within half
+ * an ulp) with a watertight test in float, and culls the point query in float: each errs by a
+ * few ulps of the largest coordinate involved, the mesh's (world->epsilon = 2^-17 of it, about
+ * 64 ulps) or the ball's (|center| + clearance). The margin is the sum of 2^-17 of each. 0 when
+ * nothing is left. A segment with both ends inside the ball (convex) meets no surface of the
+ * mesh: a ray along it is skipped. */
+double dwvg_clear_radius(const dwvg_world *world, dwvw_vec3 center, double clearance);
 
 /* The unit outward geometric normal of a triangle, (v1 - v0) x (v2 - v0) normalised (zero for a
  * degenerate one). */
