@@ -16,12 +16,13 @@ static uint64_t mixture_terms(const dwvw_walk *walk)
 /* Runs one walk from entry point x (on triangle entry_prim of mesh `mesh`) along unit `direction`
  * into the medium; on exit fills the exit hit and returns 1. */
 static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvb_material *material, uint32_t entry_prim, dwvw_vec3 x, dwvw_vec3 direction, dwvw_vec3 entry_normal, uint64_t key,
-                    dwvw_walk *walk, dwvg_hit *exit, dwvb_tally *tally)
+                    const dwvk_sampler *sampler, uint32_t walk_pair, dwvw_walk *walk, dwvg_hit *exit, dwvb_tally *tally)
 {
     const dwvg_world *world = &shader->scene->geometry;
     const dwvg_mesh *m = &shader->scene->meshes[mesh];
     dwvw_walk_begin(walk, &material->medium, &shader->guides[mesh], key, shader->max_events, x, direction,
                     entry_normal);
+    dwvw_walk_stratify(walk, sampler, walk_pair, DWVB_STRATIFIED_EVENTS);
     int needs_closest = shader->needs_closest[mesh];
     int first = 1;
     while (walk->status == DWVW_RUNNING) {
@@ -136,7 +137,9 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, 
     if (!(dwvw_dot(inward, ng) < 0.0)) return;
     dwvw_walk walk;
     dwvg_hit exit = {0};
-    if (!run_walk(shader, hit->mesh, material, hit->prim, x, inward, n, key_walk, &walk, &exit,
+    /* The walk's first events take the pairs after the exit's lights (walk.h, DWVW_PAIR_*). */
+    uint32_t walk_pair = pair + DWVB_SHADE_PAIRS + 2u * light_pairs;
+    if (!run_walk(shader, hit->mesh, material, hit->prim, x, inward, n, key_walk, sampler, walk_pair, &walk, &exit,
                   tally))
         return;
     dwvw_vec3 exit_ng = walk.exit_normal;
