@@ -108,12 +108,13 @@ static void camera_sample(const dwvb_bake *bake, uint32_t x, uint32_t row, const
 
 
 /* Sample s of pixel `index` shaded by `shader`, with the random streams `stream` (pixel
- * position, entry and lights) and `stream | WALK_STREAM` (the walk); the mesh it saw (or
- * UINT32_MAX) in *mesh_seen. */
+ * position, entry, lights and the walk's first events) and `stream | WALK_STREAM` (the rest of
+ * the walk); the mesh it saw (or UINT32_MAX) in *mesh_seen. */
 static void sample_with(const dwvb_bake *bake, const dwvb_shader *shader, uint64_t stream, uint32_t index, uint64_t s,
                         double rgb[3], double *alpha, uint32_t *mesh_seen, dwvb_tally *tally)
 {
-    /* Pixel position, entry direction and light points: stratified per pixel (kernel/sampler.h). */
+    /* Pixel position, entry direction, light points and the walk's first events (shade.h,
+     * DWVB_STRATIFIED_EVENTS): stratified per pixel (kernel/sampler.h). */
     dwvk_sampler sampler = {.key = dwvk_rng_key(bake->options.seed, stream | PIXEL_STREAM | index, 0u), .index = s,
                             .stratified = 1};
     uint64_t key_walk = dwvk_rng_key(bake->options.seed, stream | WALK_STREAM | index, s);

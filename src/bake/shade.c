@@ -25,13 +25,14 @@ static uint64_t mixture_terms(const dwvw_walk *walk)
  * mesh, so this holds for open meshes too. The first step (the probe, which the backward
  * technique needs in full) is always a ray. */
 static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvb_material *material, uint32_t entry_prim, dwvw_vec3 x, dwvw_vec3 direction, dwvw_vec3 entry_normal, uint64_t key,
-                    dwvw_walk *walk, dwvg_hit *exit, dwvb_tally *tally)
+                    const dwvk_sampler *sampler, uint32_t walk_pair, dwvw_walk *walk, dwvg_hit *exit, dwvb_tally *tally)
 {
     const dwvg_world *world = &shader->scene->geometry;
     const dwvg_mesh *m = &shader->scene->meshes[mesh];
     const dwvg_clearance *grid = &world->clearance[mesh];
     dwvw_walk_begin(walk, &material->medium, &shader->guides[mesh], key, shader->max_events, x, direction,
                     entry_normal);
+    dwvw_walk_stratify(walk, sampler, walk_pair, DWVB_STRATIFIED_EVENTS);
     int needs_closest = shader->needs_closest[mesh];
     dwvb_ball_mode ball_mode = shader->scene->ball_mode;
     int first = 1;
@@ -174,7 +175,9 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, 
     if (!(dwvw_dot(inward, ng) < 0.0)) return;
     dwvw_walk walk;
     dwvg_hit exit = {0};
-    if (!run_walk(shader, hit->mesh, material, hit->prim, x, inward, n, key_walk, &walk, &exit,
+    /* The walk's first events take the pairs after the exit's lights (walk.h, DWVW_PAIR_*). */
+    uint32_t walk_pair = pair + DWVB_SHADE_PAIRS + 2u * light_pairs;
+    if (!run_walk(shader, hit->mesh, material, hit->prim, x, inward, n, key_walk, sampler, walk_pair, &walk, &exit,
                   tally))
         return;
     dwvw_vec3 exit_ng = walk.exit_normal;

@@ -38,8 +38,12 @@ static inline uint32_t dwvk_reverse_bits32(uint32_t x)
     x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
     x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
     x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
+#if defined(__GNUC__)
+    return __builtin_bswap32(x); /* the byte swap is one instruction */
+#else
     x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
     return (x >> 16) | (x << 16);
+#endif
 }
 
 /* Sobol's second coordinate: the index's bits times the generator matrix whose columns are
@@ -52,6 +56,32 @@ static inline uint32_t dwvk_sobol_second(uint32_t index)
     return x;
 }
 
+/* The same with its bits reversed, reverse(dwvk_sobol_second(index)), without a loop over the
+ * bits: bit j of the product is the xor of the index's bits k whose positions contain j's
+ * (k AND j = j): column k + 1 of the matrix holds binomial(k, j) mod 2 in digit j, which by
+ * Lucas' theorem is 1 exactly then. That xor over supersets is five butterfly steps, one per bit
+ * of the position, each folding the positions with that bit set onto those without. */
+static inline uint32_t dwvk_sobol_second_reversed(uint32_t index)
+{
+    index ^= (index >> 1) & 0x55555555u;
+    index ^= (index >> 2) & 0x33333333u;
+    index ^= (index >> 4) & 0x0f0f0f0fu;
+    index ^= (index >> 8) & 0x00ff00ffu;
+    index ^= (index >> 16) & 0x0000ffffu;
+    return index;
+}
+
+/* Laine and Karras' hash on reversed bits (the inside of dwvk_owen_scramble below). */
+static inline uint32_t dwvk_laine_karras(uint32_t x, uint32_t seed)
+{
+    x += seed;
+    x ^= x * 0x6c50b47cu;
+    x ^= x * 0xb82f1e52u;
+    x ^= x * 0xc7afe638u;
+    x ^= x * 0x8d22f6e6u;
+    return x;
+}
+
 /* A nested uniform scramble of the 32 binary digits of x (read as the fraction 0.x): each digit is
  * flipped by a hash of the digits before it. Done as Laine and Karras 2011 on the reversed bits,
  * where "before" becomes "below" and a multiply by an even constant carries only upward; the
@@ -59,13 +89,7 @@ static inline uint32_t dwvk_sobol_second(uint32_t index)
  * bijection of x, and x + seed is a bijection of the seed. */
 static inline uint32_t dwvk_owen_scramble(uint32_t x, uint32_t seed)
 {
-    x = dwvk_reverse_bits32(x);
-    x += seed;
-    x ^= x * 0x6c50b47cu;
-    x ^= x * 0xb82f1e52u;
-    x ^= x * 0xc7afe638u;
-    x ^= x * 0x8d22f6e6u;
-    return dwvk_reverse_bits32(x);
+    return dwvk_reverse_bits32(dwvk_laine_karras(dwvk_reverse_bits32(x), seed));
 }
 
 /* The two uniforms on [0, 1) of pair `pair` (dimensions 2 pair and 2 pair + 1 of the sample). */
@@ -77,8 +101,11 @@ static inline void dwvk_sampler_pair(const dwvk_sampler *sampler, uint32_t pair,
          * the first 2^m indices go to one aligned block of 2^m points of the sequence, still a
          * net, but to a different block and order for each pair. */
         uint32_t i = dwvk_owen_scramble((uint32_t)sampler->index, (uint32_t)dwvk_mix64(seeds));
-        uint32_t first = dwvk_owen_scramble(dwvk_reverse_bits32(i), (uint32_t)seeds);
-        uint32_t second = dwvk_owen_scramble(dwvk_sobol_second(i), (uint32_t)(seeds >> 32));
+        /* The coordinates are owen_scramble(reverse(i)) and owen_scramble(sobol_second(i)); the
+         * scramble reverses its input first, so the two reversals cancel (walks draw two pairs
+         * per event: this is on their path). */
+        uint32_t first = dwvk_reverse_bits32(dwvk_laine_karras(i, (uint32_t)seeds));
+        uint32_t second = dwvk_reverse_bits32(dwvk_laine_karras(dwvk_sobol_second_reversed(i), (uint32_t)(seeds >> 32)));
         u[0] = (double)first * 0x1.0p-32;
         u[1] = (double)second * 0x1.0p-32;
         return;
@@ -86,6 +113,23 @@ static inline void dwvk_sampler_pair(const dwvk_sampler *sampler, uint32_t pair,
     uint64_t key = sampler->stratified ? dwvk_rng_key(sampler->key, 0u, sampler->index) : sampler->key;
     u[0] = dwvk_rng_uniform_d(key, 2u * pair);
     u[1] = dwvk_rng_uniform_d(key, 2u * pair + 1u);
+}
+
+/* A uniform on [0, 1) as a float on the 2^-24 grid: its top 24 bits, truncated. */
+static inline float dwvk_uniform_f_from_d(double u)
+{
+    return (float)(int32_t)(u * 0x1.0p24) * 0x1.0p-24f;
+}
+
+/* The same pair as single-precision uniforms on the 2^-24 grid (the walk's per-event sampling
+ * runs in single precision): the top 24 bits, truncated, so that a uniform on a finer dyadic grid
+ * stays uniform and never rounds up to 1 (a float conversion by rounding would). */
+static inline dwvk_uniform_pair_f dwvk_sampler_pair_f(const dwvk_sampler *sampler, uint32_t pair)
+{
+    double u[2];
+    dwvk_sampler_pair(sampler, pair, u);
+    dwvk_uniform_pair_f f = {dwvk_uniform_f_from_d(u[0]), dwvk_uniform_f_from_d(u[1])};
+    return f;
 }
 
 #endif

@@ -86,6 +86,9 @@ void dwvw_walk_begin(dwvw_walk *walk, const dwvw_medium *medium, const dwvw_guid
     walk->medium = medium;
     walk->guide = guide;
     walk->key = key;
+    walk->sampler = NULL;
+    walk->first_pair = 0u;
+    walk->stratified_events = 0u;
     walk->max_events = max_events;
     walk->events = 0;
     walk->status = DWVW_RUNNING;
@@ -101,6 +104,14 @@ void dwvw_walk_begin(dwvw_walk *walk, const dwvw_medium *medium, const dwvw_guid
     walk->step_distance = 0.0;
     walk->component_count = 0;
     walk->single_component = -1;
+}
+
+void dwvw_walk_stratify(dwvw_walk *walk, const dwvk_sampler *sampler, uint32_t first_pair, uint32_t events)
+{
+    uint32_t room = (UINT32_MAX - first_pair) / DWVW_PAIRS_PER_EVENT; /* events whose pairs fit in 32 bits */
+    walk->sampler = sampler;
+    walk->first_pair = first_pair;
+    walk->stratified_events = sampler == NULL ? 0u : events < room ? events : room;
 }
 
 void dwvw_walk_set_closest(dwvw_walk *walk, dwvw_vec3 normal)
@@ -180,17 +191,26 @@ static void build_components(dwvw_walk *walk)
     }
 }
 
-static int pick(const double *p, int n, double u)
+/* Picks i with probability p[i] / sum p by the uniform u. With `rest` non-NULL, also the position
+ * of u within the picked interval, (u total - below) / p[i]: given the pick it is uniform on
+ * [0, 1) and independent of the pick, so it can drive a further choice (held below 1 against
+ * rounding). */
+static int pick(const double *p, int n, double u, double *rest)
 {
     double total = 0.0;
     for (int i = 0; i < n; ++i) total += p[i];
-    double target = u * total, cumulative = 0.0;
+    double target = u * total, cumulative = 0.0, below = 0.0;
     int last = 0;
     for (int i = 0; i < n; ++i) {
         if (!(p[i] > 0.0)) continue;
+        below = cumulative;
         cumulative += p[i];
         last = i;
-        if (target < cumulative) return i;
+        if (target < cumulative) break;
+    }
+    if (rest != NULL) {
+        double r = (target - below) / p[last];
+        *rest = r > 0.0 ? r < 1.0 ? r : 0x1.fffffffffffffp-1 : 0.0;
     }
     return last;
 }
@@ -199,6 +219,12 @@ double dwvw_walk_sample(dwvw_walk *walk)
 {
     const dwvw_medium *m = walk->medium;
     const uint32_t dim = dwvw_event_dim(walk->events);
+    /* A stratified event's flight pair: the distance's uniform and the choice (walk.h). */
+    const int stratified = walk->events < walk->stratified_events;
+    const uint32_t pair = walk->first_pair + DWVW_PAIRS_PER_EVENT * walk->events;
+    double flight[2] = {0.0, 0.0};
+    if (stratified) dwvk_sampler_pair(walk->sampler, pair + DWVW_PAIR_FLIGHT, flight);
+    double *choice = stratified ? &flight[1] : NULL;
 
     /* Channel: proportional to throughput x albedo (Cycles), to throughput where all albedos are 0. */
     int channel = 0;
@@ -208,7 +234,8 @@ double dwvw_walk_sample(dwvw_walk *walk)
         if (!(total > 0.0))
             for (int c = 0; c < m->channels; ++c) total += (walk->channel_p[c] = walk->weight[c]);
         for (int c = 0; c < m->channels; ++c) walk->channel_p[c] /= total;
-        channel = pick(walk->channel_p, m->channels, dwvk_rng_uniform_d(walk->key, dim + DWVW_DIM_CHANNEL));
+        channel = pick(walk->channel_p, m->channels,
+                       stratified ? *choice : dwvk_rng_uniform_d(walk->key, dim + DWVW_DIM_CHANNEL), choice);
     } else {
         walk->channel_p[0] = 1.0;
     }
@@ -217,14 +244,15 @@ double dwvw_walk_sample(dwvw_walk *walk)
     int chosen = walk->single_component >= 0
                      ? walk->single_component
                      : pick(walk->component_q, walk->component_count,
-                            dwvk_rng_uniform_d(walk->key, dim + DWVW_DIM_COMPONENT));
+                            stratified ? *choice : dwvk_rng_uniform_d(walk->key, dim + DWVW_DIM_COMPONENT), NULL);
     /* Per-event sampling runs in single precision (src/kernel/fastmath.h); positions, directions,
      * pdfs, weights and their exponentials stay in double. */
     dwvw_vec3 previous = walk->direction;
     float g = (float)m->g;
     if (walk->events > 0) {
         /* The first step keeps the entry direction: only its distance is sampled. */
-        dwvk_uniform_pair_f u = dwvk_rng_uniform_pair_f(walk->key, dim + DWVW_DIM_DIRECTION);
+        dwvk_uniform_pair_f u = stratified ? dwvk_sampler_pair_f(walk->sampler, pair + DWVW_PAIR_DIRECTION)
+                                           : dwvk_rng_uniform_pair_f(walk->key, dim + DWVW_DIM_DIRECTION);
         if (chosen == 0) {
             walk->direction = dwvw_classical_direction(previous, g, u);
         } else {
@@ -245,7 +273,7 @@ double dwvw_walk_sample(dwvw_walk *walk)
         walk->component_stretch[k] = stretch;
         walk->component_pdf[k] = walk->events > 0 ? m->guided_pdf_scale / stretch : 1.0;
     }
-    float u_distance = dwvk_rng_uniform_f(walk->key, dim + DWVW_DIM_DISTANCE);
+    float u_distance = stratified ? dwvk_uniform_f_from_d(flight[0]) : dwvk_rng_uniform_f(walk->key, dim + DWVW_DIM_DISTANCE);
     walk->step_distance = dwvw_flight(m->sigma_t[channel] * walk->component_stretch[chosen], u_distance);
     return walk->step_distance;
 }

@@ -26,6 +26,7 @@
 #include "kernel/classical.h"
 #include "kernel/dwivedi.h"
 #include "kernel/rng.h"
+#include "kernel/sampler.h"
 #include "vec3.h"
 
 #define DWVW_MAX_CHANNELS 3
@@ -42,6 +43,21 @@
 #define DWVW_DIM_DISTANCE 4u
 #define DWVW_DIM_ROULETTE 5u
 #define DWVW_ROULETTE_THRESHOLD 0.05
+/* A stratified walk (dwvw_walk_stratify) draws its first events from a pixel's sampler instead:
+ * event e takes pairs first + 2e and first + 2e + 1,
+ *   +0 (the free flight's uniform, the choice): the choice picks the channel, and its remainder
+ *      within the channel's interval, (u - P(below)) / P(channel), uniform again and independent
+ *      of the channel, picks the component (one stratified number for the two discrete choices,
+ *      as Cycles folds its channel choice into the distance's number; here the distance keeps
+ *      all its bits);
+ *   +1 (the cosine, the azimuth), unused by event 0, whose direction is the entry's.
+ * The distance and the channel share a pair because together they set the step's length; the
+ * cosine and azimuth because together they are a point on the sphere of directions. The
+ * roulette keeps its counter-based number: it acts only once the throughput is below the
+ * threshold, after the first events. */
+#define DWVW_PAIRS_PER_EVENT 2u
+#define DWVW_PAIR_FLIGHT 0u
+#define DWVW_PAIR_DIRECTION 1u
 
 typedef enum dwvw_technique {
     DWVW_AUTO = 0,
@@ -93,6 +109,9 @@ typedef struct dwvw_walk {
     const dwvw_medium *medium;
     const dwvw_guide *guide;
     uint64_t key;          /* counter-based RNG key of this walk */
+    const dwvk_sampler *sampler;  /* NULL, or the pixel's sampler for the first events */
+    uint32_t first_pair;          /* the sampler's pair of event 0 (DWVW_PAIR_* above) */
+    uint32_t stratified_events;   /* events 0 .. this - 1 are drawn from the sampler */
     uint32_t max_events;
     uint32_t events;       /* scattering events so far */
     dwvw_status status;
@@ -128,6 +147,13 @@ int dwvw_guide_needs_closest(const dwvw_guide *guide);
  * there is `normal`; weight 1 in every channel. */
 void dwvw_walk_begin(dwvw_walk *walk, const dwvw_medium *medium, const dwvw_guide *guide, uint64_t key,
                      uint32_t max_events, dwvw_vec3 point, dwvw_vec3 direction, dwvw_vec3 normal);
+/* After dwvw_walk_begin: draws the channel, component, direction and distance of events
+ * 0 .. events - 1 from `sampler`'s pairs first_pair, first_pair + 1, ... (DWVW_PAIR_* above)
+ * instead of from the walk's key; the sampler must outlive the walk. Every number is still a
+ * uniform independent of the walk's others (kernel/sampler.h), so the walk's distribution is the
+ * same; only the walks of one pixel are stratified against each other. Events whose pairs would
+ * pass 2^32 - 1 stay counter-based. */
+void dwvw_walk_stratify(dwvw_walk *walk, const dwvk_sampler *sampler, uint32_t first_pair, uint32_t events);
 /* Before dwvw_walk_sample, where the guide needs it: the closest surface point's outward normal. */
 void dwvw_walk_set_closest(dwvw_walk *walk, dwvw_vec3 normal);
 /* Samples the next step's direction (walk->direction) and tentative distance (return value). */

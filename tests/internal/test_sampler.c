@@ -9,7 +9,13 @@
  *    Planted error: without the scramble (seed 0 for every pixel) every pixel gives the same
  *    point, which the same check must reject.
  * 3. The two coordinates of different pairs of one pixel are not the same numbers.
- * 4. Beyond 2^32 samples, and for unstratified samplers, the pairs are rng.h's draws. */
+ * 4. Beyond 2^32 samples, and for unstratified samplers, the pairs are rng.h's draws.
+ * 5. The loop-free Sobol coordinate equals the definition (dwvk_sobol_second, reversed) for every
+ *    index below 2^20 and for 2^20 hashed 32-bit ones; the pair equals the scrambles written out
+ *    (owen_scramble(reverse(i)), owen_scramble(sobol_second(i))) for a sample of indices.
+ * 6. The single-precision pairs the walk draws (dwvk_sampler_pair_f): the top 24 bits of the
+ *    double pair, truncated (so they stay below 1 where rounding to float would give 1: planted,
+ *    a rounded conversion of the largest uniform is 1), and still nets for 2^m points, m <= 10. */
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -17,7 +23,7 @@
 #include "check.h"
 #include "kernel/sampler.h"
 
-static int is_net(const dwvk_sampler *base, uint32_t pair, int m)
+static int is_net(const dwvk_sampler *base, uint32_t pair, int m, int single)
 {
     uint32_t n = 1u << m;
     unsigned char *seen = malloc(n);
@@ -28,7 +34,12 @@ static int is_net(const dwvk_sampler *base, uint32_t pair, int m)
             dwvk_sampler s = *base;
             s.index = i;
             double u[2];
-            dwvk_sampler_pair(&s, pair, u);
+            if (single) {
+                dwvk_uniform_pair_f f = dwvk_sampler_pair_f(&s, pair);
+                u[0] = f.a, u[1] = f.b;
+            } else {
+                dwvk_sampler_pair(&s, pair, u);
+            }
             uint32_t a = (uint32_t)(u[0] * (double)(1u << k)), b = (uint32_t)(u[1] * (double)(1u << (m - k)));
             uint32_t cell = (a << (m - k)) | b;
             if (seen[cell]++) ok = 0;
@@ -72,12 +83,15 @@ int main(void)
     for (uint64_t pixel = 0; pixel < 4; ++pixel) {
         dwvk_sampler s = {.key = dwvk_rng_key(1u, pixel, 0u), .index = 0, .stratified = 1};
         for (uint32_t pair = 0; pair < 4; ++pair)
-            for (int m = 1; m <= 10; ++m) CHECK(is_net(&s, pair, m), "pixel %llu pair %u: 2^%d points are not a net", (unsigned long long)pixel, pair, m);
+            for (int m = 1; m <= 10; ++m) {
+                CHECK(is_net(&s, pair, m, 0), "pixel %llu pair %u: 2^%d points are not a net", (unsigned long long)pixel, pair, m);
+                CHECK(is_net(&s, pair, m, 1), "pixel %llu pair %u: 2^%d single-precision points are not a net", (unsigned long long)pixel, pair, m);
+            }
     }
 
     /* Planted: independent draws (an unstratified sampler keyed per sample index) are no net. */
     dwvk_sampler independent = {.key = dwvk_rng_key(1u, 0u, 0u), .index = 0, .stratified = 0};
-    CHECK(!is_net(&independent, 0u, 10), "independent points passed the net check");
+    CHECK(!is_net(&independent, 0u, 10, 0), "independent points passed the net check");
 
     CHECK(uniform_across_pixels(5u, 1), "sample 5 is not uniform across pixels");
     CHECK(uniform_across_pixels(1000u, 1), "sample 1000 is not uniform across pixels");
@@ -101,6 +115,42 @@ int main(void)
         dwvk_sampler_pair(&s, 0u, a);
         if (!(a[0] >= 0.0 && a[0] < 1.0 && a[1] >= 0.0 && a[1] < 1.0)) {
             CHECK(0, "sample %u is outside [0, 1)", i);
+            break;
+        }
+    }
+    int same = 1;
+    for (uint32_t i = 0; i < (1u << 20); ++i) {
+        uint32_t hashed = (uint32_t)dwvk_mix64(i);
+        same &= dwvk_sobol_second_reversed(i) == dwvk_reverse_bits32(dwvk_sobol_second(i));
+        same &= dwvk_sobol_second_reversed(hashed) == dwvk_reverse_bits32(dwvk_sobol_second(hashed));
+    }
+    CHECK(same, "the loop-free Sobol coordinate differs from the definition");
+    same = 1;
+    for (uint32_t i = 0; i < 4096; ++i) {
+        s.index = (uint64_t)i * 1048573u;
+        double d[2];
+        dwvk_sampler_pair(&s, 7u, d);
+        uint64_t seeds = dwvk_rng_u64(s.key, 7u);
+        uint32_t shuffled = dwvk_owen_scramble((uint32_t)s.index, (uint32_t)dwvk_mix64(seeds));
+        same &= d[0] == dwvk_owen_scramble(dwvk_reverse_bits32(shuffled), (uint32_t)seeds) * 0x1.0p-32;
+        same &= d[1] == dwvk_owen_scramble(dwvk_sobol_second(shuffled), (uint32_t)(seeds >> 32)) * 0x1.0p-32;
+    }
+    CHECK(same, "the pair is not the scrambles of the definition");
+
+    /* The float conversion: exact on the 2^-24 grid, truncating below it. */
+    const double largest = 1.0 - 0x1.0p-32; /* the largest stratified uniform */
+    CHECK(dwvk_uniform_f_from_d(largest) == 1.0f - 0x1.0p-24f, "the largest uniform does not truncate to 1 - 2^-24");
+    CHECK((float)largest == 1.0f, "planted: a rounded conversion does not reach 1 (the truncation would be moot)");
+    CHECK(dwvk_uniform_f_from_d(0.0) == 0.0f && dwvk_uniform_f_from_d(0.5 + 0x1.0p-30) == 0.5f &&
+              dwvk_uniform_f_from_d(0x1.0p-24) == 0x1.0p-24f,
+          "the float conversion is not the truncation to 24 bits");
+    for (uint32_t i = 0; i < 4096; ++i) {
+        s.index = i;
+        double d[2];
+        dwvk_sampler_pair(&s, 5u, d);
+        dwvk_uniform_pair_f f = dwvk_sampler_pair_f(&s, 5u);
+        if (!(f.a == dwvk_uniform_f_from_d(d[0]) && f.b == dwvk_uniform_f_from_d(d[1]) && f.a < 1.0f && f.b < 1.0f)) {
+            CHECK(0, "sample %u: the float pair is not the truncated double pair", i);
             break;
         }
     }
