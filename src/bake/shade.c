@@ -123,9 +123,9 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, 
     dwvw_vec3 n = dwvg_shading_normal(mesh, hit->prim, hit->u, hit->v, ng);
     uint32_t light_pairs = dwvl_direct_pairs(&shader->env);
     /* Shadow rays of smooth-shaded triangles leave from the smooth surface near the terminator,
-     * as in Cycles with its default geometry offset (src/light/terminator.h). */
-    dwvl_terminator terminator = {dwvl_terminator_lift_at(mesh, hit->prim, hit->u, hit->v, ng),
-                                  DWVL_TERMINATOR_GEOMETRY_OFFSET};
+     * as in Cycles with the mesh's geometry offset (src/light/terminator.h). */
+    double cutoff = scene->terminator_offsets[hit->mesh];
+    dwvl_terminator terminator = {dwvl_terminator_lift_at(mesh, hit->prim, hit->u, hit->v, ng), cutoff};
     const dwvl_terminator *smooth = mesh->normals ? &terminator : NULL;
     if (material->principled_v1) {
         /* The Lambertian lobe and the retro-reflection lobe from the same light samples. */
@@ -161,8 +161,7 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, 
     dwvw_vec3 exit_ng = walk.exit_normal;
     dwvw_vec3 exit_n = dwvg_shading_normal(mesh, exit.prim, exit.u, exit.v, exit_ng);
     /* Cycles shades the exit as a surface point of its triangle: the same terminator offset. */
-    dwvl_terminator exit_terminator = {dwvl_terminator_lift_at(mesh, exit.prim, exit.u, exit.v, exit_ng),
-                                       DWVL_TERMINATOR_GEOMETRY_OFFSET};
+    dwvl_terminator exit_terminator = {dwvl_terminator_lift_at(mesh, exit.prim, exit.u, exit.v, exit_ng), cutoff};
     const dwvl_terminator *exit_smooth = mesh->normals ? &exit_terminator : NULL;
     double direct[3];
     if (material->principled_v1)

@@ -5,7 +5,7 @@
  * shading normal still faces grazes (or enters) the neighbouring facets, and the facets show as
  * dark steps. Cycles moves the origin of such shadow rays up onto a smooth surface that the
  * vertex normals describe (Blender's object setting "Shadow Terminator > Geometry Offset",
- * 0.1 by default; the idea is Hanika 2021, "Hacking the Shadow Terminator", Ray Tracing Gems II
+ * 0.1 by default, dwv_mesh_t.shadow_terminator_geometry_offset; the idea is Hanika 2021, "Hacking the Shadow Terminator", Ray Tracing Gems II
  * ch. 4, with Cycles' own surface: a parabola capped by the vertices' tangent planes). This
  * module computes that lift (dwvl_terminator_lift) and how much of it one shadow ray takes
  * (dwvl_terminator_amount); src/light/direct.c applies them to each shadow ray's origin.
@@ -19,9 +19,6 @@
 
 #include "geom/mesh.h"
 #include "walk/vec3.h"
-
-/* Cycles' default "Geometry Offset" (Blender 3.4: Object.cycles.shadow_terminator_geometry_offset). */
-#define DWVL_TERMINATOR_GEOMETRY_OFFSET 0.1
 
 /* What a shading point's shadow rays need: the lift to the smooth surface and the cutoff. */
 typedef struct dwvl_terminator {

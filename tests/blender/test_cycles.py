@@ -136,6 +136,15 @@ class CyclesTest(harness.unittest.TestCase):
     def test_front_lit_sphere_principled_diffuse(self):
         self.check(compare("sphere_diffuse", lambda r, s: scenes.sphere_scene(r, s, shader='DIFFUSE')), (0, 1, 2))
 
+    # The same with the object's geometry offset at 0: Cycles' shadow rays then leave from the flat
+    # triangles, and the add-on exports the setting (dwv_mesh_t.shadow_terminator_geometry_offset).
+    def test_front_lit_sphere_principled_diffuse_without_terminator_offset(self):
+        def build(resolution, samples):
+            scene = scenes.sphere_scene(resolution, samples, shader='DIFFUSE')
+            bpy.data.objects["Sphere"].cycles.shadow_terminator_geometry_offset = 0.0
+            return scene
+        self.check(compare("sphere_diffuse_offset_0", build), (0, 1, 2))
+
     def display_pngs(self):
         """Our display PNG and Blender's save_render of the same linear pixels (the add-on's float
         image), Filmic with a look, exposure and gamma; returns both as RGBA lists (0..1)."""

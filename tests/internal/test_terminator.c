@@ -27,6 +27,9 @@
 #include "light/light.h"
 #include "light/terminator.h"
 
+/* Cycles' default "Shadow Terminator > Geometry Offset". */
+static const double CYCLES_GEOMETRY_OFFSET = 0.1;
+
 static double uniform(uint64_t *state)
 {
     uint64_t z = (*state += 0x9E3779B97F4A7C15ull);
@@ -260,7 +263,7 @@ static void test_sphere_terminator(void)
             double cos_n = dwvw_dot(n, to_sun), cos_g = dwvw_dot(ng, to_sun);
             if (!(cos_n > 0.0)) continue;
             dwvl_terminator terminator = {dwvl_terminator_lift_at(&mesh, prim, b[1], b[2], ng),
-                                          DWVL_TERMINATOR_GEOMETRY_OFFSET};
+                                          CYCLES_GEOMETRY_OFFSET};
             double flat[3], smooth[3];
             dwvl_direct(&env, x, n, ng, NULL, &sampler, 0u, flat);
             dwvl_direct(&env, x, n, ng, &terminator, &sampler, 0u, smooth);
@@ -268,7 +271,7 @@ static void test_sphere_terminator(void)
                 ++below;
                 below_lit_flat += flat[0] > 0.0;
                 below_lit_smooth += smooth[0] > 0.0;
-            } else if (cos_g > 2.0 * DWVL_TERMINATOR_GEOMETRY_OFFSET) {
+            } else if (cos_g > 2.0 * CYCLES_GEOMETRY_OFFSET) {
                 ++lit;
                 lit_changed += flat[0] != smooth[0];
             }
