@@ -125,8 +125,8 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, 
     /* Shadow rays of smooth-shaded triangles leave from the smooth surface near the terminator,
      * as in Cycles with the mesh's geometry offset (src/light/terminator.h). */
     double cutoff = scene->terminator_offsets[hit->mesh];
-    dwvl_terminator terminator = {dwvl_terminator_lift_at(mesh, hit->prim, hit->u, hit->v, ng), cutoff};
-    const dwvl_terminator *smooth = mesh->normals ? &terminator : NULL;
+    dwvl_terminator terminator = {mesh, hit->prim, hit->u, hit->v, cutoff};
+    const dwvl_terminator *smooth = mesh->normals && cutoff > 0.0 ? &terminator : NULL;
     if (material->principled_v1) {
         /* The Lambertian lobe and the retro-reflection lobe from the same light samples. */
         retro_lobe lobe = {n, dwvw_scale(view, -1.0), -dwvw_dot(n, view), material->roughness};
@@ -161,8 +161,8 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, 
     dwvw_vec3 exit_ng = walk.exit_normal;
     dwvw_vec3 exit_n = dwvg_shading_normal(mesh, exit.prim, exit.u, exit.v, exit_ng);
     /* Cycles shades the exit as a surface point of its triangle: the same terminator offset. */
-    dwvl_terminator exit_terminator = {dwvl_terminator_lift_at(mesh, exit.prim, exit.u, exit.v, exit_ng), cutoff};
-    const dwvl_terminator *exit_smooth = mesh->normals ? &exit_terminator : NULL;
+    dwvl_terminator exit_terminator = {mesh, exit.prim, exit.u, exit.v, cutoff};
+    const dwvl_terminator *exit_smooth = mesh->normals && cutoff > 0.0 ? &exit_terminator : NULL;
     double direct[3];
     if (material->principled_v1)
         dwvl_direct_lobe(&shader->env, walk.position, exit_n, exit_ng, exit_smooth, sampler, pair + DWVB_SHADE_PAIRS + light_pairs,

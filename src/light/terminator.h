@@ -20,10 +20,13 @@
 #include "geom/mesh.h"
 #include "walk/vec3.h"
 
-/* What a shading point's shadow rays need: the lift to the smooth surface and the cutoff. */
+/* Where a shading point's shadow rays find their lift (dwvl_terminator_lift_at, computed only for
+ * the rays that take some of it: most points are far from the terminator) and the cutoff. */
 typedef struct dwvl_terminator {
-    dwvw_vec3 lift; /* from the point on the flat triangle to the smooth surface (never inward) */
-    double cutoff;  /* the geometry offset: cosines below it take (part of) the lift; 0: none */
+    const dwvg_mesh *mesh; /* with vertex normals */
+    uint32_t prim;         /* the point's triangle */
+    double u, v;           /* the point's barycentrics on it (Embree's) */
+    double cutoff;         /* the geometry offset: cosines below it take (part of) the lift; 0: none */
 } dwvl_terminator;
 
 /* The lift at the point with barycentric weights b[0..2] of the triangle with corners v[0..2] and

@@ -262,8 +262,7 @@ static void test_sphere_terminator(void)
             dwvw_vec3 n = dwvg_shading_normal(&mesh, prim, b[1], b[2], ng);
             double cos_n = dwvw_dot(n, to_sun), cos_g = dwvw_dot(ng, to_sun);
             if (!(cos_n > 0.0)) continue;
-            dwvl_terminator terminator = {dwvl_terminator_lift_at(&mesh, prim, b[1], b[2], ng),
-                                          CYCLES_GEOMETRY_OFFSET};
+            dwvl_terminator terminator = {&mesh, prim, b[1], b[2], CYCLES_GEOMETRY_OFFSET};
             double flat[3], smooth[3];
             dwvl_direct(&env, x, n, ng, NULL, &sampler, 0u, flat);
             dwvl_direct(&env, x, n, ng, &terminator, &sampler, 0u, smooth);
