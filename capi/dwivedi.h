@@ -474,10 +474,17 @@ typedef struct dwv_mesh_t {
     const float *normals;     /* optional (NULL: flat shading): 3 x vertex_count, per vertex */
     const float *uvs;         /* optional (NULL: no UV bake): 2 x 3 x triangle_count, per corner */
     double transform[12];     /* row-major 3 x 4 object-to-world, invertible */
+    /* Added after 0.1.0. A caller whose struct_size ends before it gets the default, 0.1. */
+    double shadow_terminator_geometry_offset; /* >= 0, finite: Cycles' object setting "Shadow
+                                 Terminator > Geometry Offset" (Blender 3.x:
+                                 Object.cycles.shadow_terminator_geometry_offset, default 0.1).
+                                 With normals, shadow rays toward light within this cosine of the
+                                 flat triangle's horizon leave from a smooth surface above it, as
+                                 in Cycles; 0: from the flat triangle. No effect without normals. */
 } dwv_mesh_t;
 #define DWV_MESH_INIT                                                                               \
     {sizeof(dwv_mesh_t), 0u, 0u, 0u, NULL, NULL, NULL, NULL,                                        \
-     {1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0}}
+     {1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0}, 0.1}
 
 /* Adds a mesh; *mesh_id numbers meshes from 0 in order (the id a UV bake names). Open meshes,
  * zero-area or duplicate triangles are accepted and counted in the bake's warnings. */

@@ -221,6 +221,17 @@ def _subset(arrays: Dict[str, Any], keep: List[int]) -> Dict[str, Any]:
     return {**arrays, "indices": indices, "uvs": uvs, "triangles": len(keep)}
 
 
+def _shadow_terminator_geometry_offset(obj: Any) -> float:
+    """Cycles' per-object "Shadow Terminator > Geometry Offset" (dwv_mesh_t's field of that name):
+    Object.cycles.shadow_terminator_geometry_offset in Blender 3.x, a property of Object itself in
+    later versions; Cycles' default 0.1 where neither exists."""
+    for owner in (obj, getattr(obj, "cycles", None)):
+        value = getattr(owner, "shadow_terminator_geometry_offset", None)
+        if isinstance(value, float):
+            return value
+    return 0.1
+
+
 def _is_geometry(obj: Any) -> bool:
     return obj.type in {'MESH', 'CURVE', 'SURFACE', 'META', 'FONT'}
 
@@ -392,6 +403,7 @@ def export_scene(context: Any, settings: Any, dwivedi: Any) -> Exported:
                     continue
                 arrays = _mesh_arrays(mesh, want_uvs=is_uv_target)
                 slots = [slot.material for slot in obj.material_slots]
+                terminator = _shadow_terminator_geometry_offset(obj)
                 by_material: Dict[int, List[int]] = {}
                 for tri, index in enumerate(arrays["material_index"]):
                     by_material.setdefault(index, []).append(tri)
@@ -406,7 +418,8 @@ def export_scene(context: Any, settings: Any, dwivedi: Any) -> Exported:
                                         f"slot {main + 1}'s for the whole object")
                     material = slots[main] if main < len(slots) else None
                     out.uv_mesh = dw_scene.add_mesh(arrays["positions"], arrays["indices"], material_id(material),
-                                                    normals=arrays["normals"], uvs=arrays["uvs"], transform=transform)
+                                                    normals=arrays["normals"], uvs=arrays["uvs"], transform=transform,
+                                                    shadow_terminator_geometry_offset=terminator)
                     uv_found = True
                     out.mesh_count += 1
                     out.triangle_count += arrays["triangles"]
@@ -415,7 +428,8 @@ def export_scene(context: Any, settings: Any, dwivedi: Any) -> Exported:
                     part = arrays if len(by_material) == 1 else _subset(arrays, tris)
                     material = slots[index] if index < len(slots) else None
                     dw_scene.add_mesh(part["positions"], part["indices"], material_id(material),
-                                      normals=part["normals"], transform=transform)
+                                      normals=part["normals"], transform=transform,
+                                      shadow_terminator_geometry_offset=terminator)
                     out.mesh_count += 1
                     out.triangle_count += part["triangles"]
             finally:

@@ -151,6 +151,7 @@ class Mesh(_SizedStructure):
         ("normals", ctypes.c_void_p),
         ("uvs", ctypes.c_void_p),
         ("transform", _Transform),
+        ("shadow_terminator_geometry_offset", ctypes.c_double),
     ]
 
 

@@ -492,7 +492,7 @@ class Scene:
         return out.value
 
     def add_mesh(self, positions: Any, indices: Any, material: int = 0, *, normals: Any = None, uvs: Any = None,
-                 transform: Any = None) -> int:
+                 transform: Any = None, shadow_terminator_geometry_offset: float = 0.1) -> int:
         """Adds a triangle mesh; returns its id (the uv_mesh of a UV bake).
 
         positions: 3 floats per vertex (object space); indices: 3 per triangle; normals: optional,
@@ -500,6 +500,9 @@ class Scene:
         triangle, Blender's loop UVs); transform: object-to-world, 3 x 4 or 4 x 4. Each array may
         be a flat or nested sequence or any buffer (array.array, memoryview, numpy array):
         float32 / uint32 C-contiguous buffers are passed without a copy.
+        shadow_terminator_geometry_offset: Cycles' object setting "Shadow Terminator > Geometry
+        Offset" (>= 0, default 0.1 as Cycles; 0: shadow rays of smooth-shaded triangles leave from
+        the flat triangle); see dwv_mesh_t.
         """
         if isinstance(material, bool) or not isinstance(material, numbers.Integral):
             raise TypeError(f"material must be a material id (int), not {type(material).__name__}")
@@ -524,6 +527,8 @@ class Scene:
                             _library.DWV_ERROR_INVALID_ARGUMENT)
             mesh.uvs = u.address or None
         mesh.transform[:] = transform12(transform)
+        mesh.shadow_terminator_geometry_offset = _real("shadow_terminator_geometry_offset",
+                                                       shadow_terminator_geometry_offset)
         out = ctypes.c_uint32()
         _call("dwv_scene_add_mesh", self.handle, ctypes.byref(mesh), ctypes.byref(out))
         self._meshes = out.value + 1

@@ -135,13 +135,21 @@ dwv_result_t dwv_scene_add_material(dwv_scene_t *scene, const dwv_material_t *ma
     return DWV_SUCCESS;
 }
 
-dwv_result_t dwv_scene_add_mesh(dwv_scene_t *scene, const dwv_mesh_t *mesh, uint32_t *mesh_id)
+dwv_result_t dwv_scene_add_mesh(dwv_scene_t *scene, const dwv_mesh_t *mesh_in, uint32_t *mesh_id)
 {
     static const char fn[] = "dwv_scene_add_mesh";
     dwvb_scene *s;
     DWV_TRY(open_scene(fn, scene, &s));
-    DWV_TRY(dwv_check_struct(fn, "mesh", mesh, (uint32_t)sizeof(dwv_mesh_t)));
+    /* The struct as of 0.1.0 ended at transform: such callers keep working, with the later
+     * field's default. Only the caller's struct_size bytes are read. */
+    DWV_TRY(dwv_check_struct(fn, "mesh", mesh_in,
+                             (uint32_t)offsetof(dwv_mesh_t, shadow_terminator_geometry_offset)));
     DWV_TRY(dwv_check_pointer(fn, "mesh_id", mesh_id));
+    dwv_mesh_t resolved = DWV_MESH_INIT;
+    size_t given = mesh_in->struct_size < sizeof resolved ? mesh_in->struct_size : sizeof resolved;
+    memcpy(&resolved, mesh_in, given);
+    resolved.struct_size = (uint32_t)sizeof resolved;
+    const dwv_mesh_t *mesh = &resolved;
     DWV_TRY(dwv_check_pointer(fn, "mesh->positions", mesh->positions));
     DWV_TRY(dwv_check_pointer(fn, "mesh->indices", mesh->indices));
     /* Sizes first: nothing is read or allocated for an absurd count. */
@@ -157,6 +165,8 @@ dwv_result_t dwv_scene_add_mesh(dwv_scene_t *scene, const dwv_mesh_t *mesh, uint
     if (s->mesh_count >= DWVB_MAX_MESHES)
         return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: a scene holds at most %u meshes", fn, DWVB_MAX_MESHES);
     DWV_TRY(check_transform(fn, "transform", mesh->transform));
+    DWV_TRY(dwv_check_range(fn, "shadow_terminator_geometry_offset", mesh->shadow_terminator_geometry_offset, 0.0,
+                            HUGE_VAL));
     size_t nv = mesh->vertex_count, nt = mesh->triangle_count;
     for (size_t i = 0; i < 3u * nv; ++i)
         if (!isfinite(mesh->positions[i]))
@@ -179,7 +189,7 @@ dwv_result_t dwv_scene_add_mesh(dwv_scene_t *scene, const dwv_mesh_t *mesh, uint
                        mesh->indices, mesh->normals, mesh->uvs, mesh->transform))
         return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "%s: no memory for %u vertices and %u triangles", fn,
                         mesh->vertex_count, mesh->triangle_count);
-    if (dwvb_scene_push_mesh(s, &made)) {
+    if (dwvb_scene_push_mesh(s, &made, mesh->shadow_terminator_geometry_offset)) {
         dwvg_mesh_free(&made);
         return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "%s: out of memory", fn);
     }

@@ -29,6 +29,7 @@ void dwvb_scene_free(dwvb_scene *scene)
     uncommit(scene, DWV_SUCCESS);
     for (uint32_t i = 0; i < scene->mesh_count; ++i) dwvg_mesh_free(&scene->meshes[i]);
     free(scene->meshes);
+    free(scene->terminator_offsets);
     free(scene->materials);
     free(scene->lights);
     free(scene);
@@ -54,11 +55,16 @@ int dwvb_scene_push_material(dwvb_scene *scene, const dwv_material_t *material)
     return 0;
 }
 
-int dwvb_scene_push_mesh(dwvb_scene *scene, const dwvg_mesh *mesh)
+int dwvb_scene_push_mesh(dwvb_scene *scene, const dwvg_mesh *mesh, double terminator_offset)
 {
+    void *offsets = grow(scene->terminator_offsets, scene->mesh_count, &scene->terminator_capacity,
+                         sizeof *scene->terminator_offsets);
+    if (!offsets) return -1;
+    scene->terminator_offsets = offsets;
     void *grown = grow(scene->meshes, scene->mesh_count, &scene->mesh_capacity, sizeof *mesh);
     if (!grown) return -1;
     scene->meshes = grown;
+    scene->terminator_offsets[scene->mesh_count] = terminator_offset;
     scene->meshes[scene->mesh_count++] = *mesh;
     return 0;
 }
@@ -124,7 +130,7 @@ static int make_patches(const dwvb_scene *scene, const dwvl_environment *env, ui
             double radiance[3];
             /* Independent draws; pairs from 2 on (dimensions 4, 5, ...) leave 0 to 2 to the point. */
             dwvk_sampler sampler = {.key = key, .index = 0u, .stratified = 0};
-            dwvl_direct(env, x, ng, ng, &sampler, 2u, radiance);
+            dwvl_direct(env, x, ng, ng, NULL, &sampler, 2u, radiance);
             /* The Lambertian estimate is irradiance / pi. */
             double e = 3.14159265358979323846 * luminance(radiance);
             if (!(e > 0.0)) continue;

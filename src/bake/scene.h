@@ -31,6 +31,8 @@ typedef struct dwvb_scene {
     uint32_t material_count, material_capacity;
     dwvg_mesh *meshes;
     uint32_t mesh_count, mesh_capacity;
+    double *terminator_offsets; /* per mesh: dwv_mesh_t.shadow_terminator_geometry_offset */
+    uint32_t terminator_capacity;
     dwv_light_desc_t *lights;
     uint32_t light_count, light_capacity;
     double world[3];     /* constant world radiance: colour x strength */
@@ -52,7 +54,7 @@ dwvb_scene *dwvb_scene_new(void);
 void dwvb_scene_free(dwvb_scene *scene);
 /* Append copies; 0 on success, -1 when out of memory (nothing appended). */
 int dwvb_scene_push_material(dwvb_scene *scene, const dwv_material_t *material);
-int dwvb_scene_push_mesh(dwvb_scene *scene, const dwvg_mesh *mesh);
+int dwvb_scene_push_mesh(dwvb_scene *scene, const dwvg_mesh *mesh, double terminator_offset);
 int dwvb_scene_push_light(dwvb_scene *scene, const dwv_light_desc_t *light);
 
 /* Freezes the scene: builds the Embree world, the materials' media, the lights, the lit patches

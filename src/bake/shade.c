@@ -147,22 +147,27 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, 
     dwvw_vec3 x = dwvg_point(mesh, hit->prim, hit->u, hit->v);
     dwvw_vec3 n = dwvg_shading_normal(mesh, hit->prim, hit->u, hit->v, ng);
     uint32_t light_pairs = dwvl_direct_pairs(&shader->env);
+    /* Shadow rays of smooth-shaded triangles leave from the smooth surface near the terminator,
+     * as in Cycles with the mesh's geometry offset (src/light/terminator.h). */
+    double cutoff = scene->terminator_offsets[hit->mesh];
+    dwvl_terminator terminator = {mesh, hit->prim, hit->u, hit->v, cutoff};
+    const dwvl_terminator *smooth = mesh->normals && cutoff > 0.0 ? &terminator : NULL;
     if (material->principled_v1) {
         /* The Lambertian lobe and the retro-reflection lobe from the same light samples. */
         retro_lobe lobe = {n, dwvw_scale(view, -1.0), -dwvw_dot(n, view), material->roughness};
         double direct[3], retro[3];
-        dwvl_direct_lobe(&shader->env, x, n, ng, sampler, pair + DWVB_SHADE_PAIRS, retro_factor, &lobe, direct, retro);
+        dwvl_direct_lobe(&shader->env, x, n, ng, smooth, sampler, pair + DWVB_SHADE_PAIRS, retro_factor, &lobe, direct, retro);
         for (int c = 0; c < 3; ++c) rgb[c] += material->diffuse_albedo[c] * direct[c] + material->retro_albedo[c] * retro[c];
     } else if (material->principled_diffuse) {
         retro_lobe lobe = {n, dwvw_scale(view, -1.0), -dwvw_dot(n, view), material->roughness};
         double diffuse[3];
-        dwvl_direct_lobe(&shader->env, x, n, ng, sampler, pair + DWVB_SHADE_PAIRS, principled_diffuse_factor, &lobe,
+        dwvl_direct_lobe(&shader->env, x, n, ng, smooth, sampler, pair + DWVB_SHADE_PAIRS, principled_diffuse_factor, &lobe,
                          NULL, diffuse);
         for (int c = 0; c < 3; ++c) rgb[c] += material->diffuse_albedo[c] * diffuse[c];
     } else if (material->diffuse_albedo[0] > 0.0 || material->diffuse_albedo[1] > 0.0 ||
                material->diffuse_albedo[2] > 0.0) {
         double direct[3];
-        dwvl_direct(&shader->env, x, n, ng, sampler, pair + DWVB_SHADE_PAIRS, direct);
+        dwvl_direct(&shader->env, x, n, ng, smooth, sampler, pair + DWVB_SHADE_PAIRS, direct);
         for (int c = 0; c < 3; ++c) rgb[c] += material->diffuse_albedo[c] * direct[c];
     }
     if (!material->subsurface) return;
@@ -182,12 +187,15 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, 
         return;
     dwvw_vec3 exit_ng = walk.exit_normal;
     dwvw_vec3 exit_n = dwvg_shading_normal(mesh, exit.prim, exit.u, exit.v, exit_ng);
+    /* Cycles shades the exit as a surface point of its triangle: the same terminator offset. */
+    dwvl_terminator exit_terminator = {mesh, exit.prim, exit.u, exit.v, cutoff};
+    const dwvl_terminator *exit_smooth = mesh->normals && cutoff > 0.0 ? &exit_terminator : NULL;
     double direct[3];
     if (material->principled_v1)
-        dwvl_direct_lobe(&shader->env, walk.position, exit_n, exit_ng, sampler, pair + DWVB_SHADE_PAIRS + light_pairs,
+        dwvl_direct_lobe(&shader->env, walk.position, exit_n, exit_ng, exit_smooth, sampler, pair + DWVB_SHADE_PAIRS + light_pairs,
                          exit_factor, &exit_n, NULL, direct);
     else
-        dwvl_direct(&shader->env, walk.position, exit_n, exit_ng, sampler, pair + DWVB_SHADE_PAIRS + light_pairs, direct);
+        dwvl_direct(&shader->env, walk.position, exit_n, exit_ng, exit_smooth, sampler, pair + DWVB_SHADE_PAIRS + light_pairs, direct);
     int grey = material->medium.channels == 1;
     for (int c = 0; c < 3; ++c) rgb[c] += walk.weight[grey ? 0 : c] * material->walk_scale[c] * direct[c];
 }

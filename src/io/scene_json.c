@@ -579,8 +579,8 @@ static dwv_result_t resolve_path(const char *base_dir, const char *file, const c
 
 static dwv_result_t read_mesh(parser *ps, const cJSON *item, const char *path, named *record)
 {
-    static const char *const keys[] = {"name", "material", "transform", "file", "positions", "indices",
-                                       "normals", "uvs"};
+    static const char *const keys[] = {"name",    "material", "transform", "file", "positions",
+                                       "indices", "normals",  "uvs",       "shadow_terminator_geometry_offset"};
     DWV_TRY(check_keys(item, path, keys, sizeof keys / sizeof keys[0]));
     char p[PATH_SIZE], name[SHOWN_SIZE];
     const cJSON *name_item = member(item, "name");
@@ -605,6 +605,7 @@ static dwv_result_t read_mesh(parser *ps, const cJSON *item, const char *path, n
     mesh.material_id = material->id;
     memcpy(mesh.transform, identity, sizeof identity);
     DWV_TRY(opt_transform(item, path, mesh.transform));
+    DWV_TRY(opt_number(item, path, "shadow_terminator_geometry_offset", &mesh.shadow_terminator_geometry_offset));
 
     const cJSON *file = member(item, "file");
     int inline_data = member(item, "positions") || member(item, "indices") || member(item, "normals") ||

@@ -5,23 +5,76 @@
 
 #define INV_PI 0.31830988618379067154
 
-void dwvl_direct_lobe(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng, const dwvk_sampler *sampler,
-                      uint32_t pair, dwvl_lobe_factor factor, const void *context, double lambert[3], double lobe[3])
+/* The origins of one shading point's shadow rays: x + epsilon ng, moved by a ray's share of the
+ * smooth surface's lift (terminator.h), which is computed once, for the first ray that takes some. */
+typedef struct shadow_origins {
+    const dwvl_terminator *terminator; /* NULL: a flat-shaded point */
+    dwvw_vec3 n, ng, flat, lift;
+    int have_lift;
+} shadow_origins;
+
+/* The share of the lift a shadow ray along unit `light` takes. */
+static double lift_amount(const shadow_origins *o, dwvw_vec3 light)
+{
+    const dwvl_terminator *t = o->terminator;
+    return t ? dwvl_terminator_amount(dwvw_dot(o->n, light), dwvw_dot(o->ng, light), t->cutoff) : 0.0;
+}
+
+static dwvw_vec3 shadow_origin(shadow_origins *o, double amount)
+{
+    if (!(amount > 0.0)) return o->flat;
+    if (!o->have_lift) {
+        const dwvl_terminator *t = o->terminator;
+        o->lift = dwvl_terminator_lift_at(t->mesh, t->prim, t->u, t->v, o->ng);
+        o->have_lift = 1;
+    }
+    return dwvw_madd(o->flat, o->lift, amount);
+}
+
+/* Whether a light the shading normal faces gets a shadow ray. The lift never goes below the flat
+ * triangle. Light above the flat triangle (ng.light > 0) always does: the ray cannot meet its own
+ * triangle, so the epsilon does what Cycles' skipping of the triangle itself (its
+ * self-intersection test when Ng.L > 0) does. Light below it (ng.light <= 0, the shading normal's
+ * terminator lies beyond the flat one's) does only from the smooth surface, as in Cycles: the ray
+ * takes the whole lift (dwvl_terminator_amount is 1 there) and, Cycles not skipping its own
+ * triangle then, is shadowed where it passes through that triangle. A flat point (no terminator,
+ * or cutoff 0) is unlit there: its ray would enter the mesh at once. */
+static int shadow_ray_allowed(const shadow_origins *o, dwvw_vec3 light)
+{
+    return dwvw_dot(o->ng, light) > 0.0 || (o->terminator && o->terminator->cutoff > 0.0);
+}
+
+void dwvl_direct_lobe(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng,
+                      const dwvl_terminator *terminator, const dwvk_sampler *sampler, uint32_t pair,
+                      dwvl_lobe_factor factor, const void *context, double lambert[3], double lobe[3])
 {
     double plain[3] = {0.0, 0.0, 0.0}, weighted[3] = {0.0, 0.0, 0.0};
     double eps = env->geometry ? env->geometry->epsilon : 0.0;
-    dwvw_vec3 origin = dwvw_madd(x, ng, eps);
+    shadow_origins origins = {terminator, n, ng, dwvw_madd(x, ng, eps), dwvw_v(0.0, 0.0, 0.0), 0};
     for (uint32_t i = 0; i < env->light_count; ++i) {
         dwvl_sample s;
         double u[2];
         dwvk_sampler_pair(sampler, pair + i, u);
         dwvl_light_sample(&env->lights[i], x, u[0], u[1], &s);
         double cos_n = dwvw_dot(n, s.direction);
-        if (!(cos_n > 0.0) || !(dwvw_dot(ng, s.direction) > 0.0)) continue;
+        if (!(cos_n > 0.0)) continue;
+        if (!shadow_ray_allowed(&origins, s.direction)) continue;
         if (!(s.value[0] > 0.0 || s.value[1] > 0.0 || s.value[2] > 0.0)) continue;
-        /* The segment stops short of the light by the offset, so that an area light lying on a
-         * surface does not shadow itself. */
-        if (env->geometry && dwvg_occluded(env->geometry, origin, s.direction, 0.0, s.distance - 2.0 * eps)) continue;
+        if (env->geometry) {
+            double amount = lift_amount(&origins, s.direction);
+            dwvw_vec3 origin = shadow_origin(&origins, amount);
+            dwvw_vec3 toward = s.direction;
+            double distance = s.distance;
+            if (amount > 0.0 && isfinite(distance)) {
+                /* The sampled light point, seen from the moved origin (as Cycles aims it). */
+                dwvw_vec3 to_light = dwvw_sub(dwvw_madd(x, s.direction, s.distance), origin);
+                distance = dwvw_length(to_light);
+                toward = dwvw_scale(to_light, 1.0 / distance);
+            }
+            /* The segment stops short of the light by the offset, so that an area light lying on
+             * a surface does not shadow itself. */
+            if (dwvg_occluded(env->geometry, origin, toward, 0.0, distance - 2.0 * eps)) continue;
+        }
         double f = factor ? factor(context, s.direction) : 0.0;
         for (int c = 0; c < 3; ++c) {
             plain[c] += s.value[c] * cos_n * INV_PI;
@@ -35,7 +88,9 @@ void dwvl_direct_lobe(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwv
         dwvk_sampler_pair(sampler, pair + env->light_count, u);
         double mu = sqrt(u[0]);
         dwvw_vec3 w = dwvw_direction_about(n, mu, 1.0 - mu, 1.0 + mu, u[1]);
-        if (dwvw_dot(ng, w) > 0.0 && !(env->geometry && dwvg_occluded(env->geometry, origin, w, 0.0, INFINITY))) {
+        if (shadow_ray_allowed(&origins, w) &&
+            !(env->geometry &&
+              dwvg_occluded(env->geometry, shadow_origin(&origins, lift_amount(&origins, w)), w, 0.0, INFINITY))) {
             double f = factor ? factor(context, w) : 0.0;
             for (int c = 0; c < 3; ++c) {
                 plain[c] += env->world[c];
@@ -49,8 +104,8 @@ void dwvl_direct_lobe(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwv
     }
 }
 
-void dwvl_direct(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng, const dwvk_sampler *sampler,
-                 uint32_t pair, double out[3])
+void dwvl_direct(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng,
+                 const dwvl_terminator *terminator, const dwvk_sampler *sampler, uint32_t pair, double out[3])
 {
-    dwvl_direct_lobe(env, x, n, ng, sampler, pair, NULL, NULL, out, NULL);
+    dwvl_direct_lobe(env, x, n, ng, terminator, sampler, pair, NULL, NULL, out, NULL);
 }

@@ -8,6 +8,7 @@
 #include "geom/embree.h"
 #include "kernel/sampler.h"
 #include "light.h"
+#include "terminator.h"
 
 typedef struct dwvl_environment {
     const dwvl_light *lights;
@@ -25,9 +26,14 @@ static inline uint32_t dwvl_direct_pairs(const dwvl_environment *env)
 
 /* (1/pi) integral of L_in cos over the hemisphere of the shading normal `n` at x, estimated with
  * the uniform pairs of `sampler` starting at pair `pair`; `ng` is the unit geometric normal on
- * the same side (shadow rays leave from x + epsilon ng and never below the geometric surface). */
-void dwvl_direct(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng, const dwvk_sampler *sampler,
-                 uint32_t pair, double out[3]);
+ * the same side (shadow rays leave from x + epsilon ng).
+ * `terminator` (NULL: a flat-shaded point) moves each shadow ray's origin by its share of the
+ * smooth surface's lift (terminator.h), as Cycles does for smooth-shaded triangles; a light at a
+ * finite distance is then aimed at from the moved origin. With a terminator whose cutoff is
+ * above 0, light that n faces but the flat triangle does not (ng.light <= 0) is also tested, from
+ * the smooth surface, as Cycles does; without one it is taken as shadowed. */
+void dwvl_direct(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng,
+                 const dwvl_terminator *terminator, const dwvk_sampler *sampler, uint32_t pair, double out[3]);
 
 /* A BRDF's factor beside the Lambertian 1/pi for light arriving along unit `light` (toward the
  * light): the BRDF is (1/pi) factor(context, light). */
@@ -36,7 +42,8 @@ typedef double (*dwvl_lobe_factor)(const void *context, dwvw_vec3 light);
 /* dwvl_direct with the same light samples (the same pairs of `sampler`) also weighted by
  * `factor`: lambert gets what dwvl_direct gives (NULL: not wanted), lobe the same integral with
  * (1/pi) factor(light) cos as the BRDF term. */
-void dwvl_direct_lobe(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng, const dwvk_sampler *sampler,
-                      uint32_t pair, dwvl_lobe_factor factor, const void *context, double lambert[3], double lobe[3]);
+void dwvl_direct_lobe(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng,
+                      const dwvl_terminator *terminator, const dwvk_sampler *sampler, uint32_t pair,
+                      dwvl_lobe_factor factor, const void *context, double lambert[3], double lobe[3]);
 
 #endif

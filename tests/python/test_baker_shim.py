@@ -24,7 +24,7 @@ SOURCE_DIR = Path(os.environ.get("DWIVEDI_SOURCE_DIR", Path(__file__).resolve().
 sys.path.append(str(SOURCE_DIR / "python_shim"))
 
 import dwivedi  # noqa: E402
-from dwivedi import _buffers, _library  # noqa: E402
+from dwivedi import _buffers, _library, report  # noqa: E402
 
 try:
     import numpy
@@ -80,7 +80,7 @@ class StructLayoutTest(unittest.TestCase):
     def test_sizes_on_lp64(self):
         if ctypes.sizeof(ctypes.c_void_p) != 8:
             self.skipTest("the sizes below are those of an LP64 ABI")
-        sizes = {"dwv_material_t": 128, "dwv_mesh_t": 144, "dwv_light_desc_t": 216, "dwv_camera_t": 128,
+        sizes = {"dwv_material_t": 128, "dwv_mesh_t": 152, "dwv_light_desc_t": 216, "dwv_camera_t": 128,
                  "dwv_bake_progress_t": 48, "dwv_bake_options_t": 96, "dwv_image_info_t": 40,
                  "dwv_bake_stats_t": 128, "dwv_error_point_t": 24, "dwv_display_options_t": 56}
         for name, size in sizes.items():
@@ -202,6 +202,10 @@ class SceneTest(unittest.TestCase):
                 (lambda: scene.set_world((0.1, 0.1, math.inf)), None),
                 (lambda: scene.set_camera(dwivedi.Camera(focal_length=0.0)), _library.DWV_ERROR_OUT_OF_RANGE),
                 (lambda: scene.add_mesh(CUBE_POSITIONS, CUBE_TRIANGLES, material, uvs=[0.0] * 6), 2),
+                (lambda: scene.add_mesh(CUBE_POSITIONS, CUBE_TRIANGLES, material,
+                                        shadow_terminator_geometry_offset=-0.1), _library.DWV_ERROR_OUT_OF_RANGE),
+                (lambda: scene.add_mesh(CUBE_POSITIONS, CUBE_TRIANGLES, material,
+                                        shadow_terminator_geometry_offset=math.nan), None),
             ]
             for call, code in cases:
                 with self.assertRaises(dwivedi.Error) as caught:
@@ -338,6 +342,38 @@ class BakeTest(unittest.TestCase):
             self.assertEqual(again.pixels().tobytes(), pixels.tobytes())
             other = dwivedi.bake(scene, width=24, height=16, samples=8, threads=2, seed=4)
             self.assertNotEqual(other.pixels().tobytes(), pixels.tobytes())
+
+    def test_shadow_terminator_geometry_offset(self):
+        """A smooth-shaded low-poly sphere lit from the side: with Cycles' default geometry offset
+        (0.1, also add_mesh's default) the points whose shading normal faces the sun but whose
+        flat triangle does not are lit from the smooth surface, so the image is brighter than
+        with 0 (shadow rays from the flat triangle), and only near the terminator."""
+        points, triangles = report.uv_sphere(segments=12, rings=6)
+        # Light travelling along -(cos 15, sin 15, 0) degrees: the terminator, at azimuth 105 and -75
+        # degrees, crosses the middle of the 30-degree facets (on their edges the flat and the
+        # smooth terminator coincide).
+        travel = (-math.cos(math.radians(15.0)), -math.sin(math.radians(15.0)), 0.0)
+
+        def bake(**offset):
+            scene = dwivedi.Scene()
+            material = scene.add_material(dwivedi.Material(kind="diffuse", base_color=(0.8, 0.8, 0.8)))
+            scene.add_mesh(points, triangles, material, normals=points, **offset)
+            scene.add_light(dwivedi.SunLight(direction=travel, strength=3.0))
+            scene.set_camera(dwivedi.Camera.look_at((0.0, -4.0, 0.0), (0.0, 0.0, 0.0)))
+            with scene.commit() as committed:
+                return dwivedi.bake(committed, width=32, height=32, samples=4, threads=2, seed=1).pixels()
+
+        default, cycles, flat = bake(), bake(shadow_terminator_geometry_offset=0.1), bake(
+            shadow_terminator_geometry_offset=0.0)
+        self.assertEqual(default.tobytes(), cycles.tobytes())
+        brighter = [i for i in range(0, len(flat), 4) if cycles[i] > flat[i]]
+        darker = [i for i in range(0, len(flat), 4) if cycles[i] < flat[i]]
+        self.assertFalse(darker, "the offset only lights points the flat triangle shadows")
+        self.assertTrue(brighter, "the offset lights points past the flat triangles' terminator")
+        # The camera looks along +y from -y: the seen terminator is at x = cos 75 degrees = 0.26 m,
+        # right of the middle column.
+        columns = {(i // 4) % 32 for i in brighter}
+        self.assertTrue(all(16 <= c < 26 for c in columns), sorted(columns))
 
     def test_uv_bake(self):
         with cube_scene(uvs=True, camera=False).commit() as scene:

@@ -130,8 +130,24 @@ static void test_meshes(dwv_scene_t *scene)
     EXPECT(dwv_scene_add_mesh(NULL, &m, &id), DWV_ERROR_NULL_POINTER, "scene");
     EXPECT(dwv_scene_add_mesh(scene, NULL, &id), DWV_ERROR_NULL_POINTER, "mesh");
     EXPECT(dwv_scene_add_mesh(scene, &m, NULL), DWV_ERROR_NULL_POINTER, "mesh_id");
-    m.struct_size = sizeof(dwv_mesh_t) - 8;
+    m.struct_size = (uint32_t)offsetof(dwv_mesh_t, shadow_terminator_geometry_offset) - 8u;
     EXPECT(dwv_scene_add_mesh(scene, &m, &id), DWV_ERROR_STRUCT_SIZE, "mesh");
+    /* A 0.1.0 caller's struct ends at transform: accepted, and what lies beyond its struct_size
+     * (here garbage) is never read. */
+    m = tetra(0);
+    m.struct_size = (uint32_t)offsetof(dwv_mesh_t, shadow_terminator_geometry_offset);
+    m.shadow_terminator_geometry_offset = NAN;
+    uint32_t old_id = 12345u;
+    CHECK(dwv_scene_add_mesh(scene, &m, &old_id) == DWV_SUCCESS && old_id != 12345u, "a 0.1.0-sized mesh: %s",
+          dwv_last_error_message());
+    m = tetra(0);
+    CHECK(m.shadow_terminator_geometry_offset == 0.1, "DWV_MESH_INIT's geometry offset is Cycles' default 0.1");
+    m.shadow_terminator_geometry_offset = NAN;
+    EXPECT(dwv_scene_add_mesh(scene, &m, &id), DWV_ERROR_INVALID_ARGUMENT, "shadow_terminator_geometry_offset");
+    m.shadow_terminator_geometry_offset = -0.1;
+    EXPECT(dwv_scene_add_mesh(scene, &m, &id), DWV_ERROR_OUT_OF_RANGE, "shadow_terminator_geometry_offset");
+    m.shadow_terminator_geometry_offset = 0.0;
+    CHECK(dwv_scene_add_mesh(scene, &m, &id) == DWV_SUCCESS, "geometry offset 0: %s", dwv_last_error_message());
     m = tetra(0);
     m.positions = NULL;
     EXPECT(dwv_scene_add_mesh(scene, &m, &id), DWV_ERROR_NULL_POINTER, "positions");

@@ -327,6 +327,18 @@ static void test_schema(void)
                    "meshes[0]: unknown key 'matrial'", NULL);
     expect_failure("mesh without material", "{\"version\": 1, " MATERIAL ", \"meshes\": [{" TETRA "}]}",
                    DWV_ERROR_FORMAT, "meshes[0]", "material");
+    expect_failure("negative geometry offset",
+                   "{\"version\": 1, " MATERIAL ", \"meshes\": [{\"material\": \"m\", " TETRA
+                   ", \"shadow_terminator_geometry_offset\": -1}]}",
+                   DWV_ERROR_OUT_OF_RANGE, "meshes[0]", "shadow_terminator_geometry_offset");
+    expect_failure("geometry offset a string",
+                   "{\"version\": 1, " MATERIAL ", \"meshes\": [{\"material\": \"m\", " TETRA
+                   ", \"shadow_terminator_geometry_offset\": \"0.1\"}]}",
+                   DWV_ERROR_FORMAT, "meshes[0].shadow_terminator_geometry_offset", "number");
+    CHECK(load_text("{\"version\": 1, " MATERIAL ", \"meshes\": [{\"material\": \"m\", " TETRA
+                    ", \"shadow_terminator_geometry_offset\": 0}]}",
+                    NULL) == DWV_SUCCESS,
+          "a mesh with geometry offset 0: %s", dwv_last_error_message());
     expect_failure("file and inline",
                    "{\"version\": 1, " MATERIAL ", \"meshes\": [{\"material\": \"m\", \"file\": \"a.obj\", " TETRA "}]}",
                    DWV_ERROR_FORMAT, "meshes[0]", "either");
