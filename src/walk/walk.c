@@ -320,14 +320,19 @@ dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 h
          * to 0 only where the weight is negligible. The classical component (s = 1) reuses those
          * channel factors, so a classical walk needs `channels` exponentials per event, a mixture
          * `channels` more per guided component (components x channels^2 without the factoring). */
-        double rate = INFINITY;
+        double rate = INFINITY; /* (extinctions are finite and positive: no NaN to order) */
         for (int k = 0; k < components; ++k) {
             if (!(qp[k] > 0.0)) continue;
-            for (int c = 0; c < channels; ++c)
-                if (walk->channel_p[c] > 0.0) rate = fmin(rate, m->sigma_t[c] * walk->component_stretch[k]);
+            for (int c = 0; c < channels; ++c) {
+                double sigma = m->sigma_t[c] * walk->component_stretch[k];
+                if (walk->channel_p[c] > 0.0 && sigma < rate) rate = sigma;
+            }
         }
+        /* The channel whose extinction is the rate has exp(0) = 1 exactly (dwvk_exp_fast(0) is 1):
+         * skip the call, one of the `channels` exponentials of a classical event. */
         double channel_factor[DWVW_MAX_CHANNELS], denominator = 0.0;
-        for (int c = 0; c < channels; ++c) channel_factor[c] = dwvk_exp_fast((rate - m->sigma_t[c]) * t);
+        for (int c = 0; c < channels; ++c)
+            channel_factor[c] = m->sigma_t[c] == rate ? 1.0 : dwvk_exp_fast((rate - m->sigma_t[c]) * t);
         if (rate < INFINITY) {
             for (int k = 0; k < components; ++k) {
                 if (!(qp[k] > 0.0)) continue;
