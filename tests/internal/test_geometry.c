@@ -8,41 +8,10 @@
 #include "bake/bake.h"
 #include "bake/scene.h"
 #include "bake_scenes.h"
+#include "brute_force.h"
 #include "check.h"
 #include "geom/embree.h"
 #include "kernel/rng.h"
-
-/* Distance from p to triangle abc by brute force: the face's plane where the projection falls
- * inside, else the nearest of the three edges (segments). */
-static double segment_distance(dwvw_vec3 p, dwvw_vec3 a, dwvw_vec3 b)
-{
-    dwvw_vec3 ab = dwvw_sub(b, a);
-    double t = dwvw_dot(dwvw_sub(p, a), ab) / dwvw_dot(ab, ab);
-    t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
-    return dwvw_length(dwvw_sub(p, dwvw_madd(a, ab, t)));
-}
-
-static double brute_distance(const dwvg_mesh *mesh, uint32_t prim, dwvw_vec3 p)
-{
-    dwvw_vec3 v[3];
-    for (int k = 0; k < 3; ++k) {
-        const float *q = mesh->positions + 3u * mesh->indices[3u * prim + (uint32_t)k];
-        v[k] = dwvw_v(q[0], q[1], q[2]);
-    }
-    dwvw_vec3 n = dwvg_geometric_normal(mesh, prim);
-    double h = dwvw_dot(dwvw_sub(p, v[0]), n);
-    dwvw_vec3 x = dwvw_madd(p, n, -h);
-    int inside = 1;
-    for (int k = 0; k < 3; ++k) {
-        dwvw_vec3 e = dwvw_sub(v[(k + 1) % 3], v[k]), w = dwvw_sub(x, v[k]);
-        dwvw_vec3 c = dwvw_v(e.y * w.z - e.z * w.y, e.z * w.x - e.x * w.z, e.x * w.y - e.y * w.x);
-        if (dwvw_dot(c, n) < 0.0) inside = 0;
-    }
-    if (inside) return fabs(h);
-    double d = segment_distance(p, v[0], v[1]);
-    d = fmin(d, segment_distance(p, v[1], v[2]));
-    return fmin(d, segment_distance(p, v[2], v[0]));
-}
 
 static dwvb_scene *commit_meshes(const test_mesh *meshes, int count, const double *transform)
 {
@@ -73,7 +42,7 @@ static void test_closest_and_rays(void)
         dwvw_vec3 p = dwvw_v(0.3 + 2.4 * (dwvk_rng_uniform_d(key, 0) - 0.5), -0.2 + 2.4 * (dwvk_rng_uniform_d(key, 1) - 0.5),
                              0.1 + 2.4 * (dwvk_rng_uniform_d(key, 2) - 0.5));
         double best = INFINITY;
-        for (uint32_t t = 0; t < mesh->triangle_count; ++t) best = fmin(best, brute_distance(mesh, t, p));
+        for (uint32_t t = 0; t < mesh->triangle_count; ++t) best = fmin(best, brute_triangle_distance(mesh, t, p, NULL));
         dwvg_hit hit;
         int found = dwvg_closest_mesh(&scene->geometry, 0, p, &hit);
         double d = found ? dwvw_length(dwvw_sub(dwvg_point(mesh, hit.prim, hit.u, hit.v), p)) : INFINITY;

@@ -15,22 +15,13 @@
 #include <stdio.h>
 
 #include "bake/material.h"
+#include "brute_force.h"
 #include "check.h"
 #include "light/direct.h"
 #include "light/light.h"
 
 /* 1 - 1/42: the exit BSDF's albedo (see above). */
 static const double EXIT_ALBEDO = 41.0 / 42.0;
-
-/* A small deterministic generator for test directions (SplitMix64 to [0, 1)). */
-static double uniform(uint64_t *state)
-{
-    uint64_t z = (*state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    z ^= z >> 31;
-    return (double)(z >> 11) * 0x1.0p-53;
-}
 
 /* A unit direction on the upper hemisphere (z > 0) from two uniforms. */
 static dwvw_vec3 upper(double u1, double u2)
@@ -100,8 +91,8 @@ static void test_retro_reflection(void)
     uint64_t state = 12345u;
     double worst = 0.0;
     for (int i = 0; i < 100000; ++i) {
-        dwvw_vec3 l = upper(uniform(&state), uniform(&state)), v = upper(uniform(&state), uniform(&state));
-        double roughness = uniform(&state);
+        dwvw_vec3 l = upper(brute_uniform(&state), brute_uniform(&state)), v = upper(brute_uniform(&state), brute_uniform(&state));
+        double roughness = brute_uniform(&state);
         /* The half-vector form: R_R = 2 roughness cos^2 theta_d, theta_d between L and H. */
         dwvw_vec3 h = dwvw_add(l, v);
         double len = sqrt(dwvw_dot(h, h));
@@ -133,8 +124,8 @@ static void test_principled_diffuse(void)
     uint64_t state = 777u;
     double worst = 0.0;
     for (int i = 0; i < 10000; ++i) {
-        dwvw_vec3 l = upper(uniform(&state), uniform(&state)), v = upper(uniform(&state), uniform(&state));
-        double roughness = uniform(&state);
+        dwvw_vec3 l = upper(brute_uniform(&state), brute_uniform(&state)), v = upper(brute_uniform(&state), brute_uniform(&state));
+        double roughness = brute_uniform(&state);
         double fl = pow(1.0 - l.z, 5.0), fv = pow(1.0 - v.z, 5.0);
         double want = (1.0 - 0.5 * fl) * (1.0 - 0.5 * fv) +
                       dwvb_principled_retro_factor(l.z, v.z, dwvw_dot(l, v), roughness);

@@ -23,6 +23,7 @@
 #include "bake/bake.h"
 #include "bake/scene.h"
 #include "bake_scenes.h"
+#include "brute_force.h"
 #include "check.h"
 #include "dwivedi.h"
 #include "geom/embree.h"
@@ -121,55 +122,6 @@ static dwv_scene_t *make_scene(int kind)
 
 /* --- 1. the grid's bound ------------------------------------------------------------------- */
 
-static double segment_distance(dwvw_vec3 p, dwvw_vec3 a, dwvw_vec3 b)
-{
-    dwvw_vec3 ab = dwvw_sub(b, a);
-    double length2 = dwvw_dot(ab, ab);
-    double t = length2 > 0.0 ? dwvw_dot(dwvw_sub(p, a), ab) / length2 : 0.0;
-    t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
-    return dwvw_length(dwvw_sub(p, dwvw_madd(a, ab, t)));
-}
-
-/* Brute force, written apart from the library's: inside the face's prism the plane's distance,
- * else the nearest edge; a zero-area triangle by its edges. *nearest gets the nearest point. */
-static double triangle_distance(const dwvg_mesh *mesh, uint32_t prim, dwvw_vec3 p, dwvw_vec3 *nearest)
-{
-    dwvw_vec3 v[3];
-    for (int k = 0; k < 3; ++k) {
-        const float *q = mesh->positions + 3u * mesh->indices[3u * prim + (uint32_t)k];
-        v[k] = dwvw_v(q[0], q[1], q[2]);
-    }
-    dwvw_vec3 n = dwvg_geometric_normal(mesh, prim);
-    if (n.x != 0.0 || n.y != 0.0 || n.z != 0.0) {
-        double h = dwvw_dot(dwvw_sub(p, v[0]), n);
-        dwvw_vec3 x = dwvw_madd(p, n, -h);
-        int inside = 1;
-        for (int k = 0; k < 3; ++k) {
-            dwvw_vec3 e = dwvw_sub(v[(k + 1) % 3], v[k]), w = dwvw_sub(x, v[k]);
-            dwvw_vec3 c = dwvw_v(e.y * w.z - e.z * w.y, e.z * w.x - e.x * w.z, e.x * w.y - e.y * w.x);
-            if (dwvw_dot(c, n) < 0.0) inside = 0;
-        }
-        if (inside) {
-            *nearest = x;
-            return fabs(h);
-        }
-    }
-    double best = INFINITY;
-    *nearest = v[0];
-    for (int k = 0; k < 3; ++k) {
-        dwvw_vec3 a = v[k], b = v[(k + 1) % 3], ab = dwvw_sub(b, a);
-        double length2 = dwvw_dot(ab, ab);
-        double t = length2 > 0.0 ? dwvw_dot(dwvw_sub(p, a), ab) / length2 : 0.0;
-        t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
-        double d = segment_distance(p, a, b);
-        if (d < best) {
-            best = d;
-            *nearest = dwvw_madd(a, ab, t);
-        }
-    }
-    return best;
-}
-
 static void check_bound(int kind)
 {
     dwv_scene_t *handle = make_scene(kind);
@@ -201,7 +153,7 @@ static void check_bound(int kind)
         uint32_t nearest_prim = 0;
         for (uint32_t t = 0; t < mesh->triangle_count; ++t) {
             dwvw_vec3 x = p;
-            double d = triangle_distance(mesh, t, p, &x);
+            double d = brute_triangle_distance(mesh, t, p, &x);
             if (d < exact) {
                 exact = d;
                 nearest = x;

@@ -20,6 +20,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+#include "brute_force.h"
 #include "check.h"
 #include "geom/embree.h"
 #include "geom/mesh.h"
@@ -30,24 +31,15 @@
 /* Cycles' default "Shadow Terminator > Geometry Offset". */
 static const double CYCLES_GEOMETRY_OFFSET = 0.1;
 
-static double uniform(uint64_t *state)
-{
-    uint64_t z = (*state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    z ^= z >> 31;
-    return (double)(z >> 11) * 0x1.0p-53;
-}
-
 static dwvw_vec3 unit_vector(uint64_t *state)
 {
-    double z = 2.0 * uniform(state) - 1.0, r = sqrt(fmax(0.0, 1.0 - z * z)), phi = 6.283185307179586 * uniform(state);
+    double z = 2.0 * brute_uniform(state) - 1.0, r = sqrt(fmax(0.0, 1.0 - z * z)), phi = 6.283185307179586 * brute_uniform(state);
     return dwvw_v(r * cos(phi), r * sin(phi), z);
 }
 
 static void random_barycentrics(uint64_t *state, double b[3])
 {
-    double su = sqrt(uniform(state)), v = uniform(state);
+    double su = sqrt(brute_uniform(state)), v = brute_uniform(state);
     b[1] = su * (1.0 - v);
     b[2] = su * v;
     b[0] = 1.0 - b[1] - b[2];
@@ -183,7 +175,7 @@ static void test_amount(void)
     uint64_t state = 11u;
     int rising = 0;
     for (int trial = 0; trial < 1000; ++trial) {
-        double cos_n = uniform(&state), g1 = 2.0 * uniform(&state) - 1.0, g2 = 2.0 * uniform(&state) - 1.0;
+        double cos_n = brute_uniform(&state), g1 = 2.0 * brute_uniform(&state) - 1.0, g2 = 2.0 * brute_uniform(&state) - 1.0;
         double lo = fmin(g1, g2), hi = fmax(g1, g2);
         double a_lo = dwvl_terminator_amount(cos_n, lo, cutoff), a_hi = dwvl_terminator_amount(cos_n, hi, cutoff);
         rising += a_hi > a_lo || a_lo < 0.0 || a_lo > 1.0;
