@@ -594,7 +594,7 @@ typedef struct dwv_bake_options_t {
     uint32_t uv_margin;       /* UV bakes: pixels of dilation around islands, <= 64 */
     dwv_technique_t technique;
     uint64_t samples;         /* samples per pixel, 1 to 2^24; the bake stops there */
-    double time_limit;        /* seconds, >= 0; 0: none */
+    double time_limit;        /* seconds, >= 0; 0: none; cuts only after the first pass (2 spp) */
     double target_error;      /* relative error of the image, >= 0; 0: none */
     uint32_t threads;         /* 0: all cores; at most 1024 */
     uint32_t max_events;      /* cap on scattering events per walk; 0: 10^6 */

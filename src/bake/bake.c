@@ -161,11 +161,15 @@ static int pixel_active(const dwvb_bake *bake, uint32_t index)
     return bake->options.target == DWV_BAKE_CAMERA || bake->raster.texels[index].triangle >= 0;
 }
 
-/* Whether the worker must stop: cancelled, or (with a time limit) out of time. */
+/* Whether the worker must stop: cancelled, or (with a time limit) out of time. The time limit
+ * cuts only once the first pass is done (spp_done is written between passes, while no worker
+ * runs), so that a budget shorter than auto's pilot and the first pass ends the bake right after
+ * them with that pass's samples (2 per pixel, 1 where 1 is asked), not with an empty image; as
+ * Cycles, which renders at least one sample. */
 static int must_stop(dwvb_bake *bake)
 {
     if (atomic_load_explicit(&bake->cancelled, memory_order_relaxed)) return 1;
-    if (bake->options.time_limit > 0.0 && elapsed(bake) >= bake->options.time_limit) {
+    if (bake->options.time_limit > 0.0 && bake->spp_done > 0 && elapsed(bake) >= bake->options.time_limit) {
         atomic_store(&bake->time_up, 1);
         return 1;
     }

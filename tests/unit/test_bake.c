@@ -281,6 +281,18 @@ static void test_cancel_and_budgets(void)
         dwv_image_release(image);
         image = NULL;
     }
+    /* A budget shorter than the first pass: that pass completes, the next one is cut at once. */
+    o.time_limit = 1e-9;
+    CHECK(dwv_bake(scene, &o, &image) == DWV_SUCCESS, "tiny time budget: %s", dwv_last_error_message());
+    if (image) {
+        dwv_bake_stats_t st = DWV_BAKE_STATS_INIT;
+        dwv_image_stats(image, &st);
+        CHECK(st.samples_per_pixel == 2u && st.samples > 0 && st.samples % 2u == 0u,
+              "tiny time budget: %llu spp, %llu samples (want the first pass's 2 per pixel)",
+              (unsigned long long)st.samples_per_pixel, (unsigned long long)st.samples);
+        dwv_image_release(image);
+        image = NULL;
+    }
     /* Target error: stops after the pass that reaches it. */
     o.time_limit = 0.0;
     o.target_error = 0.1;
