@@ -17,6 +17,7 @@
 #include "bake/material.h"
 #include "brute_force.h"
 #include "check.h"
+#include "stats.h"
 #include "light/direct.h"
 #include "light/light.h"
 
@@ -30,31 +31,23 @@ static dwvw_vec3 upper(double u1, double u2)
     return dwvw_v(r * cos(phi), r * sin(phi), z);
 }
 
-/* int_0^1 2 mu g(mu) dmu by 64-point Gauss-Legendre on [0, 1] (exact for polynomials of degree
- * up to 127; the integrands here are polynomials of degree 6). Nodes by Newton on P_64. */
+/* The cosine-weighted hemisphere albedo of a factor g(mu) of the Lambertian BSDF. */
+typedef struct albedo_integrand {
+    double (*g)(double);
+} albedo_integrand;
+
+static double albedo_term(double mu, void *context)
+{
+    const albedo_integrand *integrand = context;
+    return 2.0 * mu * integrand->g(mu);
+}
+
+/* int_0^1 2 mu g(mu) dmu by one 20-point Gauss-Legendre panel (stats.h): exact for polynomials up
+ * to degree 39, and the integrands here are polynomials of degree 7 at most. */
 static double hemisphere_albedo(double (*g)(double))
 {
-    const int n = 64;
-    double sum = 0.0;
-    for (int i = 1; i <= n; ++i) {
-        double x = cos(3.141592653589793 * (i - 0.25) / (n + 0.5)), dp = 1.0;
-        for (int it = 0; it < 100; ++it) {
-            double p0 = 1.0, p1 = x;
-            for (int k = 2; k <= n; ++k) {
-                double p2 = ((2.0 * k - 1.0) * x * p1 - (k - 1.0) * p0) / k;
-                p0 = p1;
-                p1 = p2;
-            }
-            dp = n * (x * p1 - p0) / (x * x - 1.0);
-            double dx = p1 / dp;
-            x -= dx;
-            if (fabs(dx) < 1e-16) break;
-        }
-        double w = 2.0 / ((1.0 - x * x) * dp * dp);
-        double mu = 0.5 * (x + 1.0);
-        sum += 0.5 * w * 2.0 * mu * g(mu);
-    }
-    return sum;
+    albedo_integrand integrand = {g};
+    return stats_gl_panel(albedo_term, &integrand, 0.0, 1.0);
 }
 
 static double exit_of_mu(double mu)
