@@ -203,7 +203,7 @@ static inline double aligned_cosine(const fast_plan *plan, dwvw_vec3 direction)
 /* The Russian roulette of dwvw_walk_complete on a weight exp(log_weight) after `events` events:
  * 0 if the walk ends (absorbed), 1 if it goes on unchanged, 2 if it goes on with its weight raised
  * to the threshold (*log_weight = its log). */
-#define DWVW_LOG_ROULETTE_THRESHOLD -2.9957322735539909 /* log(DWVW_ROULETTE_THRESHOLD) */
+#define DWVW_LOG_ROULETTE_THRESHOLD -0.69314718055994531 /* log(DWVW_ROULETTE_THRESHOLD) */
 static int roulette(uint64_t key, uint32_t events, double *log_weight)
 {
     const double log_threshold = DWVW_LOG_ROULETTE_THRESHOLD;

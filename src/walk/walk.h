@@ -42,7 +42,7 @@
 #define DWVW_DIM_DIRECTION 2u
 #define DWVW_DIM_DISTANCE 4u
 #define DWVW_DIM_ROULETTE 5u
-#define DWVW_ROULETTE_THRESHOLD 0.05
+#define DWVW_ROULETTE_THRESHOLD 0.5
 /* A stratified walk (dwvw_walk_stratify) draws its first events from a pixel's sampler instead:
  * event e takes pairs first + 2e and first + 2e + 1,
  *   +0 (the free flight's uniform, the choice): the choice picks the channel, and its remainder
