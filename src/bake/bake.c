@@ -586,20 +586,25 @@ static void setup_guides(dwvb_bake *bake)
  * cannot decide (too few samples). Every candidate is unbiased, so the choice moves noise, never
  * the mean.
  * The cost is counted, not timed, so that the choice (and the image) depends on the seed only:
- * nanoseconds per sample (camera ray, shading, exit lighting), per walk event (the event's
- * sampling and weight), per Embree ray the walk casts (steps inside a ball clear of the mesh cast
- * none: shade.c run_walk), per closest-point query and per mixture term (see dwvb_tally). The
- * sample, term and event-with-its-ray costs are a least-squares fit of one-thread bake times of
- * the report's sphere, slab and default scene with every technique; the event's 415 ns are split
- * between the event and its ray, and the query priced, by a least-squares fit of instruction
- * counts (callgrind) over the sphere, slab, leaf and default scene, every technique, with and
- * without ray-free steps: 726 per event, 566 per ray, 6677 per query (x86-64, docs/speed.md).
- * Only their ratios matter. */
-#define PILOT_COST_SAMPLE 606.0
-#define PILOT_COST_EVENT 233.0
-#define PILOT_COST_RAY 182.0
-#define PILOT_COST_QUERY 2145.0
-#define PILOT_COST_TERM 18.4
+ * instructions per sample (camera ray, shading, exit lighting), per walk event (the event's
+ * sampling and weight), more per event of a walk with a guided component (every candidate but
+ * classical: a Dwivedi direction's frame, sampling and pdf; measured 1.35x a classical event on
+ * the report's sphere), per Embree ray the walk casts (steps inside a ball clear of the mesh cast
+ * none: shade.c run_walk), per closest-point query and per mixture term (see dwvb_tally). They
+ * are a least-squares fit (relative residuals, coefficients >= 0) of callgrind's instruction
+ * counts in the bake's workers, one thread, 24 x 24 pixels, 8 spp, over the report's sphere,
+ * slab, leaf and default scene x classical, poe, backward, incident, closest and cycles:
+ * tools/fit_pilot_cost.py, which refits them (rms residual 13.6%, 5.1% without closest, whose
+ * query cost depends on the mesh's size; docs/speed.md). One-thread bake times agreed where the
+ * machine was quiet enough to measure (report's sphere, 32 x 32 pixels, 16 spp, best of 6:
+ * backward and poe 1.5% and 5.4% faster than classical, instructions 5.0% and 7.1%); under
+ * load a timed fit (--measure time) is not usable (rms 32%). Only their ratios matter. */
+#define PILOT_COST_SAMPLE 4170.0
+#define PILOT_COST_EVENT 651.0
+#define PILOT_COST_GUIDED_EVENT 345.0
+#define PILOT_COST_RAY 766.0
+#define PILOT_COST_QUERY 6580.0
+#define PILOT_COST_TERM 43.7
 /* Pilot samples per candidate: a sixteenth of the bake's samples, at most PILOT_MAX; below
  * PILOT_MIN the estimate is too noisy to act on and auto keeps its mixture. A mesh needs
  * PILOT_MESH_MIN of them to be decided. */
@@ -699,9 +704,9 @@ static void *pilot_worker(void *arg)
                 p->count += 1.0;
                 p->sum += l;
                 p->sum_squares += l * l;
-                p->cost += PILOT_COST_SAMPLE + PILOT_COST_EVENT * (double)tally.events +
-                           PILOT_COST_RAY * (double)tally.rays + PILOT_COST_QUERY * (double)tally.point_queries +
-                           PILOT_COST_TERM * (double)tally.mixture_terms;
+                double event_cost = PILOT_COST_EVENT + (candidate == PILOT_CLASSICAL ? 0.0 : PILOT_COST_GUIDED_EVENT);
+                p->cost += PILOT_COST_SAMPLE + event_cost * (double)tally.events + PILOT_COST_RAY * (double)tally.rays +
+                           PILOT_COST_QUERY * (double)tally.point_queries + PILOT_COST_TERM * (double)tally.mixture_terms;
             }
         }
     }
