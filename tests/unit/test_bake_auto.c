@@ -8,15 +8,20 @@
  * The cases and the pilot's variance x cost ratio of the winner against the next candidate,
  * measured over seeds 1-3 at these settings (16 x 16 pixels, 128 spp: 2048 pilot samples per
  * candidate, about 1100 of them on the sphere):
- * - a sphere of subsurface colour 0.5 under a white world: entry normal, 3.0-3.4x better than
- *   incident, 10x better than classical (it fails if the pilot does not try the entry normal);
+ * - a sphere of subsurface colour 0.5 under a white world: entry normal, 2.6-3.5x better than
+ *   incident, 8-10x better than classical (main's pilot, which did not try the entry normal,
+ *   took incident here: this case fails without the candidate);
  * - a thick (2 m, 8 mean free paths) slab of colour 0.5 lit from the camera's side by a sun:
- *   guided (entry normal or incident: the lit face's normal is the entry normal), 25x classical;
- * - a thin (0.1 m) slab of colour 0.3 lit from behind: incident, 7x classical, 17x entry normal;
- * - the same thin back-lit slab with g = 0.8 (forward scattering), colour 0.8: classical, 6-8x
- *   better than either guided candidate (which keep auto's defensive classical share |g|).
- * A thick front-lit slab of colour 0.95 is no case: there classical and the entry normal are
- * within 4% of each other and either may win. */
+ *   guided (entry normal or incident: the lit face's normal is the entry normal), 19x classical;
+ * - a thin (0.1 m) slab of colour 0.3 lit from behind: incident, 6x classical, 16x entry normal;
+ * - the same thin back-lit slab with g = 0.8 (forward scattering), colour 0.8: classical, 7-12x
+ *   better than either guided candidate (which keep auto's defensive classical share |g|; main's
+ *   pilot, whose guided candidate had none, took it by chance for seed 2).
+ * A thick front-lit slab of colour 0.95 is no case: there the entry normal's variance is 0.92x
+ * to 1.05x classical's at the same 42 events per walk, so the choice rests on what a guided event
+ * costs against a classical one (1.53x in the fitted model: classical by 1.2x to 1.45x), which
+ * changes as events get cheaper. Nor is a low albedo a case for classical (colour 0.08 to 0.3,
+ * thick, front-lit): guiding back to the lit face pays there, 1.3x to 8x. */
 #include <stdio.h>
 #include <stdlib.h>
 
