@@ -597,7 +597,7 @@ static void setup_guides(dwvb_bake *bake)
  * tools/fit_pilot_cost.py, which refits them (rms residual 13.6%, 5.1% without closest, whose
  * query cost depends on the mesh's size; docs/speed.md). One-thread bake times agreed where the
  * machine was quiet enough to measure (report's sphere, 32 x 32 pixels, 16 spp, best of 6:
- * backward and poe 1.5% and 5.4% faster than classical, instructions 5.0% and 7.1%); under
+ * backward and poe 1.3% and 5.4% faster than classical, instructions 5.0% and 7.1%); under
  * load a timed fit (--measure time) is not usable (rms 32%). Only their ratios matter. */
 #define PILOT_COST_SAMPLE 4170.0
 #define PILOT_COST_EVENT 651.0
