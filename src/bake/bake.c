@@ -557,7 +557,7 @@ static void setup_guides(dwvb_bake *bake)
             technique = DWVW_CLASSICAL;
         dwvw_guide_init(&bake->guides[m], technique, &material->medium, scene->patches[m], scene->patch_count[m]);
         bake->needs_closest[m] = dwvw_guide_needs_closest(&bake->guides[m]);
-        /* Above that albedo auto's mixture competes with classical sampling in the pilot. */
+        /* Above that albedo the pilot chooses (choose_auto); the mixture stays where it cannot. */
         bake->auto_choice[m] = technique == DWVW_AUTO && mesh_used(bake, m);
     }
     update_features(bake);
@@ -565,28 +565,46 @@ static void setup_guides(dwvb_bake *bake)
 
 /* ---- auto: the technique that pays, per mesh --------------------------------------------------
  * Guiding lowers a walk's variance but costs work per event (a mixture of components, each with
- * a pdf and an exponential per channel pair); where the image's variance hardly moves (front-lit
- * thick objects) that work is wasted, and auto's small defensive classical share doubles the
- * mixture's terms where guiding alone would do (thin back-lit sheets). Before the first pass, a
- * pilot shades the same pixel samples with each candidate (classical sampling, auto's mixture,
- * and the mixture's guided part alone) and keeps, per mesh, the one with the largest efficiency
- * 1 / (variance x cost) (Veach 1997, Sec. 2.4: the efficiency of an estimator;
- * Hammersley and Handscomb 1964). Both are unbiased, so the choice moves noise, never the mean.
+ * a pdf and an exponential per channel pair); where the image's variance hardly moves that work
+ * is wasted, and auto's small defensive classical share doubles the mixture's terms where guiding
+ * alone would do (thin back-lit sheets). Before the first pass, a pilot shades the same pixel
+ * samples with each candidate and keeps, per mesh, the one with the largest efficiency
+ * 1 / (variance x cost) (Veach 1997, Sec. 2.4: the efficiency of an estimator; Hammersley and
+ * Handscomb 1964). The candidates:
+ * - classical sampling;
+ * - Dwivedi sampling about the entry normal, toward the opposite interface where the first step
+ *   found one (the backward technique; with no opposite interface it is the entry-normal
+ *   technique, poe): on thick front-lit media its walks need 30% fewer events than classical ones
+ *   at equal or lower variance (report's sphere: 17.4 against 24.3 events per walk), and on thin
+ *   sheets it aims at the far face as well as the near one (slab: variance 0.61x poe's);
+ * - the guided part of auto's mixture alone: toward the lit patches (incident), or the closest
+ *   surface point where no light reaches the mesh.
+ * Auto's mixture itself (the guided part plus a classical share of 1% or less) is no candidate:
+ * its variance was that of the guided part alone within the pilot's noise and its cost above it,
+ * so it won none of the pilots on the report's sphere, slab, leaf and default scene (both meshes)
+ * and the example scenes (20 pilots, seeds 1-3 or 1-2); it stays the technique of meshes the pilot
+ * cannot decide (too few samples). Every candidate is unbiased, so the choice moves noise, never
+ * the mean.
  * The cost is counted, not timed, so that the choice (and the image) depends on the seed only:
- * nanoseconds per sample (camera ray, shading, exit lighting), per walk event (the event's
- * sampling and weight), per Embree ray the walk casts (steps inside a ball clear of the mesh cast
- * none: shade.c run_walk), per closest-point query and per mixture term (see dwvb_tally). The
- * sample, term and event-with-its-ray costs are a least-squares fit of one-thread bake times of
- * the report's sphere, slab and default scene with every technique; the event's 415 ns are split
- * between the event and its ray, and the query priced, by a least-squares fit of instruction
- * counts (callgrind) over the sphere, slab, leaf and default scene, every technique, with and
- * without ray-free steps: 726 per event, 566 per ray, 6677 per query (x86-64, docs/speed.md).
- * Only their ratios matter. */
-#define PILOT_COST_SAMPLE 606.0
-#define PILOT_COST_EVENT 233.0
-#define PILOT_COST_RAY 182.0
-#define PILOT_COST_QUERY 2145.0
-#define PILOT_COST_TERM 18.4
+ * instructions per sample (camera ray, shading, exit lighting), per walk event (the event's
+ * sampling and weight), more per event of a walk with a guided component (every candidate but
+ * classical: a Dwivedi direction's frame, sampling and pdf; measured 1.35x a classical event on
+ * the report's sphere), per Embree ray the walk casts (steps inside a ball clear of the mesh cast
+ * none: shade.c run_walk), per closest-point query and per mixture term (see dwvb_tally). They
+ * are a least-squares fit (relative residuals, coefficients >= 0) of callgrind's instruction
+ * counts in the bake's workers, one thread, 24 x 24 pixels, 8 spp, over the report's sphere,
+ * slab, leaf and default scene x classical, poe, backward, incident, closest and cycles:
+ * tools/fit_pilot_cost.py, which refits them (rms residual 13.6%, 5.1% without closest, whose
+ * query cost depends on the mesh's size; docs/speed.md). One-thread bake times agreed where the
+ * machine was quiet enough to measure (report's sphere, 32 x 32 pixels, 16 spp, best of 6:
+ * backward and poe 1.3% and 5.4% faster than classical, instructions 5.0% and 7.1%); under
+ * load a timed fit (--measure time) is not usable (rms 32%). Only their ratios matter. */
+#define PILOT_COST_SAMPLE 4170.0
+#define PILOT_COST_EVENT 651.0
+#define PILOT_COST_GUIDED_EVENT 345.0
+#define PILOT_COST_RAY 766.0
+#define PILOT_COST_QUERY 6580.0
+#define PILOT_COST_TERM 43.7
 /* Pilot samples per candidate: a sixteenth of the bake's samples, at most PILOT_MAX; below
  * PILOT_MIN the estimate is too noisy to act on and auto keeps its mixture. A mesh needs
  * PILOT_MESH_MIN of them to be decided. */
@@ -596,18 +614,38 @@ static void setup_guides(dwvb_bake *bake)
 
 /* The candidates, in the order of the pilot (a tie keeps the earlier, cheaper one). */
 #define PILOT_CANDIDATES 3
-enum { PILOT_CLASSICAL = 0, PILOT_GUIDED = 1, PILOT_MIXTURE = 2 };
+enum { PILOT_CLASSICAL = 0, PILOT_ENTRY = 1, PILOT_GUIDED = 2 };
 
-/* Candidate `candidate` for mesh m, whose guide auto made (bake->guides[m]). */
+/* Auto's classical share at or below which the guided candidates drop it: the isotropic
+ * defensive share, min(0.01, 0.1 sqrt(1 - alpha)) (dwvw_auto_weights). Above it auto raised the
+ * share to |g| for an anisotropic medium, where the Dwivedi pdf misses the phase function's peak
+ * and a guided walk's weight per event, phase / pdf, grows without that share to bound it (it is
+ * at most 1 / share: Hesterberg's defensive mixture). Measured on a thin back-lit slab with
+ * g = 0.8, 2048 pilot samples: guided alone had sample variances of 0.003 to 380 over three seeds
+ * against classical's 0.23, so the pilot's estimate would pick it by chance. */
+#define PILOT_ISOTROPIC_SHARE 0.01
+
+/* Candidate `candidate` for mesh m, whose guide auto made (bake->guides[m]: the mixture). */
 static void pilot_guide(const dwvb_bake *bake, uint32_t m, int candidate, dwvw_guide *guide)
 {
     const dwvb_scene *scene = bake->scene;
     const dwvw_medium *medium = &scene->shading[scene->meshes[m].material_id].medium;
-    *guide = bake->guides[m];
-    if (candidate == PILOT_CLASSICAL) dwvw_guide_init(guide, DWVW_CLASSICAL, medium, NULL, 0);
-    else if (candidate == PILOT_GUIDED && guide->q_incident > 0.0)
+    const dwvw_guide *mixture = &bake->guides[m];
+    if (candidate == PILOT_CLASSICAL) {
+        dwvw_guide_init(guide, DWVW_CLASSICAL, medium, NULL, 0);
+        return;
+    }
+    if (candidate == PILOT_ENTRY) dwvw_guide_init(guide, DWVW_BACKWARD, medium, NULL, 0);
+    else if (mixture->q_incident > 0.0)
         dwvw_guide_init(guide, DWVW_INCIDENT, medium, scene->patches[m], scene->patch_count[m]);
-    else if (candidate == PILOT_GUIDED) dwvw_guide_init(guide, DWVW_CLOSEST, medium, NULL, 0);
+    else dwvw_guide_init(guide, DWVW_CLOSEST, medium, NULL, 0);
+    if (mixture->q_classical > PILOT_ISOTROPIC_SHARE) { /* keep auto's defensive classical share */
+        double guided = 1.0 - mixture->q_classical;
+        guide->q_classical = mixture->q_classical;
+        guide->q_backward *= guided;
+        guide->q_incident *= guided;
+        guide->q_closest *= guided;
+    }
 }
 
 typedef struct pilot_sums {
@@ -666,9 +704,9 @@ static void *pilot_worker(void *arg)
                 p->count += 1.0;
                 p->sum += l;
                 p->sum_squares += l * l;
-                p->cost += PILOT_COST_SAMPLE + PILOT_COST_EVENT * (double)tally.events +
-                           PILOT_COST_RAY * (double)tally.rays + PILOT_COST_QUERY * (double)tally.point_queries +
-                           PILOT_COST_TERM * (double)tally.mixture_terms;
+                double event_cost = PILOT_COST_EVENT + (candidate == PILOT_CLASSICAL ? 0.0 : PILOT_COST_GUIDED_EVENT);
+                p->cost += PILOT_COST_SAMPLE + event_cost * (double)tally.events + PILOT_COST_RAY * (double)tally.rays +
+                           PILOT_COST_QUERY * (double)tally.point_queries + PILOT_COST_TERM * (double)tally.mixture_terms;
             }
         }
     }
@@ -742,7 +780,7 @@ static int choose_auto(dwvb_bake *bake)
             /* Every candidate traced the same camera rays, so each saw the mesh equally often. */
             if (!bake->auto_choice[m] || sums[m].count < PILOT_MESH_MIN) continue;
             /* variance x cost, per sample that saw the mesh */
-            int best = PILOT_MIXTURE;
+            int best = PILOT_CLASSICAL;
             double best_work = INFINITY;
             for (int c = 0; c < PILOT_CANDIDATES; ++c) {
                 const pilot_sums *p = &sums[(size_t)c * meshes + m];
@@ -754,7 +792,6 @@ static int choose_auto(dwvb_bake *bake)
                     best = c;
                 }
             }
-            if (best == PILOT_MIXTURE) continue; /* bake->guides[m] is the mixture already */
             dwvw_guide chosen;
             pilot_guide(bake, m, best, &chosen);
             bake->guides[m] = chosen;

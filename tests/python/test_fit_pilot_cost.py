@@ -1,0 +1,93 @@
+"""tools/fit_pilot_cost.py: its non-negative least squares, and a tiny timed run end to end.
+
+Run by ctest with DWIVEDI_SOURCE_DIR and DWIVEDI_BUILD_DIR set (the tool runs the build's
+dwivedi_bake_counts). The end-to-end run bakes a few 8 x 8 images: its times are noise, so it
+checks the counts and the output's form, never a fitted value.
+"""
+
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import unittest
+
+
+def environment(name):
+    value = os.environ.get(name)
+    if not value:
+        raise AssertionError("%s is not set: run this test through ctest" % name)
+    return value
+
+
+def tool_module():
+    sys.path.insert(0, os.path.join(environment("DWIVEDI_SOURCE_DIR"), "tools"))
+    import fit_pilot_cost
+    return fit_pilot_cost
+
+
+class Fit(unittest.TestCase):
+    def test_recovers_known_costs(self):
+        fit = tool_module()
+        truth = [4000.0, 650.0, 350.0, 750.0, 6500.0, 45.0]
+        counts = [[1000, 5000, 0, 3000, 0, 45000], [1000, 3500, 3500, 2800, 0, 31000],
+                  [1000, 6000, 6000, 5900, 0, 110000], [1000, 900, 900, 500, 950, 8000],
+                  [1000, 800, 0, 760, 0, 7000], [1000, 5100, 5100, 7000, 0, 52000],
+                  [1000, 10000, 10000, 4000, 0, 190000]]
+        rows = [([float(c) for c in x], sum(t * c for t, c in zip(truth, x))) for x in counts]
+        coef, rms = fit.fit(rows)
+        self.assertLess(rms, 1e-9)
+        for got, want in zip(coef, truth):
+            self.assertAlmostEqual(got, want, delta=1e-6 * want)
+
+    def test_costs_stay_non_negative(self):
+        # Costs that fall with the ray count: the unconstrained fit's ray cost is negative.
+        fit = tool_module()
+        counts = [[100, 500, 0, 100, 0, 900], [100, 500, 0, 900, 0, 900], [100, 900, 900, 300, 0, 2000],
+                  [100, 300, 300, 600, 10, 700], [100, 700, 0, 200, 0, 1500], [100, 600, 600, 800, 0, 1000]]
+        rows = [([float(c) for c in x], 1000.0 + 10.0 * x[1] - 2.0 * x[3] + 30.0 * x[4] + x[5])
+                for x in counts]
+        coef, rms = fit.fit(rows)
+        self.assertEqual(len(coef), 6)
+        self.assertTrue(all(c >= 0.0 for c in coef), coef)
+        self.assertGreater(rms, 0.0)
+
+    def test_names_are_the_pilots_constants(self):
+        # The printed #define lines must replace bake.c's, name for name.
+        fit = tool_module()
+        with open(os.path.join(environment("DWIVEDI_SOURCE_DIR"), "src", "bake", "bake.c")) as f:
+            defined = set(re.findall(r"#define PILOT_COST_(\w+) ", f.read()))
+        self.assertEqual(defined, set(fit.NAMES))
+
+
+class EndToEnd(unittest.TestCase):
+    def test_timed_run(self):
+        source, build = environment("DWIVEDI_SOURCE_DIR"), environment("DWIVEDI_BUILD_DIR")
+        with tempfile.TemporaryDirectory() as work:
+            out = os.path.join(work, "fit.json")
+            run = subprocess.run([sys.executable, os.path.join(source, "tools", "fit_pilot_cost.py"), "--build", build,
+                                  "--measure", "time", "--repeats", "1", "--size", "8", "--spp", "2",
+                                  "--scenes", "slab,default", "--techniques", "classical,backward,closest",
+                                  "--json", out], capture_output=True, text=True, timeout=120)
+            self.assertEqual(run.returncode, 0, run.stderr)
+            for name in ("SAMPLE", "EVENT", "GUIDED_EVENT", "RAY", "QUERY", "TERM"):
+                self.assertRegex(run.stdout, r"#define PILOT_COST_%s [0-9.e+]+\n" % name)
+            with open(out) as f:
+                data = json.load(f)
+        rows = data["rows"]
+        self.assertEqual(sorted((r["scene"], r["technique"]) for r in rows),
+                         sorted((s, t) for s in ("slab", "default") for t in ("classical", "backward", "closest")))
+        for r in rows:
+            what = "%s %s" % (r["scene"], r["technique"])
+            self.assertEqual(r["samples"], 8 * 8 * 2, what)
+            self.assertGreater(r["events"], 0, what)
+            self.assertGreater(r["rays"], 0, what)
+            self.assertGreater(r["mixture_terms"], 0, what)
+            self.assertGreater(r["cost"], 0.0, what)
+            self.assertEqual(r["guided_events"], 0 if r["technique"] == "classical" else r["events"], what)
+            self.assertEqual(r["point_queries"] > 0, r["technique"] == "closest", what)
+
+
+if __name__ == "__main__":
+    unittest.main()
