@@ -58,12 +58,13 @@ static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvb_materia
             /* The first step is the probe: its full distance to the surface locates an opposite
              * interface. A ray leaving a flat triangle inward cannot meet that triangle again, so a
              * hit on the entry triangle is rounding and the ray goes on past it. */
-            double tnear = 0.0, tfar = first ? INFINITY : distance;
-            for (;;) {
+            if (first) {
+                uint32_t rays = 0;
+                found = dwvg_intersect_mesh_leaving(world, mesh, walk->position, walk->direction, entry_prim, &hit, &rays);
+                tally->rays += rays;
+            } else {
                 ++tally->rays;
-                found = dwvg_intersect_mesh(world, mesh, walk->position, walk->direction, tnear, tfar, &hit);
-                if (!(found && first && hit.prim == entry_prim)) break;
-                tnear = nextafterf((float)hit.t, INFINITY);
+                found = dwvg_intersect_mesh(world, mesh, walk->position, walk->direction, 0.0, distance, &hit);
             }
             /* Checked mode: a ray-free step whose ray meets the surface would be a wrong walk. */
             if (ray_free && found) ++tally->ray_free_misses;

@@ -125,6 +125,7 @@ int dwvg_world_build(dwvg_world *world, const dwvg_mesh *meshes, uint32_t count,
         return -1;
     }
     world->device = device;
+    world->leaving_filter = rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED) != 0;
     rtcSetDeviceErrorFunction(device, embree_error, world);
     rtcSetDeviceMemoryMonitorFunction(device, embree_memory, world);
     world->mesh_scenes = calloc(count ? count : 1u, sizeof *world->mesh_scenes);
@@ -142,7 +143,10 @@ int dwvg_world_build(dwvg_world *world, const dwvg_mesh *meshes, uint32_t count,
         RTCScene scene = rtcNewScene(device);
         if (!scene) return failed(world, message, size, "creating a mesh scene");
         world->mesh_scenes[m] = scene;
-        rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+        /* The context filter lets a walk's probe pass over the triangle it starts on in one ray
+         * (dwvg_intersect_mesh_leaving); other rays set none, and Embree then calls nothing. */
+        rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST |
+                                    (world->leaving_filter ? RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION : 0));
         RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
         if (!geometry) return failed(world, message, size, "creating a triangle geometry");
         rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, mesh->positions, 0,
@@ -235,6 +239,65 @@ int dwvg_intersect_mesh(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwv
 {
     if (!trace(world->mesh_scenes[mesh], 0, o, d, tnear, tfar, hit)) return 0;
     hit->mesh = mesh;
+    return 1;
+}
+
+/* An intersect context that rejects the hits on one triangle and keeps where it met them. Embree
+ * hands the filter the context's address, so the context comes first. */
+typedef struct leaving_context {
+    struct RTCIntersectContext context;
+    uint32_t prim;
+    float t; /* the distance Embree found on triangle prim; +inf if none */
+} leaving_context;
+
+static void leaving_filter(const struct RTCFilterFunctionNArguments *args)
+{
+    /* Ray and hit 0 of Embree's structure-of-arrays layout (rtcore_ray.h's RTCHitN_primID and
+     * RTCRayN_tfar, C++ only): rtcIntersect1 hands one (N = 1). */
+    leaving_context *leaving = (leaving_context *)args->context;
+    unsigned int n = args->N;
+    if (((const unsigned int *)args->hit)[5u * n] != leaving->prim) return;
+    leaving->t = ((const float *)args->ray)[8u * n];
+    args->valid[0] = 0;
+}
+
+/* The loop that dwvg_intersect_mesh_leaving stands for: one ray after another, each from just
+ * past the last hit on `prim`. */
+static int leaving_by_rays(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, uint32_t prim, dwvg_hit *hit,
+                           uint32_t *rays)
+{
+    double tnear = 0.0;
+    for (;;) {
+        ++*rays;
+        int found = dwvg_intersect_mesh(world, mesh, o, d, tnear, INFINITY, hit);
+        if (!(found && hit->prim == prim)) return found;
+        tnear = nextafterf((float)hit->t, INFINITY);
+    }
+}
+
+int dwvg_intersect_mesh_leaving(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, uint32_t prim,
+                                dwvg_hit *hit, uint32_t *rays)
+{
+    if (!world->leaving_filter) return leaving_by_rays(world, mesh, o, d, prim, hit, rays);
+    leaving_context leaving;
+    rtcInitIntersectContext(&leaving.context);
+    leaving.context.filter = leaving_filter;
+    leaving.prim = prim;
+    leaving.t = INFINITY;
+    struct RTCRayHit rh;
+    ++*rays;
+    if (!make_ray(&rh, o, d, 0.0, INFINITY)) return 0;
+    rtcIntersect1(world->mesh_scenes[mesh], &leaving.context, &rh);
+    int found = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+    /* Another triangle met at the very distance of prim: which of the two the first of the rays
+     * would have returned is up to Embree's traversal order, so they are cast. */
+    if (found && rh.ray.tfar == leaving.t) return leaving_by_rays(world, mesh, o, d, prim, hit, rays);
+    if (!found) return 0;
+    hit->mesh = mesh;
+    hit->prim = rh.hit.primID;
+    hit->t = rh.ray.tfar;
+    hit->u = rh.hit.u;
+    hit->v = rh.hit.v;
     return 1;
 }
 

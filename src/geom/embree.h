@@ -24,6 +24,7 @@ typedef struct dwvg_world {
                              ulps there), so it scales with the scene and clears float rounding */
     uint64_t warnings;    /* zero-area or non-finite triangles (Embree skips them) */
     uint64_t triangles;
+    int leaving_filter;   /* Embree runs context filters: mesh scenes take them */
     atomic_llong embree_bytes; /* what Embree holds now (its memory monitor) */
     atomic_int embree_error;   /* the first Embree error code, 0 if none */
 } dwvg_world;
@@ -46,6 +47,16 @@ int dwvg_occluded(const dwvg_world *world, dwvw_vec3 o, dwvw_vec3 d, double tnea
 /* As dwvg_intersect, against one mesh only. */
 int dwvg_intersect_mesh(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, double tnear,
                         double tfar, dwvg_hit *hit);
+/* The first surface of `mesh` along unit d from o, o on triangle `prim`, past that triangle: what
+ * dwvg_intersect_mesh over (0, +inf) gives when it is cast again from just past each hit on
+ * `prim` (float rounding puts o a little above or below the triangle, so the first ray may meet
+ * it). Done as one ray whose context filter rejects the hits on `prim`: the nearest other hit at
+ * or beyond 0 is the loop's answer when it lies beyond prim's (the loop's later rays see the same
+ * hits at the same distances) or before it (the loop's first ray returns it), and at equal
+ * distances, where the loop's answer depends on Embree's order of traversal, the loop itself is
+ * run. Adds the rays cast to *rays. */
+int dwvg_intersect_mesh_leaving(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, uint32_t prim,
+                                dwvg_hit *hit, uint32_t *rays);
 /* The point of `mesh` closest to p (rtcPointQuery with our own point-triangle distance): 1 and
  * *hit (t = the distance), or 0 if the mesh has no valid triangle. */
 int dwvg_closest_mesh(const dwvg_world *world, uint32_t mesh, dwvw_vec3 p, dwvg_hit *hit);
