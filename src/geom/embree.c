@@ -228,9 +228,12 @@ static int trace(RTCScene scene, int instanced, dwvw_vec3 o, dwvw_vec3 d, double
     return 1;
 }
 
+/* A world of one mesh traces that mesh's scene: the top-level scene would only add an instance
+ * (the identity transform, which leaves a ray's floats as they are) around the same BVH. */
 int dwvg_intersect(const dwvg_world *world, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar, dwvg_hit *hit)
 {
     if (world->mesh_count == 0) return 0;
+    if (world->mesh_count == 1) return trace(world->mesh_scenes[0], 0, o, d, tnear, tfar, hit);
     return trace(world->top, 1, o, d, tnear, tfar, hit);
 }
 
@@ -308,7 +311,7 @@ int dwvg_occluded(const dwvg_world *world, dwvw_vec3 o, dwvw_vec3 d, double tnea
     rtcInitIntersectContext(&context);
     struct RTCRayHit rh;
     if (!make_ray(&rh, o, d, tnear, tfar)) return 0;
-    rtcOccluded1(world->top, &context, &rh.ray);
+    rtcOccluded1(world->mesh_count == 1 ? world->mesh_scenes[0] : world->top, &context, &rh.ray);
     return rh.ray.tfar < 0.0f; /* Embree marks an occluded ray with tfar = -inf */
 }
 
