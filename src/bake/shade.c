@@ -47,9 +47,11 @@ static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvb_materia
         double distance = dwvw_walk_sample(walk);
         tally->mixture_terms += mixture_terms(walk);
         int ray_free = 0;
-        if (!first && ball_mode != DWVB_BALL_OFF && (needs_closest || grid->lower)) {
+        /* The ball's radius is below the clearance, which the grid bounds by its largest cell:
+         * a step at least that long needs neither the lookup nor the radius. */
+        if (!first && ball_mode != DWVB_BALL_OFF && (needs_closest || distance < grid->largest)) {
             if (!needs_closest) clearance = dwvg_clearance_at(grid, walk->position);
-            ray_free = distance < dwvg_clear_radius(world, walk->position, clearance);
+            ray_free = distance < clearance && distance < dwvg_clear_radius(world, walk->position, clearance);
         }
         dwvg_hit hit;
         int found = 0;

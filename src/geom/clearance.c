@@ -275,6 +275,8 @@ int dwvg_clearance_build(dwvg_clearance *grid, const dwvg_mesh *mesh, double cel
     double slack = CELL_SLACK * h;
     for (size_t i = 0; i < count; ++i)
         grid->lower[i] = fmaxf(float_below(sqrt(squared[i]) * h - half_diagonal), float_below((double)grid->lower[i] - slack));
+    grid->largest = 0.0;
+    for (size_t i = 0; i < count; ++i) grid->largest = fmax(grid->largest, (double)grid->lower[i]);
     free(squared);
     free(f);
     free(z);

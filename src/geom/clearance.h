@@ -31,6 +31,7 @@ typedef struct dwvg_clearance {
     double origin[3];  /* the grid's lowest corner */
     double cell;       /* the cell size h */
     uint32_t n[3];     /* cells per axis */
+    double largest;    /* the largest bound of any cell (0 without a grid): no lookup gives more */
 } dwvg_clearance;
 
 /* Builds the grid of `mesh` with cells of at least `cell_size` (finite, > 0), coarser where
