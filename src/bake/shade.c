@@ -3,14 +3,17 @@
 #include <math.h>
 
 
-/* The mixture terms of the step just sampled (see dwvb_tally). */
-static uint64_t mixture_terms(const dwvw_walk *walk)
+/* The mixture terms of the step just sampled (see dwvb_tally): `per_component` (the channels
+ * squared) for each component of weight > 0, of which a walk with a single one (the classical
+ * technique at every step) has 1, plus `patches`, the lit patches weighed per step. */
+static uint64_t mixture_terms(const dwvw_walk *walk, uint64_t per_component, uint64_t patches)
 {
-    uint64_t active = 0;
-    for (int k = 0; k < walk->component_count; ++k) active += walk->component_q[k] > 0.0;
-    uint64_t channels = (uint64_t)walk->medium->channels;
-    uint64_t patches = walk->guide->q_incident > 0.0 && walk->guide->patch_count > 1 ? (uint64_t)walk->guide->patch_count : 0u;
-    return active * channels * channels + patches;
+    uint64_t active = 1;
+    if (walk->single_component < 0) {
+        active = 0;
+        for (int k = 0; k < walk->component_count; ++k) active += walk->component_q[k] > 0.0;
+    }
+    return active * per_component + patches;
 }
 
 /* Runs one walk from entry point x (on triangle entry_prim of mesh `mesh`) along unit `direction`
@@ -36,6 +39,8 @@ static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvb_materia
     int needs_closest = shader->needs_closest[mesh];
     dwvb_ball_mode ball_mode = shader->scene->ball_mode;
     int first = 1;
+    uint64_t terms_per_component = (uint64_t)walk->medium->channels * (uint64_t)walk->medium->channels;
+    uint64_t patches = walk->guide->q_incident > 0.0 && walk->guide->patch_count > 1 ? (uint64_t)walk->guide->patch_count : 0u;
     while (walk->status == DWVW_RUNNING) {
         double clearance = 0.0;
         if (needs_closest) {
@@ -45,7 +50,7 @@ static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvb_materia
                 dwvw_walk_set_closest(walk, dwvg_geometric_normal(m, closest.prim));
         }
         double distance = dwvw_walk_sample(walk);
-        tally->mixture_terms += mixture_terms(walk);
+        tally->mixture_terms += mixture_terms(walk, terms_per_component, patches);
         int ray_free = 0;
         /* The ball's radius is below the clearance, which the grid bounds by its largest cell:
          * a step at least that long needs neither the lookup nor the radius. */
