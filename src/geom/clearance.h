@@ -18,6 +18,7 @@
 #ifndef DWV_GEOM_CLEARANCE_H
 #define DWV_GEOM_CLEARANCE_H
 
+#include <math.h>
 #include <stdint.h>
 
 #include "mesh.h"
@@ -25,16 +26,27 @@
 
 /* At most this many cells per mesh (4 bytes each: 1 MiB). */
 #define DWVG_CLEARANCE_MAX_CELLS (1u << 18)
+/* A mesh whose triangles lie in at most this many planes gets the planes instead of a grid: the
+ * distance from a point p to a triangle is at least that to the triangle's plane, |n.p - d|, so
+ * the least over the planes is a lower bound for any mesh, and for a convex one (a box: 6
+ * planes) it is the distance itself: no cell to lose, and no grid too coarse for a thin box (the
+ * leaf). A lookup costs about what a grid's does. */
+#define DWVG_CLEARANCE_MAX_PLANES 8u
 
 typedef struct dwvg_clearance {
     float *lower;      /* per cell (x fastest): the bound at the cell centre; <= 0 where marked */
     double origin[3];  /* the grid's lowest corner */
     double cell;       /* the cell size h */
     uint32_t n[3];     /* cells per axis */
-    double largest;    /* the largest bound of any cell (0 without a grid): no lookup gives more */
+    double largest;    /* no lookup gives more: the largest bound of any cell; +inf with planes; 0 if
+                          neither */
+    uint32_t plane_count;                          /* 0: none (the grid, if any, is used) */
+    double planes[DWVG_CLEARANCE_MAX_PLANES][4];   /* unit normal n and offset d: n.p = d on it */
 } dwvg_clearance;
 
-/* Builds the grid of `mesh` with cells of at least `cell_size` (finite, > 0), coarser where
+/* Keeps the planes of `mesh` where it has at most DWVG_CLEARANCE_MAX_PLANES (triangles in the
+ * same plane share one) and no triangle of zero area or with a non-finite corner (returns 0);
+ * else builds the grid with cells of at least `cell_size` (finite, > 0), coarser where
  * DWVG_CLEARANCE_MAX_CELLS would be exceeded. 0 on success, 1 when no grid is made (no finite
  * triangle; cells would have to be larger than `largest_cell`; or the marking would take more than
  * 64 cell visits per cell): *grid is then empty and every lookup returns 0. -1 out of memory. */
@@ -55,9 +67,18 @@ static inline dwvw_vec3 dwvg_clearance_centre(const dwvg_clearance *grid, uint32
 }
 
 /* A lower bound on the distance from p to the mesh (0 where none is known: outside the grid, or
- * near the surface). */
+ * near the surface; or p not finite). */
 static inline double dwvg_clearance_at(const dwvg_clearance *grid, dwvw_vec3 p)
 {
+    if (grid->plane_count) {
+        double bound = INFINITY;
+        for (uint32_t i = 0; i < grid->plane_count; ++i) {
+            const double *q = grid->planes[i];
+            double d = fabs(q[0] * p.x + q[1] * p.y + q[2] * p.z - q[3]);
+            bound = d < bound ? d : bound;
+        }
+        return bound < INFINITY ? bound : 0.0; /* a NaN or infinite p leaves it infinite */
+    }
     if (!grid->lower) return 0.0;
     double inverse = 1.0 / grid->cell;
     double fx = (p.x - grid->origin[0]) * inverse, fy = (p.y - grid->origin[1]) * inverse,
