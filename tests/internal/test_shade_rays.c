@@ -1,0 +1,298 @@
+/* The rays and clearances of a walk's shading (src/geom/embree.c, src/geom/clearance.[ch],
+ * src/bake/shade.c run_walk), each against the plain way it stands for.
+ *
+ * 1. The probe past its entry triangle (dwvg_intersect_mesh_leaving, one ray with a context
+ *    filter) gives what the loop of rays from just past each hit on that triangle gives, bit for
+ *    bit (found, triangle, distance, barycentrics), for inward rays from random points of a box's
+ *    and a sphere's triangles; without the filter (the loop itself) likewise; and with one ray
+ *    where the loop needed two (the count can fail).
+ * 2. A world of one mesh traces camera and shadow rays in the mesh's scene: the same hits, bit for
+ *    bit, as a world where that mesh is instanced beside a second one far away, for random rays
+ *    and for rays along the axes (zero direction components).
+ * 3. A box's clearance is its 6 planes (no grid): never above the brute-force distance to its
+ *    triangles at random points in and around it, equal to it inside (a convex mesh); a sphere
+ *    and a mesh with a zero-area triangle get no planes; a grid's largest bound is no less than
+ *    any lookup and is reached by one of its cells.
+ * 4. Bakes of a thin back-lit box (the leaf) with ray-free steps from its planes equal bakes with
+ *    a ray at every step bit for bit, and in checked mode no ray-free step's ray meets the box. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "api/image_handle.h"
+#include "api/scene_handle.h"
+#include "bake/scene.h"
+#include "bake_scenes.h"
+#include "brute_force.h"
+#include "check.h"
+#include "dwivedi.h"
+#include "geom/embree.h"
+
+static const double identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+
+static dwvg_mesh make_mesh(const test_mesh *m)
+{
+    dwvg_mesh mesh;
+    if (dwvg_mesh_init(&mesh, m->vertex_count, m->triangle_count, 0u, m->positions, m->indices, NULL, NULL, identity))
+        exit(2);
+    return mesh;
+}
+
+static int same_hit(int found_a, const dwvg_hit *a, int found_b, const dwvg_hit *b)
+{
+    if (found_a != found_b) return 0;
+    return !found_a || (a->mesh == b->mesh && a->prim == b->prim && a->t == b->t && a->u == b->u && a->v == b->v);
+}
+
+/* A unit direction about unit n, cosine-weighted (as the entry's). */
+static dwvw_vec3 about(dwvw_vec3 n, uint64_t *state)
+{
+    double mu = sqrt(brute_uniform(state));
+    return dwvw_direction_about(n, mu, 1.0 - mu, 1.0 + mu, brute_uniform(state));
+}
+
+/* --- 1. the probe ------------------------------------------------------------------------- */
+
+static void check_leaving(const char *name, const test_mesh *m)
+{
+    dwvg_mesh mesh = make_mesh(m);
+    dwvg_world world;
+    char message[256];
+    if (dwvg_world_build(&world, &mesh, 1u, message, sizeof message)) {
+        CHECK(0, "%s: world: %s", name, message);
+        dwvg_mesh_free(&mesh);
+        return;
+    }
+    CHECK(world.leaving_filter, "%s: Embree runs no context filters here", name);
+    uint64_t state = 5u;
+    int walks = 4000, same = 0, same_unfiltered = 0, found_count = 0;
+    uint64_t rays_loop = 0, rays_one = 0;
+    for (int i = 0; i < walks; ++i) {
+        uint32_t prim = (uint32_t)(brute_uniform(&state) * mesh.triangle_count);
+        double u = brute_uniform(&state), v = brute_uniform(&state);
+        if (u + v > 1.0) {
+            u = 1.0 - u;
+            v = 1.0 - v;
+        }
+        dwvw_vec3 x = dwvg_point(&mesh, prim, u, v);
+        dwvw_vec3 d = about(dwvw_scale(dwvg_geometric_normal(&mesh, prim), -1.0), &state);
+        /* The loop, as run_walk cast it before. */
+        dwvg_hit loop;
+        int found_loop;
+        double tnear = 0.0;
+        for (;;) {
+            ++rays_loop;
+            found_loop = dwvg_intersect_mesh(&world, 0u, x, d, tnear, INFINITY, &loop);
+            if (!(found_loop && loop.prim == prim)) break;
+            tnear = nextafterf((float)loop.t, INFINITY);
+        }
+        dwvg_hit one, unfiltered;
+        uint32_t rays = 0, rays_unfiltered = 0;
+        int found_one = dwvg_intersect_mesh_leaving(&world, 0u, x, d, prim, &one, &rays);
+        world.leaving_filter = 0;
+        int found_unfiltered = dwvg_intersect_mesh_leaving(&world, 0u, x, d, prim, &unfiltered, &rays_unfiltered);
+        world.leaving_filter = 1;
+        rays_one += rays;
+        same += same_hit(found_one, &one, found_loop, &loop);
+        same_unfiltered += same_hit(found_unfiltered, &unfiltered, found_loop, &loop);
+        found_count += found_loop;
+    }
+    CHECK(same == walks && same_unfiltered == walks && found_count == walks,
+          "%s: %d of %d probes as the loop's (%d without the filter), %d found the far side", name, same, walks,
+          same_unfiltered, found_count);
+    /* The loop needs a second ray wherever rounding leaves the origin on the entry triangle. */
+    CHECK(rays_one < rays_loop && rays_one >= (uint64_t)walks, "%s: %llu rays against the loop's %llu", name,
+          (unsigned long long)rays_one, (unsigned long long)rays_loop);
+    printf("%s: %d probes as the loop's, %llu rays against %llu\n", name, walks, (unsigned long long)rays_one,
+           (unsigned long long)rays_loop);
+    dwvg_world_free(&world);
+    dwvg_mesh_free(&mesh);
+}
+
+/* --- 2. one mesh, no instance ------------------------------------------------------------- */
+
+static void check_one_mesh(void)
+{
+    test_mesh s = test_sphere(0.0, 0.0, 0.0, 1.0, 12, 24), far = test_box(50.0, 50.0, 50.0, 51.0, 51.0, 51.0);
+    dwvg_mesh meshes[2] = {make_mesh(&s), make_mesh(&far)};
+    dwvg_world one, two;
+    char message[256];
+    if (dwvg_world_build(&one, meshes, 1u, message, sizeof message) ||
+        dwvg_world_build(&two, meshes, 2u, message, sizeof message)) {
+        CHECK(0, "world: %s", message);
+        return;
+    }
+    uint64_t state = 9u;
+    int rays = 6000, same = 0, same_occluded = 0, hits = 0, occluded = 0;
+    for (int i = 0; i < rays; ++i) {
+        /* From a shell around the sphere, aimed at it or past it; every fourth along an axis. */
+        dwvw_vec3 o = dwvw_scale(about(dwvw_v(0.0, 0.0, 1.0), &state), 1.2 + 2.0 * brute_uniform(&state));
+        if (brute_uniform(&state) < 0.5) o = dwvw_scale(o, -1.0);
+        dwvw_vec3 d = dwvw_normalize(dwvw_sub(dwvw_scale(about(dwvw_v(1.0, 0.0, 0.0), &state), 1.6 * brute_uniform(&state)), o));
+        if (i % 4 == 0) {
+            int axis = (i / 4) % 3;
+            double sign = (i / 12) % 2 ? 1.0 : -1.0;
+            d = dwvw_v(axis == 0 ? sign : -0.0, axis == 1 ? sign : 0.0, axis == 2 ? sign : -0.0);
+            o = dwvw_v(axis == 0 ? -2.0 * sign : 1.4 * brute_uniform(&state), axis == 1 ? -2.0 * sign : 0.0,
+                       axis == 2 ? -2.0 * sign : -1.4 * brute_uniform(&state));
+        }
+        double tfar = 4.0 * brute_uniform(&state);
+        dwvg_hit a, b;
+        int found_a = dwvg_intersect(&one, o, d, 0.0, INFINITY, &a), found_b = dwvg_intersect(&two, o, d, 0.0, INFINITY, &b);
+        same += same_hit(found_a, &a, found_b, &b);
+        hits += found_a;
+        int blocked = dwvg_occluded(&one, o, d, 0.0, tfar);
+        same_occluded += blocked == dwvg_occluded(&two, o, d, 0.0, tfar);
+        occluded += blocked;
+    }
+    CHECK(same == rays && same_occluded == rays && hits > rays / 4 && hits < rays && occluded > rays / 8 && occluded < rays,
+          "%d of %d hits and %d occlusions as with the instance (%d hits, %d occluded)", same, rays, same_occluded, hits,
+          occluded);
+    dwvg_world_free(&one);
+    dwvg_world_free(&two);
+    dwvg_mesh_free(&meshes[0]);
+    dwvg_mesh_free(&meshes[1]);
+    test_mesh_free(&s);
+    test_mesh_free(&far);
+}
+
+/* --- 3. planes and the grid's largest bound ------------------------------------------------ */
+
+static void check_planes(void)
+{
+    test_mesh b = test_box(-2.0, -1.0, -0.01, 2.0, 1.0, 0.01);
+    dwvg_mesh box = make_mesh(&b);
+    dwvg_clearance c;
+    CHECK(dwvg_clearance_build(&c, &box, 0.001, 0.004) == 0 && c.plane_count == 6u && c.lower == NULL &&
+              c.largest == INFINITY,
+          "box: %u planes, grid %p", c.plane_count, (void *)c.lower);
+    uint64_t state = 3u;
+    int points = 20000, below = 0, inside = 0, exact_inside = 0;
+    for (int i = 0; i < points; ++i) {
+        dwvw_vec3 p = dwvw_v(-2.2 + 4.4 * brute_uniform(&state), -1.2 + 2.4 * brute_uniform(&state),
+                             -0.03 + 0.06 * brute_uniform(&state));
+        double exact = INFINITY;
+        for (uint32_t t = 0; t < box.triangle_count; ++t) exact = fmin(exact, brute_triangle_distance(&box, t, p, NULL));
+        double bound = dwvg_clearance_at(&c, p);
+        below += bound <= exact;
+        if (fabs(p.x) < 2.0 && fabs(p.y) < 1.0 && fabs(p.z) < 0.01) {
+            ++inside;
+            exact_inside += fabs(bound - exact) <= 1e-12;
+        }
+    }
+    CHECK(below == points && inside > 1000 && exact_inside == inside,
+          "box: the planes' bound %d of %d times at most the distance, exact at %d of %d inside", below, points,
+          exact_inside, inside);
+    CHECK(dwvg_clearance_at(&c, dwvw_v(NAN, 0.0, 0.0)) == 0.0 && dwvg_clearance_at(&c, dwvw_v(0.0, INFINITY, 0.0)) == 0.0,
+          "box: a point not finite has clearance 0");
+    dwvg_clearance_free(&c);
+    dwvg_mesh_free(&box);
+
+    /* A zero-area triangle (a ray may graze it) leaves the box to a grid. */
+    b.indices[3] = b.indices[4] = b.indices[5];
+    box = make_mesh(&b);
+    CHECK(dwvg_clearance_build(&c, &box, 0.05, 1.0) == 0 && c.plane_count == 0u && c.lower != NULL,
+          "box with a zero-area triangle: %u planes", c.plane_count);
+    dwvg_clearance_free(&c);
+    dwvg_mesh_free(&box);
+    test_mesh_free(&b);
+
+    test_mesh s = test_sphere(0.0, 0.0, 0.0, 1.0, 12, 24);
+    dwvg_mesh sphere = make_mesh(&s);
+    CHECK(dwvg_clearance_build(&c, &sphere, 0.05, 1.0) == 0 && c.plane_count == 0u && c.lower != NULL,
+          "sphere: %u planes", c.plane_count);
+    if (c.lower) {
+        int reached = 0, above = 0;
+        size_t cells = (size_t)c.n[0] * c.n[1] * c.n[2];
+        for (size_t i = 0; i < cells; ++i) reached += (double)c.lower[i] == c.largest;
+        for (int i = 0; i < points; ++i) {
+            dwvw_vec3 p = dwvw_v(-1.2 + 2.4 * brute_uniform(&state), -1.2 + 2.4 * brute_uniform(&state),
+                                 -1.2 + 2.4 * brute_uniform(&state));
+            above += dwvg_clearance_at(&c, p) > c.largest;
+        }
+        CHECK(reached > 0 && above == 0 && c.largest > 0.5, "sphere: largest bound %g held by %d cells, %d lookups above",
+              c.largest, reached, above);
+    }
+    dwvg_clearance_free(&c);
+    dwvg_mesh_free(&sphere);
+    test_mesh_free(&s);
+}
+
+/* --- 4. bakes of the leaf ----------------------------------------------------------------- */
+
+static dwvb_image *bake_leaf(dwv_scene_t *handle, dwvb_ball_mode mode)
+{
+    dwv_scene_object(handle)->ball_mode = mode;
+    dwv_bake_options_t o = DWV_BAKE_OPTIONS_INIT;
+    o.width = o.height = 16;
+    o.samples = 16;
+    o.technique = DWV_TECHNIQUE_CLASSICAL;
+    o.threads = 2;
+    o.seed = 11;
+    dwv_image_t *image = NULL;
+    if (dwv_bake(handle, &o, &image) != DWV_SUCCESS) {
+        CHECK(0, "bake: %s", dwv_last_error_message());
+        return NULL;
+    }
+    return dwv_image_object(image);
+}
+
+static void check_leaf_bakes(void)
+{
+    dwv_scene_t *scene;
+    dwv_scene_create(&scene);
+    dwv_material_t material = DWV_MATERIAL_INIT;
+    const double colour[3] = {0.6, 0.95, 0.4};
+    for (int c = 0; c < 3; ++c) {
+        material.base_color[c] = material.subsurface_color[c] = colour[c];
+        material.subsurface_radius[c] = 0.1;
+    }
+    material.subsurface_scale = 1.0;
+    test_mesh m = test_box(-2.0, -2.0, -0.01, 2.0, 2.0, 0.01);
+    test_add(scene, &m, &material);
+    test_mesh_free(&m);
+    dwv_light_desc_t sun = DWV_LIGHT_DESC_INIT;
+    sun.direction[0] = 0.0;
+    sun.direction[1] = 0.0;
+    sun.direction[2] = 1.0;
+    sun.strength = 3.0;
+    dwv_scene_add_light(scene, &sun);
+    dwv_camera_t camera = test_ortho_camera(0.0, 0.0, 3.0, 1.0);
+    dwv_scene_set_camera(scene, &camera);
+    CHECK(dwv_scene_commit(scene) == DWV_SUCCESS, "commit: %s", dwv_last_error_message());
+    CHECK(dwv_scene_object(scene)->geometry.clearance[0].plane_count == 6u, "the leaf has %u planes",
+          dwv_scene_object(scene)->geometry.clearance[0].plane_count);
+    dwvb_image *off = bake_leaf(scene, DWVB_BALL_OFF), *on = bake_leaf(scene, DWVB_BALL_ON),
+               *checked = bake_leaf(scene, DWVB_BALL_CHECKED);
+    if (off && on && checked) {
+        size_t floats = 4u * (size_t)on->width * on->height;
+        CHECK(memcmp(on->rgba, off->rgba, floats * sizeof(float)) == 0 &&
+                  memcmp(checked->rgba, off->rgba, floats * sizeof(float)) == 0,
+              "leaf: the images with and without ray-free steps differ");
+        CHECK(on->rays + on->ray_free_steps == off->rays && on->ray_free_steps * 10u > on->stats.events &&
+                  checked->ray_free_misses == 0u && checked->ray_free_steps == on->ray_free_steps,
+              "leaf: rays %llu + ray-free %llu against %llu for %llu events; checked: %llu met the surface",
+              (unsigned long long)on->rays, (unsigned long long)on->ray_free_steps, (unsigned long long)off->rays,
+              (unsigned long long)on->stats.events, (unsigned long long)checked->ray_free_misses);
+        printf("leaf: %llu events, %llu ray-free steps, none met the surface\n", (unsigned long long)on->stats.events,
+               (unsigned long long)on->ray_free_steps);
+    }
+    if (off) dwv_image_release(dwv_image_handle(off));
+    if (on) dwv_image_release(dwv_image_handle(on));
+    if (checked) dwv_image_release(dwv_image_handle(checked));
+    dwv_scene_release(scene);
+}
+
+int main(void)
+{
+    test_mesh box = test_box(-2.0, -2.0, -0.05, 2.0, 2.0, 0.05), sphere = test_sphere(0.0, 0.0, 0.0, 1.0, 24, 48);
+    check_leaving("box", &box);
+    check_leaving("sphere", &sphere);
+    test_mesh_free(&box);
+    test_mesh_free(&sphere);
+    check_one_mesh();
+    check_planes();
+    check_leaf_bakes();
+    return check_report("test_shade_rays");
+}
