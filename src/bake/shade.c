@@ -143,6 +143,7 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, 
         ++tally->warnings;
         return;
     }
+    int ng_flipped = 0;
     if (dwvw_dot(view, ng) > 0.0) {
         /* The back of a face. A diffuse surface is two-sided; a subsurface one is seen from inside
          * its medium (an open or inside-out mesh): no walk is defined there. */
@@ -151,6 +152,7 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, 
             return;
         }
         ng = dwvw_scale(ng, -1.0);
+        ng_flipped = 1;
     }
     dwvw_vec3 x = dwvg_point(mesh, hit->prim, hit->u, hit->v);
     dwvw_vec3 n = dwvg_shading_normal(mesh, hit->prim, hit->u, hit->v, ng);
@@ -160,22 +162,24 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, 
     double cutoff = scene->terminator_offsets[hit->mesh];
     dwvl_terminator terminator = {mesh, hit->prim, hit->u, hit->v, cutoff};
     const dwvl_terminator *smooth = mesh->normals && cutoff > 0.0 ? &terminator : NULL;
+    /* The world's top along ng is known for the outward side of the triangle only. */
+    double top = ng_flipped ? INFINITY : dwvg_world_top(&scene->geometry, hit->mesh, hit->prim);
     if (material->principled_v1) {
         /* The Lambertian lobe and the retro-reflection lobe from the same light samples. */
         retro_lobe lobe = {n, dwvw_scale(view, -1.0), -dwvw_dot(n, view), material->roughness};
         double direct[3], retro[3];
-        dwvl_direct_lobe(&shader->env, x, n, ng, smooth, sampler, pair + DWVB_SHADE_PAIRS, retro_factor, &lobe, direct, retro);
+        dwvl_direct_lobe(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, retro_factor, &lobe, direct, retro);
         for (int c = 0; c < 3; ++c) rgb[c] += material->diffuse_albedo[c] * direct[c] + material->retro_albedo[c] * retro[c];
     } else if (material->principled_diffuse) {
         retro_lobe lobe = {n, dwvw_scale(view, -1.0), -dwvw_dot(n, view), material->roughness};
         double diffuse[3];
-        dwvl_direct_lobe(&shader->env, x, n, ng, smooth, sampler, pair + DWVB_SHADE_PAIRS, principled_diffuse_factor, &lobe,
+        dwvl_direct_lobe(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, principled_diffuse_factor, &lobe,
                          NULL, diffuse);
         for (int c = 0; c < 3; ++c) rgb[c] += material->diffuse_albedo[c] * diffuse[c];
     } else if (material->diffuse_albedo[0] > 0.0 || material->diffuse_albedo[1] > 0.0 ||
                material->diffuse_albedo[2] > 0.0) {
         double direct[3];
-        dwvl_direct(&shader->env, x, n, ng, smooth, sampler, pair + DWVB_SHADE_PAIRS, direct);
+        dwvl_direct(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, direct);
         for (int c = 0; c < 3; ++c) rgb[c] += material->diffuse_albedo[c] * direct[c];
     }
     if (!material->subsurface) return;
@@ -198,12 +202,13 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, 
     /* Cycles shades the exit as a surface point of its triangle: the same terminator offset. */
     dwvl_terminator exit_terminator = {mesh, exit.prim, exit.u, exit.v, cutoff};
     const dwvl_terminator *exit_smooth = mesh->normals && cutoff > 0.0 ? &exit_terminator : NULL;
+    double exit_top = dwvg_world_top(&scene->geometry, hit->mesh, exit.prim);
     double direct[3];
     if (material->principled_v1)
-        dwvl_direct_lobe(&shader->env, walk.position, exit_n, exit_ng, exit_smooth, sampler, pair + DWVB_SHADE_PAIRS + light_pairs,
+        dwvl_direct_lobe(&shader->env, walk.position, exit_n, exit_ng, exit_smooth, exit_top, sampler, pair + DWVB_SHADE_PAIRS + light_pairs,
                          exit_factor, &exit_n, NULL, direct);
     else
-        dwvl_direct(&shader->env, walk.position, exit_n, exit_ng, exit_smooth, sampler, pair + DWVB_SHADE_PAIRS + light_pairs, direct);
+        dwvl_direct(&shader->env, walk.position, exit_n, exit_ng, exit_smooth, exit_top, sampler, pair + DWVB_SHADE_PAIRS + light_pairs, direct);
     int grey = material->medium.channels == 1;
     for (int c = 0; c < 3; ++c) rgb[c] += walk.weight[grey ? 0 : c] * material->walk_scale[c] * direct[c];
 }

@@ -102,6 +102,36 @@ static int failed(dwvg_world *world, char *message, size_t size, const char *wha
     return -1;
 }
 
+/* world->tops (embree.h), where the world is small enough: 0, or -1 out of memory. */
+static int make_tops(dwvg_world *world)
+{
+    double vertices = 0.0, triangles = 0.0;
+    for (uint32_t m = 0; m < world->mesh_count; ++m) {
+        vertices += world->meshes[m].vertex_count;
+        triangles += world->meshes[m].triangle_count;
+    }
+    if (vertices * triangles > DWVG_TOPS_WORK) return 0;
+    world->tops = calloc(world->mesh_count, sizeof *world->tops);
+    if (!world->tops) return -1;
+    for (uint32_t m = 0; m < world->mesh_count; ++m) {
+        const dwvg_mesh *mesh = &world->meshes[m];
+        world->tops[m] = malloc((mesh->triangle_count ? mesh->triangle_count : 1u) * sizeof **world->tops);
+        if (!world->tops[m]) return -1;
+        for (uint32_t t = 0; t < mesh->triangle_count; ++t) {
+            dwvw_vec3 n = dwvg_geometric_normal(mesh, t);
+            double top = -INFINITY;
+            for (uint32_t o = 0; o < world->mesh_count && top < INFINITY; ++o)
+                for (uint32_t v = 0; v < world->meshes[o].vertex_count; ++v) {
+                    /* A non-finite vertex (Embree skips its triangles) counts as unbounded. */
+                    double h = dwvw_dot(n, vertex(&world->meshes[o], v));
+                    top = h > top ? h : isnan(h) ? INFINITY : top;
+                }
+            world->tops[m][t] = n.x == 0.0 && n.y == 0.0 && n.z == 0.0 ? INFINITY : top;
+        }
+    }
+    return 0;
+}
+
 int dwvg_world_build(dwvg_world *world, const dwvg_mesh *meshes, uint32_t count, char *message, size_t size)
 {
     memset(world, 0, sizeof *world);
@@ -170,6 +200,7 @@ int dwvg_world_build(dwvg_world *world, const dwvg_mesh *meshes, uint32_t count,
     }
     rtcCommitScene(top);
     if (atomic_load(&world->embree_error)) return failed(world, message, size, "building the top-level BVH");
+    if (make_tops(world) < 0) return failed(world, message, size, "finding the triangles' tops");
     return 0;
 }
 
@@ -183,6 +214,10 @@ void dwvg_world_free(dwvg_world *world)
         for (uint32_t m = 0; m < world->mesh_count; ++m) dwvg_clearance_free(&world->clearance[m]);
     free(world->clearance);
     world->clearance = NULL;
+    if (world->tops)
+        for (uint32_t m = 0; m < world->mesh_count; ++m) free(world->tops[m]);
+    free(world->tops);
+    world->tops = NULL;
     if (world->top) rtcReleaseScene(world->top);
     if (world->device) rtcReleaseDevice(world->device);
     world->mesh_scenes = NULL;

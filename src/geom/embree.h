@@ -5,6 +5,7 @@
 #ifndef DWV_GEOM_EMBREE_H
 #define DWV_GEOM_EMBREE_H
 
+#include <math.h>
 #include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -25,6 +26,10 @@ typedef struct dwvg_world {
     uint64_t warnings;    /* zero-area or non-finite triangles (Embree skips them) */
     uint64_t triangles;
     int leaving_filter;   /* Embree runs context filters: mesh scenes take them */
+    /* Per mesh and triangle T: the largest n_T.v over every vertex v of the world, n_T the unit
+     * geometric normal (+inf for a zero-area triangle); NULL where the world has more than
+     * DWVG_TOPS_WORK vertices x triangles (see dwvg_world_top). */
+    double **tops;
     atomic_llong embree_bytes; /* what Embree holds now (its memory monitor) */
     atomic_int embree_error;   /* the first Embree error code, 0 if none */
 } dwvg_world;
@@ -77,6 +82,18 @@ int dwvg_world_build_clearance(dwvg_world *world, uint32_t mesh, double cell_siz
  * nothing is left. A segment with both ends inside the ball (convex) meets no surface of the
  * mesh: a ray along it is skipped. */
 double dwvg_clear_radius(const dwvg_world *world, dwvw_vec3 center, double clearance);
+
+/* At most this many vertex-triangle products for the tops table (dwvg_world_top): about a tenth
+ * of a second at commit. */
+#define DWVG_TOPS_WORK (1u << 24)
+/* The highest any point of the world reaches along the unit geometric normal n_T of triangle
+ * `prim` of `mesh`: max n_T.y over the world's points y (its vertices; every point of a triangle is
+ * a mix of its corners), +inf where unknown. A ray from an origin o with n_T.o above that, rising
+ * along n_T, meets nothing: it only moves away from the world's half-space n_T.y <= top. */
+static inline double dwvg_world_top(const dwvg_world *world, uint32_t mesh, uint32_t prim)
+{
+    return world->tops ? world->tops[mesh][prim] : INFINITY;
+}
 
 /* The unit outward geometric normal of a triangle, (v1 - v0) x (v2 - v0) normalised (zero for a
  * degenerate one). */
