@@ -14,7 +14,10 @@
  *    and a mesh with a zero-area triangle get no planes; a grid's largest bound is no less than
  *    any lookup and is reached by one of its cells.
  * 4. Bakes of a thin back-lit box (the leaf) with ray-free steps from its planes equal bakes with
- *    a ray at every step bit for bit, and in checked mode no ray-free step's ray meets the box. */
+ *    a ray at every step bit for bit, and in checked mode no ray-free step's ray meets the box.
+ * 5. Next-event estimates that skip the shadow rays known to meet nothing (dwvg_world_top) equal
+ *    those that cast every one, bit for bit, on a box, a sphere and a box with a post on it, with
+ *    suns down to grazing; the tops are the faces' planes on the convex meshes only. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -28,6 +31,7 @@
 #include "check.h"
 #include "dwivedi.h"
 #include "geom/embree.h"
+#include "light/direct.h"
 
 static const double identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
 
@@ -219,6 +223,81 @@ static void check_planes(void)
     test_mesh_free(&s);
 }
 
+/* --- 5. shadow rays known to meet nothing ------------------------------------------------- */
+
+/* Next-event estimates at random points of the world's triangles (the exit's Lambertian, a sun
+ * at a random, often grazing, direction within its 10-degree disc and the world light) with the
+ * triangle's top equal those without it (every shadow ray cast), bit for bit; the tops are the
+ * faces' planes on a convex mesh (so rays are skipped) and above them where another mesh rises. */
+static void check_tops(const char *name, const dwvg_mesh *meshes, uint32_t count, int convex)
+{
+    dwvg_world world;
+    char message[256];
+    if (dwvg_world_build(&world, meshes, count, message, sizeof message)) {
+        CHECK(0, "%s: world: %s", name, message);
+        return;
+    }
+    CHECK(world.tops != NULL, "%s: no tops", name);
+    int on_plane = 0, triangles = 0;
+    for (uint32_t t = 0; t < meshes[0].triangle_count; ++t) {
+        dwvw_vec3 n = dwvg_geometric_normal(&meshes[0], t);
+        const float *a = meshes[0].positions + 3u * meshes[0].indices[3u * t];
+        double plane = dwvw_dot(n, dwvw_v(a[0], a[1], a[2]));
+        on_plane += fabs(dwvg_world_top(&world, 0u, t) - plane) <= 1e-6;
+        ++triangles;
+    }
+    CHECK(convex ? on_plane == triangles : on_plane < triangles, "%s: %d of %d tops on their planes", name, on_plane,
+          triangles);
+    uint64_t state = 17u;
+    int points = 3000, same = 0, lit = 0;
+    for (int i = 0; i < points; ++i) {
+        const dwvg_mesh *mesh = &meshes[0];
+        uint32_t prim = (uint32_t)(brute_uniform(&state) * mesh->triangle_count);
+        double u = brute_uniform(&state), v = brute_uniform(&state);
+        if (u + v > 1.0) {
+            u = 1.0 - u;
+            v = 1.0 - v;
+        }
+        dwvw_vec3 x = dwvg_point(mesh, prim, u, v), ng = dwvg_geometric_normal(mesh, prim);
+        /* A sun whose disc reaches from the normal's side down to grazing and below. */
+        dwvw_vec3 to_sun = about(ng, &state);
+        double tilt = brute_uniform(&state);
+        to_sun = dwvw_normalize(dwvw_madd(to_sun, ng, -tilt * dwvw_dot(to_sun, ng) * 1.1));
+        dwv_light_desc_t desc = DWV_LIGHT_DESC_INIT;
+        for (int k = 0; k < 3; ++k) desc.direction[k] = -(k == 0 ? to_sun.x : k == 1 ? to_sun.y : to_sun.z);
+        desc.angle = 10.0 * 3.14159265358979323846 / 180.0;
+        dwvl_light sun;
+        dwvl_light_init(&sun, &desc);
+        dwvl_environment env = {&sun, 1u, {0.2, 0.3, 0.4}, 1, &world};
+        dwvk_sampler sampler = {.key = state, .index = 0u, .stratified = 0};
+        double with[3], without[3];
+        dwvl_direct(&env, x, ng, ng, NULL, dwvg_world_top(&world, 0u, prim), &sampler, 0u, with);
+        dwvl_direct(&env, x, ng, ng, NULL, INFINITY, &sampler, 0u, without);
+        same += memcmp(with, without, sizeof with) == 0;
+        lit += with[0] > 0.2;
+    }
+    CHECK(same == points && lit > points / 4, "%s: %d of %d estimates as with every shadow ray cast (%d sunlit)", name,
+          same, points, lit);
+    dwvg_world_free(&world);
+}
+
+static void check_shadow_tops(void)
+{
+    test_mesh b = test_box(-2.0, -2.0, -0.05, 2.0, 2.0, 0.05), s = test_sphere(0.0, 0.0, 0.0, 1.0, 24, 48);
+    test_mesh post = test_box(0.5, 0.5, 0.05, 0.7, 0.7, 1.0);
+    dwvg_mesh box = make_mesh(&b), sphere = make_mesh(&s), with_post[2] = {make_mesh(&b), make_mesh(&post)};
+    check_tops("box", &box, 1u, 1);
+    check_tops("sphere", &sphere, 1u, 1);
+    check_tops("box with a post", with_post, 2u, 0);
+    dwvg_mesh_free(&box);
+    dwvg_mesh_free(&sphere);
+    dwvg_mesh_free(&with_post[0]);
+    dwvg_mesh_free(&with_post[1]);
+    test_mesh_free(&b);
+    test_mesh_free(&s);
+    test_mesh_free(&post);
+}
+
 /* --- 4. bakes of the leaf ----------------------------------------------------------------- */
 
 static dwvb_image *bake_leaf(dwv_scene_t *handle, dwvb_ball_mode mode)
@@ -294,5 +373,6 @@ int main(void)
     check_one_mesh();
     check_planes();
     check_leaf_bakes();
+    check_shadow_tops();
     return check_report("test_shade_rays");
 }
