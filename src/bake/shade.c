@@ -55,7 +55,7 @@ static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvb_materia
         /* The ball's radius is below the clearance, which the grid bounds by its largest cell:
          * a step at least that long needs neither the lookup nor the radius. */
         if (!first && ball_mode != DWVB_BALL_OFF && (needs_closest || distance < grid->largest)) {
-            if (!needs_closest) clearance = dwvg_clearance_at(grid, walk->position);
+            if (!needs_closest) clearance = dwvg_clearance_above(grid, walk->position, distance);
             ray_free = distance < clearance && distance < dwvg_clear_radius(world, walk->position, clearance);
         }
         dwvg_hit hit;

@@ -196,6 +196,7 @@ static void exact_near(dwvg_clearance *grid, const dwvg_mesh *mesh, uint32_t t, 
 static int find_planes(dwvg_clearance *grid, const dwvg_mesh *mesh)
 {
     uint32_t count = 0;
+    double area[DWVG_CLEARANCE_MAX_PLANES];
     for (uint32_t t = 0; t < mesh->triangle_count; ++t) {
         double lo[3], hi[3];
         if (!finite_triangle(mesh, t, lo, hi)) return 0;
@@ -211,21 +212,35 @@ static int find_planes(dwvg_clearance *grid, const dwvg_mesh *mesh)
         if (!(length > 0.0 && isfinite(length))) return 0;
         n = dwvw_scale(n, 1.0 / length);
         double d = dwvw_dot(n, p[0]);
-        int known = 0;
-        for (uint32_t i = 0; i < count && !known; ++i) {
+        uint32_t known = count;
+        for (uint32_t i = 0; i < count && known == count; ++i) {
             const double *q = grid->planes[i];
-            known = (q[0] == n.x && q[1] == n.y && q[2] == n.z && q[3] == d) ||
-                    (q[0] == -n.x && q[1] == -n.y && q[2] == -n.z && q[3] == -d);
+            if ((q[0] == n.x && q[1] == n.y && q[2] == n.z && q[3] == d) ||
+                (q[0] == -n.x && q[1] == -n.y && q[2] == -n.z && q[3] == -d))
+                known = i;
         }
-        if (known) continue;
-        if (count == DWVG_CLEARANCE_MAX_PLANES) return 0;
-        double *q = grid->planes[count++];
-        q[0] = n.x;
-        q[1] = n.y;
-        q[2] = n.z;
-        q[3] = d;
+        if (known == count) {
+            if (count == DWVG_CLEARANCE_MAX_PLANES) return 0;
+            double *q = grid->planes[count];
+            q[0] = n.x;
+            q[1] = n.y;
+            q[2] = n.z;
+            q[3] = d;
+            area[count++] = 0.0;
+        }
+        area[known] += 0.5 * length;
     }
     if (count == 0) return 0;
+    /* Largest area first (insertion sort, stable): a walk is most often nearest those. */
+    for (uint32_t i = 1; i < count; ++i)
+        for (uint32_t j = i; j > 0 && area[j] > area[j - 1]; --j) {
+            double a = area[j], q[4];
+            area[j] = area[j - 1];
+            area[j - 1] = a;
+            memcpy(q, grid->planes[j], sizeof q);
+            memcpy(grid->planes[j], grid->planes[j - 1], sizeof q);
+            memcpy(grid->planes[j - 1], q, sizeof q);
+        }
     grid->plane_count = count;
     grid->largest = INFINITY;
     return 1;

@@ -66,18 +66,22 @@ static inline dwvw_vec3 dwvg_clearance_centre(const dwvg_clearance *grid, uint32
                   grid->origin[2] + (iz + 0.5) * grid->cell);
 }
 
-/* A lower bound on the distance from p to the mesh (0 where none is known: outside the grid, or
- * near the surface; or p not finite). */
-static inline double dwvg_clearance_at(const dwvg_clearance *grid, dwvw_vec3 p)
+/* A lower bound on the distance from p to the mesh where it exceeds `floor` (>= 0), else 0: 0 also
+ * where none is known (outside the grid, or near the surface; or p not finite). A walk asks with
+ * its step's length as the floor (a bound no longer than the step cannot spare the ray), which
+ * lets the planes stop at the first one that close (they are kept largest first: the nearest,
+ * in a thin box). */
+static inline double dwvg_clearance_above(const dwvg_clearance *grid, dwvw_vec3 p, double floor)
 {
     if (grid->plane_count) {
         double bound = INFINITY;
         for (uint32_t i = 0; i < grid->plane_count; ++i) {
             const double *q = grid->planes[i];
             double d = fabs(q[0] * p.x + q[1] * p.y + q[2] * p.z - q[3]);
+            if (!(d > floor)) return 0.0; /* a NaN p stops here */
             bound = d < bound ? d : bound;
         }
-        return bound < INFINITY ? bound : 0.0; /* a NaN or infinite p leaves it infinite */
+        return bound < INFINITY ? bound : 0.0; /* an infinite p leaves it infinite */
     }
     if (!grid->lower) return 0.0;
     double inverse = 1.0 / grid->cell;
@@ -87,9 +91,15 @@ static inline double dwvg_clearance_at(const dwvg_clearance *grid, dwvw_vec3 p)
     if (!(fx >= 0.0 && fy >= 0.0 && fz >= 0.0 && fx < grid->n[0] && fy < grid->n[1] && fz < grid->n[2])) return 0.0;
     uint32_t ix = (uint32_t)fx, iy = (uint32_t)fy, iz = (uint32_t)fz;
     double bound = grid->lower[((size_t)iz * grid->n[1] + iy) * grid->n[0] + ix];
-    if (!(bound > 0.0)) return 0.0;
+    if (!(bound > floor)) return 0.0;
     bound -= dwvw_length(dwvw_sub(p, dwvg_clearance_centre(grid, ix, iy, iz)));
-    return bound > 0.0 ? bound : 0.0;
+    return bound > floor ? bound : 0.0;
+}
+
+/* A lower bound on the distance from p to the mesh (0 where none is known). */
+static inline double dwvg_clearance_at(const dwvg_clearance *grid, dwvw_vec3 p)
+{
+    return dwvg_clearance_above(grid, p, 0.0);
 }
 
 #endif

@@ -12,7 +12,8 @@
  * 3. A box's clearance is its 6 planes (no grid): never above the brute-force distance to its
  *    triangles at random points in and around it, equal to it inside (a convex mesh); a sphere
  *    and a mesh with a zero-area triangle get no planes; a grid's largest bound is no less than
- *    any lookup and is reached by one of its cells.
+ *    any lookup and is reached by one of its cells; a lookup above a floor gives the bound where
+ *    it exceeds the floor and 0 elsewhere.
  * 4. Bakes of a thin back-lit box (the leaf) with ray-free steps from its planes equal bakes with
  *    a ray at every step bit for bit, and in checked mode no ray-free step's ray meets the box.
  * 5. Next-event estimates that skip the shadow rays known to meet nothing (dwvg_world_top) equal
@@ -178,15 +179,15 @@ static void check_planes(void)
                              -0.03 + 0.06 * brute_uniform(&state));
         double exact = INFINITY;
         for (uint32_t t = 0; t < box.triangle_count; ++t) exact = fmin(exact, brute_triangle_distance(&box, t, p, NULL));
-        double bound = dwvg_clearance_at(&c, p);
-        below += bound <= exact;
+        double bound = dwvg_clearance_at(&c, p), floor = 0.02 * brute_uniform(&state);
+        below += bound <= exact && dwvg_clearance_above(&c, p, floor) == (bound > floor ? bound : 0.0);
         if (fabs(p.x) < 2.0 && fabs(p.y) < 1.0 && fabs(p.z) < 0.01) {
             ++inside;
             exact_inside += fabs(bound - exact) <= 1e-12;
         }
     }
     CHECK(below == points && inside > 1000 && exact_inside == inside,
-          "box: the planes' bound %d of %d times at most the distance, exact at %d of %d inside", below, points,
+          "box: the planes' bound %d of %d times at most the distance (and above a floor as asked), exact at %d of %d inside", below, points,
           exact_inside, inside);
     CHECK(dwvg_clearance_at(&c, dwvw_v(NAN, 0.0, 0.0)) == 0.0 && dwvg_clearance_at(&c, dwvw_v(0.0, INFINITY, 0.0)) == 0.0,
           "box: a point not finite has clearance 0");
@@ -213,9 +214,11 @@ static void check_planes(void)
         for (int i = 0; i < points; ++i) {
             dwvw_vec3 p = dwvw_v(-1.2 + 2.4 * brute_uniform(&state), -1.2 + 2.4 * brute_uniform(&state),
                                  -1.2 + 2.4 * brute_uniform(&state));
-            above += dwvg_clearance_at(&c, p) > c.largest;
+            double bound = dwvg_clearance_at(&c, p), floor = 0.3 * brute_uniform(&state);
+            above += bound > c.largest || dwvg_clearance_above(&c, p, floor) != (bound > floor ? bound : 0.0);
         }
-        CHECK(reached > 0 && above == 0 && c.largest > 0.5, "sphere: largest bound %g held by %d cells, %d lookups above",
+        CHECK(reached > 0 && above == 0 && c.largest > 0.5,
+              "sphere: largest bound %g held by %d cells, %d lookups above it or wrong above a floor",
               c.largest, reached, above);
     }
     dwvg_clearance_free(&c);
