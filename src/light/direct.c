@@ -70,6 +70,9 @@ void dwvl_direct_lobe(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwv
         origins.clear = top + 0.25 * eps + 0x1p-19 * coordinate;
     }
     for (uint32_t i = 0; i < env->light_count; ++i) {
+        /* A sun below the shading normal's horizon gives nothing: its pair is not drawn (each
+         * light has its own pair, which nothing else uses). */
+        if (dwvl_light_below(&env->lights[i], n)) continue;
         dwvl_sample s;
         double u[2];
         dwvk_sampler_pair(sampler, pair + i, u);

@@ -18,7 +18,9 @@
  *    a ray at every step bit for bit, and in checked mode no ray-free step's ray meets the box.
  * 5. Next-event estimates that skip the shadow rays known to meet nothing (dwvg_world_top) equal
  *    those that cast every one, bit for bit, on a box, a sphere and a box with a post on it, with
- *    suns down to grazing; the tops are the faces' planes on the convex meshes only. */
+ *    suns down to grazing; the tops are the faces' planes on the convex meshes only.
+ * 6. A sun that dwvl_light_below puts below a normal's horizon (so next-event estimation draws no
+ *    sample of it) has no sample above it, for suns of 0, 14 and 29 degrees. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -301,6 +303,45 @@ static void check_shadow_tops(void)
     test_mesh_free(&post);
 }
 
+/* --- 6. suns below the horizon ----------------------------------------------------------- */
+
+/* Wherever dwvl_light_below says a sun's disc lies below a normal's horizon, none of many samples
+ * of it rises above (and it says so for most normals that far below, so the check can fail). */
+static void check_suns_below(void)
+{
+    uint64_t state = 23u;
+    int normals = 3000, below = 0, far_below = 0, wrong = 0, rising = 0;
+    for (int i = 0; i < normals; ++i) {
+        dwv_light_desc_t desc = DWV_LIGHT_DESC_INIT;
+        dwvw_vec3 d = about(dwvw_v(0.0, 0.0, brute_uniform(&state) < 0.5 ? 1.0 : -1.0), &state);
+        desc.direction[0] = d.x;
+        desc.direction[1] = d.y;
+        desc.direction[2] = d.z;
+        desc.angle = (i % 3) * 0.25; /* 0, 14 and 29 degrees across */
+        dwvl_light sun;
+        dwvl_light_init(&sun, &desc);
+        dwvw_vec3 n = about(dwvw_v(1.0, 0.0, 0.0), &state);
+        if (brute_uniform(&state) < 0.5) n = dwvw_scale(n, -1.0);
+        int says = dwvl_light_below(&sun, n);
+        below += says;
+        /* Directions of the disc (half-angle angle / 2) are within the chord 2 sin(angle / 4) of
+         * its centre: all below once the centre is that far below. */
+        if (dwvw_dot(n, sun.direction) < -2.0 * sin(0.25 * desc.angle) - 1e-6) {
+            ++far_below;
+            wrong += !says;
+        }
+        if (!says) continue;
+        for (int k = 0; k < 200; ++k) {
+            dwvl_sample sample;
+            dwvl_light_sample(&sun, dwvw_v(0.0, 0.0, 0.0), brute_uniform(&state), brute_uniform(&state), &sample);
+            rising += dwvw_dot(n, sample.direction) >= 0.0;
+        }
+    }
+    CHECK(rising == 0 && below > normals / 8 && wrong == 0 && far_below >= below,
+          "suns below: said for %d of %d normals (%d well below, %d of them missed), %d samples rose", below, normals,
+          far_below, wrong, rising);
+}
+
 /* --- 4. bakes of the leaf ----------------------------------------------------------------- */
 
 static dwvb_image *bake_leaf(dwv_scene_t *handle, dwvb_ball_mode mode)
@@ -377,5 +418,6 @@ int main(void)
     check_planes();
     check_leaf_bakes();
     check_shadow_tops();
+    check_suns_below();
     return check_report("test_shade_rays");
 }
