@@ -413,11 +413,3 @@ int dwvg_world_build_clearance(dwvg_world *world, uint32_t mesh, double cell_siz
 {
     return dwvg_clearance_build(&world->clearance[mesh], &world->meshes[mesh], cell_size, largest_cell) < 0 ? -1 : 0;
 }
-
-double dwvg_clear_radius(const dwvg_world *world, dwvw_vec3 center, double clearance)
-{
-    double largest = fmax(fabs(center.x), fmax(fabs(center.y), fabs(center.z))) + clearance;
-    double margin = world->epsilon + 0x1p-17 * largest;
-    double radius = clearance - margin;
-    return radius > 0.0 && radius < INFINITY ? radius : 0.0;
-}

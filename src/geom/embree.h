@@ -81,7 +81,17 @@ int dwvg_world_build_clearance(dwvg_world *world, uint32_t mesh, double cell_siz
  * 64 ulps) or the ball's (|center| + clearance). The margin is the sum of 2^-17 of each. 0 when
  * nothing is left. A segment with both ends inside the ball (convex) meets no surface of the
  * mesh: a ray along it is skipped. */
-double dwvg_clear_radius(const dwvg_world *world, dwvw_vec3 center, double clearance);
+static inline double dwvg_clear_radius(const dwvg_world *world, dwvw_vec3 center, double clearance)
+{
+    /* Inline (a walk asks at most steps): the largest |coordinate| by comparisons, which equal
+     * fmax's for numbers; a NaN anywhere gives 0. */
+    double largest = fabs(center.x), ay = fabs(center.y), az = fabs(center.z);
+    largest = ay > largest ? ay : largest;
+    largest = (az > largest ? az : largest) + clearance;
+    double margin = world->epsilon + 0x1p-17 * largest;
+    double radius = clearance - margin;
+    return radius > 0.0 && radius < INFINITY && !isnan(center.x + center.y + center.z) ? radius : 0.0;
+}
 
 /* At most this many vertex-triangle products for the tops table (dwvg_world_top): about a tenth
  * of a second at commit. */

@@ -20,7 +20,8 @@
  *    those that cast every one, bit for bit, on a box, a sphere and a box with a post on it, with
  *    suns down to grazing; the tops are the faces' planes on the convex meshes only.
  * 6. A sun that dwvl_light_below puts below a normal's horizon (so next-event estimation draws no
- *    sample of it) has no sample above it, for suns of 0, 14 and 29 degrees. */
+ *    sample of it) has no sample above it, for suns of 0, 14 and 29 degrees.
+ * 7. The ball's radius (dwvg_clear_radius, inline) equals its fmax form bit for bit. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -303,6 +304,41 @@ static void check_shadow_tops(void)
     test_mesh_free(&post);
 }
 
+/* --- 7. the ball's radius ---------------------------------------------------------------- */
+
+/* dwvg_clear_radius as it was written with fmax: equal bit for bit at finite centres (ties,
+ * zeros and signs included), 0 for a centre with a NaN coordinate. */
+static void check_clear_radius(void)
+{
+    dwvg_world world;
+    memset(&world, 0, sizeof world);
+    world.epsilon = 0x1p-17 * 2.0;
+    uint64_t state = 29u;
+    int points = 20000, same = 0, positive = 0;
+    for (int i = 0; i < points; ++i) {
+        double c[3];
+        for (int a = 0; a < 3; ++a) {
+            double u = brute_uniform(&state);
+            /* Now and then equal magnitudes, zeros of either sign. */
+            c[a] = u < 0.1 ? (a ? c[0] : 0.5) : u < 0.2 ? (u < 0.15 ? 0.0 : -0.0) : 4.0 * brute_uniform(&state) - 2.0;
+            if (brute_uniform(&state) < 0.5) c[a] = -c[a];
+        }
+        double clearance = 0.2 * brute_uniform(&state);
+        double largest = fmax(fabs(c[0]), fmax(fabs(c[1]), fabs(c[2]))) + clearance;
+        double radius = clearance - (world.epsilon + 0x1p-17 * largest);
+        double reference = radius > 0.0 && radius < INFINITY ? radius : 0.0;
+        double got = dwvg_clear_radius(&world, dwvw_v(c[0], c[1], c[2]), clearance);
+        same += memcmp(&got, &reference, sizeof got) == 0;
+        positive += got > 0.0;
+    }
+    CHECK(same == points && positive > points / 2, "clear radius: %d of %d as with fmax (%d positive)", same, points,
+          positive);
+    CHECK(dwvg_clear_radius(&world, dwvw_v(0.0, NAN, 0.0), 0.1) == 0.0 &&
+              dwvg_clear_radius(&world, dwvw_v(0.0, 0.0, NAN), 0.1) == 0.0 &&
+              dwvg_clear_radius(&world, dwvw_v(INFINITY, 0.0, 0.0), 0.1) == 0.0,
+          "clear radius: a centre not finite gets 0");
+}
+
 /* --- 6. suns below the horizon ----------------------------------------------------------- */
 
 /* Wherever dwvl_light_below says a sun's disc lies below a normal's horizon, none of many samples
@@ -419,5 +455,6 @@ int main(void)
     check_leaf_bakes();
     check_shadow_tops();
     check_suns_below();
+    check_clear_radius();
     return check_report("test_shade_rays");
 }
