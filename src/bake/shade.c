@@ -26,7 +26,7 @@ static uint64_t mixture_terms(const dwvw_walk *walk, uint64_t per_component, uin
  * length t < that radius stays in the ball: the walk scatters at its end without a ray, exactly as
  * after a ray that met nothing (the same walk and image, bit for bit). Walks meet only their own
  * mesh, so this holds for open meshes too. The first step (the probe, which the backward
- * technique needs in full) is always a ray. */
+ * technique needs in full) is always a ray (its origin is on the surface: no ball there). */
 static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvb_material *material, uint32_t entry_prim, dwvw_vec3 x, dwvw_vec3 direction, dwvw_vec3 entry_normal, uint64_t key,
                     const dwvk_sampler *sampler, uint32_t walk_pair, dwvw_walk *walk, dwvg_hit *exit, dwvb_tally *tally)
 {
@@ -39,6 +39,11 @@ static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvb_materia
     int needs_closest = shader->needs_closest[mesh];
     dwvb_ball_mode ball_mode = shader->scene->ball_mode;
     int first = 1;
+    /* The first step's ray goes on past the sampled distance only where its answer is used: the
+     * backward technique's opposite interface, and on an open mesh the warning below (a closed
+     * one always has a far side: dwvg_mesh_closed). Elsewhere it stops there as every later step's
+     * does, which changes no walk (a hit beyond the step is not an exit) and is shorter to trace. */
+    int full_probe = walk->guide->q_backward > 0.0 || !world->closed[mesh];
     uint64_t terms_per_component = (uint64_t)walk->medium->channels * (uint64_t)walk->medium->channels;
     uint64_t patches = walk->guide->q_incident > 0.0 && walk->guide->patch_count > 1 ? (uint64_t)walk->guide->patch_count : 0u;
     while (walk->status == DWVW_RUNNING) {
@@ -67,7 +72,8 @@ static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvb_materia
              * hit on the entry triangle is rounding and the ray goes on past it. */
             if (first) {
                 uint32_t rays = 0;
-                found = dwvg_intersect_mesh_leaving(world, mesh, walk->position, walk->direction, entry_prim, &hit, &rays);
+                found = dwvg_intersect_mesh_leaving(world, mesh, walk->position, walk->direction, entry_prim,
+                                                    full_probe ? INFINITY : distance, &hit, &rays);
                 tally->rays += rays;
             } else {
                 ++tally->rays;
@@ -77,8 +83,8 @@ static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvb_materia
             if (ray_free && found) ++tally->ray_free_misses;
         }
         /* A closed mesh surrounds every point inside: a probe that meets nothing means the
-         * mesh is open there (or the ray slipped through), and the walk may wander off. */
-        if (first && !found) ++tally->warnings;
+         * mesh is open there, and the walk may wander off. */
+        if (first && full_probe && !found) ++tally->warnings;
         first = 0;
         dwvw_vec3 normal = dwvw_v(0.0, 0.0, 0.0);
         if (found) {

@@ -102,6 +102,36 @@ static int failed(dwvg_world *world, char *message, size_t size, const char *wha
     return -1;
 }
 
+static int edge_order(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+int dwvg_mesh_closed(const dwvg_mesh *mesh)
+{
+    size_t edges = 3u * (size_t)mesh->triangle_count;
+    if (edges == 0) return 0;
+    uint64_t *directed = malloc(edges * sizeof *directed);
+    if (!directed) return -1;
+    for (uint32_t t = 0; t < mesh->triangle_count; ++t) {
+        const uint32_t *i = mesh->indices + 3u * (size_t)t;
+        for (int k = 0; k < 3; ++k) directed[3u * (size_t)t + (size_t)k] = (uint64_t)i[k] << 32 | i[(k + 1) % 3];
+    }
+    qsort(directed, edges, sizeof *directed, edge_order);
+    /* Closed: no directed edge twice, and each one's reverse present (then, with the first, its
+     * undirected edge has exactly two triangles, one each way). */
+    int closed = 1;
+    for (size_t e = 0; e < edges && closed; ++e) {
+        uint64_t edge = directed[e], reverse = edge << 32 | edge >> 32;
+        closed = (e + 1 == edges || directed[e + 1] != edge) && (edge >> 32) != (edge & 0xffffffffu) &&
+                 bsearch(&reverse, directed, edges, sizeof *directed, edge_order) != NULL;
+    }
+    free(directed);
+    for (uint32_t t = 0; t < mesh->triangle_count && closed; ++t) closed = dwvg_triangle_area(mesh, t) > 0.0;
+    return closed;
+}
+
 /* world->tops (embree.h), where the world is small enough: 0, or -1 out of memory. */
 static int make_tops(dwvg_world *world)
 {
@@ -160,7 +190,8 @@ int dwvg_world_build(dwvg_world *world, const dwvg_mesh *meshes, uint32_t count,
     rtcSetDeviceMemoryMonitorFunction(device, embree_memory, world);
     world->mesh_scenes = calloc(count ? count : 1u, sizeof *world->mesh_scenes);
     world->clearance = calloc(count ? count : 1u, sizeof *world->clearance);
-    if (!world->mesh_scenes || !world->clearance) return failed(world, message, size, "listing the meshes");
+    world->closed = calloc(count ? count : 1u, sizeof *world->closed);
+    if (!world->mesh_scenes || !world->clearance || !world->closed) return failed(world, message, size, "listing the meshes");
     world->mesh_count = count;
     RTCScene top = rtcNewScene(device);
     if (!top) return failed(world, message, size, "creating the top-level scene");
@@ -201,6 +232,8 @@ int dwvg_world_build(dwvg_world *world, const dwvg_mesh *meshes, uint32_t count,
     rtcCommitScene(top);
     if (atomic_load(&world->embree_error)) return failed(world, message, size, "building the top-level BVH");
     if (make_tops(world) < 0) return failed(world, message, size, "finding the triangles' tops");
+    for (uint32_t m = 0; m < count; ++m)
+        if ((world->closed[m] = dwvg_mesh_closed(&meshes[m])) < 0) return failed(world, message, size, "finding closed meshes");
     return 0;
 }
 
@@ -218,6 +251,8 @@ void dwvg_world_free(dwvg_world *world)
         for (uint32_t m = 0; m < world->mesh_count; ++m) free(world->tops[m]);
     free(world->tops);
     world->tops = NULL;
+    free(world->closed);
+    world->closed = NULL;
     if (world->top) rtcReleaseScene(world->top);
     if (world->device) rtcReleaseDevice(world->device);
     world->mesh_scenes = NULL;
@@ -301,22 +336,22 @@ static void leaving_filter(const struct RTCFilterFunctionNArguments *args)
 
 /* The loop that dwvg_intersect_mesh_leaving stands for: one ray after another, each from just
  * past the last hit on `prim`. */
-static int leaving_by_rays(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, uint32_t prim, dwvg_hit *hit,
-                           uint32_t *rays)
+static int leaving_by_rays(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, uint32_t prim, double tfar,
+                           dwvg_hit *hit, uint32_t *rays)
 {
     double tnear = 0.0;
     for (;;) {
         ++*rays;
-        int found = dwvg_intersect_mesh(world, mesh, o, d, tnear, INFINITY, hit);
+        int found = dwvg_intersect_mesh(world, mesh, o, d, tnear, tfar, hit);
         if (!(found && hit->prim == prim)) return found;
         tnear = nextafterf((float)hit->t, INFINITY);
     }
 }
 
 int dwvg_intersect_mesh_leaving(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, uint32_t prim,
-                                dwvg_hit *hit, uint32_t *rays)
+                                double tfar, dwvg_hit *hit, uint32_t *rays)
 {
-    if (!world->leaving_filter) return leaving_by_rays(world, mesh, o, d, prim, hit, rays);
+    if (!world->leaving_filter) return leaving_by_rays(world, mesh, o, d, prim, tfar, hit, rays);
     leaving_context leaving;
     rtcInitIntersectContext(&leaving.context);
     leaving.context.filter = leaving_filter;
@@ -324,12 +359,12 @@ int dwvg_intersect_mesh_leaving(const dwvg_world *world, uint32_t mesh, dwvw_vec
     leaving.t = INFINITY;
     struct RTCRayHit rh;
     ++*rays;
-    if (!make_ray(&rh, o, d, 0.0, INFINITY)) return 0;
+    if (!make_ray(&rh, o, d, 0.0, tfar)) return 0;
     rtcIntersect1(world->mesh_scenes[mesh], &leaving.context, &rh);
     int found = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
     /* Another triangle met at the very distance of prim: which of the two the first of the rays
      * would have returned is up to Embree's traversal order, so they are cast. */
-    if (found && rh.ray.tfar == leaving.t) return leaving_by_rays(world, mesh, o, d, prim, hit, rays);
+    if (found && rh.ray.tfar == leaving.t) return leaving_by_rays(world, mesh, o, d, prim, tfar, hit, rays);
     if (!found) return 0;
     hit->mesh = mesh;
     hit->prim = rh.hit.primID;

@@ -26,6 +26,7 @@ typedef struct dwvg_world {
     uint64_t warnings;    /* zero-area or non-finite triangles (Embree skips them) */
     uint64_t triangles;
     int leaving_filter;   /* Embree runs context filters: mesh scenes take them */
+    int *closed;          /* per mesh: dwvg_mesh_closed */
     /* Per mesh and triangle T: the largest n_T.v over every vertex v of the world, n_T the unit
      * geometric normal (+inf for a zero-area triangle); NULL where the world has more than
      * DWVG_TOPS_WORK vertices x triangles (see dwvg_world_top). */
@@ -52,8 +53,15 @@ int dwvg_occluded(const dwvg_world *world, dwvw_vec3 o, dwvw_vec3 d, double tnea
 /* As dwvg_intersect, against one mesh only. */
 int dwvg_intersect_mesh(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, double tnear,
                         double tfar, dwvg_hit *hit);
+/* Whether every edge of the mesh's triangles is shared, by vertex index, with exactly one other
+ * triangle that runs it the other way, and every triangle has area: a closed, consistently
+ * oriented surface, which surrounds every point inside it (a ray from inside always meets it:
+ * Embree's watertight test leaves no gap along a shared edge). Meshes whose vertices are split
+ * (seams) count as open. 1 closed, 0 open, -1 out of memory. */
+int dwvg_mesh_closed(const dwvg_mesh *mesh);
+
 /* The first surface of `mesh` along unit d from o, o on triangle `prim`, past that triangle: what
- * dwvg_intersect_mesh over (0, +inf) gives when it is cast again from just past each hit on
+ * dwvg_intersect_mesh over (0, tfar) gives when it is cast again from just past each hit on
  * `prim` (float rounding puts o a little above or below the triangle, so the first ray may meet
  * it). Done as one ray whose context filter rejects the hits on `prim`: the nearest other hit at
  * or beyond 0 is the loop's answer when it lies beyond prim's (the loop's later rays see the same
@@ -61,7 +69,7 @@ int dwvg_intersect_mesh(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwv
  * distances, where the loop's answer depends on Embree's order of traversal, the loop itself is
  * run. Adds the rays cast to *rays. */
 int dwvg_intersect_mesh_leaving(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, uint32_t prim,
-                                dwvg_hit *hit, uint32_t *rays);
+                                double tfar, dwvg_hit *hit, uint32_t *rays);
 /* The point of `mesh` closest to p (rtcPointQuery with our own point-triangle distance): 1 and
  * *hit (t = the distance), or 0 if the mesh has no valid triangle. */
 int dwvg_closest_mesh(const dwvg_world *world, uint32_t mesh, dwvw_vec3 p, dwvg_hit *hit);

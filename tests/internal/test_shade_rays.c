@@ -4,8 +4,8 @@
  * 1. The probe past its entry triangle (dwvg_intersect_mesh_leaving, one ray with a context
  *    filter) gives what the loop of rays from just past each hit on that triangle gives, bit for
  *    bit (found, triangle, distance, barycentrics), for inward rays from random points of a box's
- *    and a sphere's triangles; without the filter (the loop itself) likewise; and with one ray
- *    where the loop needed two (the count can fail).
+ *    and a sphere's triangles, over (0, +inf) and cut at random distances; without the filter (the
+ *    loop itself) likewise; and with one ray where the loop needed two (the count can fail).
  * 2. A world of one mesh traces camera and shadow rays in the mesh's scene: the same hits, bit for
  *    bit, as a world where that mesh is instanced beside a second one far away, for random rays
  *    and for rays along the axes (zero direction components).
@@ -21,7 +21,9 @@
  *    suns down to grazing; the tops are the faces' planes on the convex meshes only.
  * 6. A sun that dwvl_light_below puts below a normal's horizon (so next-event estimation draws no
  *    sample of it) has no sample above it, for suns of 0, 14 and 29 degrees.
- * 7. The ball's radius (dwvg_clear_radius, inline) equals its fmax form bit for bit. */
+ * 7. The ball's radius (dwvg_clear_radius, inline) equals its fmax form bit for bit.
+ * 8. dwvg_mesh_closed: a box and a sphere are closed; with a triangle missing, flipped or twice,
+ *    of zero area, or a vertex split, a box is not (those walks keep the full probe). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -74,7 +76,7 @@ static void check_leaving(const char *name, const test_mesh *m)
     }
     CHECK(world.leaving_filter, "%s: Embree runs no context filters here", name);
     uint64_t state = 5u;
-    int walks = 4000, same = 0, same_unfiltered = 0, found_count = 0;
+    int walks = 4000, same = 0, same_unfiltered = 0, found_count = 0, same_cut = 0, found_within = 0;
     uint64_t rays_loop = 0, rays_one = 0;
     for (int i = 0; i < walks; ++i) {
         uint32_t prim = (uint32_t)(brute_uniform(&state) * mesh.triangle_count);
@@ -95,11 +97,25 @@ static void check_leaving(const char *name, const test_mesh *m)
             if (!(found_loop && loop.prim == prim)) break;
             tnear = nextafterf((float)loop.t, INFINITY);
         }
+        /* Cut at a random distance, against the loop cut there. */
+        double tfar = 0.3 * brute_uniform(&state);
+        dwvg_hit cut_loop, cut;
+        int found_cut_loop;
+        tnear = 0.0;
+        for (;;) {
+            found_cut_loop = dwvg_intersect_mesh(&world, 0u, x, d, tnear, tfar, &cut_loop);
+            if (!(found_cut_loop && cut_loop.prim == prim)) break;
+            tnear = nextafterf((float)cut_loop.t, INFINITY);
+        }
+        uint32_t rays_cut = 0;
+        int found_cut = dwvg_intersect_mesh_leaving(&world, 0u, x, d, prim, tfar, &cut, &rays_cut);
+        same_cut += same_hit(found_cut, &cut, found_cut_loop, &cut_loop);
+        found_within += found_cut;
         dwvg_hit one, unfiltered;
         uint32_t rays = 0, rays_unfiltered = 0;
-        int found_one = dwvg_intersect_mesh_leaving(&world, 0u, x, d, prim, &one, &rays);
+        int found_one = dwvg_intersect_mesh_leaving(&world, 0u, x, d, prim, INFINITY, &one, &rays);
         world.leaving_filter = 0;
-        int found_unfiltered = dwvg_intersect_mesh_leaving(&world, 0u, x, d, prim, &unfiltered, &rays_unfiltered);
+        int found_unfiltered = dwvg_intersect_mesh_leaving(&world, 0u, x, d, prim, INFINITY, &unfiltered, &rays_unfiltered);
         world.leaving_filter = 1;
         rays_one += rays;
         same += same_hit(found_one, &one, found_loop, &loop);
@@ -109,6 +125,8 @@ static void check_leaving(const char *name, const test_mesh *m)
     CHECK(same == walks && same_unfiltered == walks && found_count == walks,
           "%s: %d of %d probes as the loop's (%d without the filter), %d found the far side", name, same, walks,
           same_unfiltered, found_count);
+    CHECK(same_cut == walks && found_within > 0 && found_within < walks,
+          "%s: %d of %d probes cut short as the loop's (%d met the surface)", name, same_cut, walks, found_within);
     /* The loop needs a second ray wherever rounding leaves the origin on the entry triangle. */
     CHECK(rays_one < rays_loop && rays_one >= (uint64_t)walks, "%s: %llu rays against the loop's %llu", name,
           (unsigned long long)rays_one, (unsigned long long)rays_loop);
@@ -339,6 +357,56 @@ static void check_clear_radius(void)
           "clear radius: a centre not finite gets 0");
 }
 
+/* --- 8. closed meshes --------------------------------------------------------------------- */
+
+static int closed_of(const test_mesh *m)
+{
+    dwvg_mesh mesh = make_mesh(m);
+    int closed = dwvg_mesh_closed(&mesh);
+    dwvg_mesh_free(&mesh);
+    return closed;
+}
+
+/* A box and a sphere are closed; without a triangle, with one flipped, with a face twice, with a
+ * zero-area triangle or with a vertex split in two they are not. */
+static void check_closed(void)
+{
+    test_mesh box = test_box(-1.0, -1.0, -1.0, 1.0, 1.0, 1.0), sphere = test_sphere(0.0, 0.0, 0.0, 1.0, 12, 24);
+    CHECK(closed_of(&box) == 1 && closed_of(&sphere) == 1, "box %d and sphere %d closed", closed_of(&box), closed_of(&sphere));
+    test_mesh m = test_box(-1.0, -1.0, -1.0, 1.0, 1.0, 1.0);
+    m.triangle_count = 11u;
+    int without = closed_of(&m);
+    m.triangle_count = 12u;
+    uint32_t keep = m.indices[1];
+    m.indices[1] = m.indices[2];
+    m.indices[2] = keep;
+    int flipped = closed_of(&m);
+    m.indices[2] = m.indices[1];
+    m.indices[1] = keep;
+    memcpy(m.indices + 3, m.indices, 3u * sizeof(uint32_t));
+    int twice = closed_of(&m);
+    test_mesh_free(&m);
+    m = test_box(-1.0, -1.0, -1.0, 1.0, 1.0, 1.0);
+    m.positions[3] = m.positions[0]; /* vertex 1 onto vertex 0: the triangles with both lose their area */
+    m.positions[4] = m.positions[1];
+    m.positions[5] = m.positions[2];
+    int flat = closed_of(&m);
+    test_mesh_free(&m);
+    m = test_box(-1.0, -1.0, -1.0, 1.0, 1.0, 1.0);
+    m.positions = realloc(m.positions, 28u * sizeof(float));
+    if (!m.positions) exit(2);
+    memcpy(m.positions + 24, m.positions, 3u * sizeof(float)); /* vertex 8: a copy of vertex 0 */
+    m.vertex_count = 9u;
+    m.indices[0] = 8u;
+    int split = closed_of(&m);
+    test_mesh_free(&m);
+    CHECK(without == 0 && flipped == 0 && twice == 0 && flat == 0 && split == 0,
+          "not closed: without a triangle %d, flipped %d, a face twice %d, zero area %d, a split vertex %d", without,
+          flipped, twice, flat, split);
+    test_mesh_free(&box);
+    test_mesh_free(&sphere);
+}
+
 /* --- 6. suns below the horizon ----------------------------------------------------------- */
 
 /* Wherever dwvl_light_below says a sun's disc lies below a normal's horizon, none of many samples
@@ -456,5 +524,6 @@ int main(void)
     check_shadow_tops();
     check_suns_below();
     check_clear_radius();
+    check_closed();
     return check_report("test_shade_rays");
 }
