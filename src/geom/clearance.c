@@ -270,8 +270,10 @@ int dwvg_clearance_build(dwvg_clearance *grid, const dwvg_mesh *mesh, double cel
     }
     if (!(h <= largest_cell)) return 1;
     grid->cell = h;
+    grid->inverse_cell = 1.0 / h;
     for (int a = 0; a < 3; ++a) {
         grid->n[a] = (uint32_t)(floor((hi[a] - lo[a]) / h) + 3.0);
+        grid->cells[a] = grid->n[a];
         grid->origin[a] = lo[a] - h;
     }
     size_t count = (size_t)grid->n[0] * grid->n[1] * grid->n[2];

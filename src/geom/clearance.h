@@ -38,6 +38,7 @@ typedef struct dwvg_clearance {
     double origin[3];  /* the grid's lowest corner */
     double cell;       /* the cell size h */
     uint32_t n[3];     /* cells per axis */
+    double inverse_cell, cells[3]; /* 1 / cell and n as doubles, for lookups */
     double largest;    /* no lookup gives more: the largest bound of any cell; +inf with planes; 0 if
                           neither */
     uint32_t plane_count;                          /* 0: none (the grid, if any, is used) */
@@ -84,11 +85,12 @@ static inline double dwvg_clearance_above(const dwvg_clearance *grid, dwvw_vec3 
         return bound < INFINITY ? bound : 0.0; /* an infinite p leaves it infinite */
     }
     if (!grid->lower) return 0.0;
-    double inverse = 1.0 / grid->cell;
+    double inverse = grid->inverse_cell;
     double fx = (p.x - grid->origin[0]) * inverse, fy = (p.y - grid->origin[1]) * inverse,
            fz = (p.z - grid->origin[2]) * inverse;
     /* The negated tests also send NaN to 0. */
-    if (!(fx >= 0.0 && fy >= 0.0 && fz >= 0.0 && fx < grid->n[0] && fy < grid->n[1] && fz < grid->n[2])) return 0.0;
+    if (!(fx >= 0.0 && fy >= 0.0 && fz >= 0.0 && fx < grid->cells[0] && fy < grid->cells[1] && fz < grid->cells[2]))
+        return 0.0;
     uint32_t ix = (uint32_t)fx, iy = (uint32_t)fy, iz = (uint32_t)fz;
     double bound = grid->lower[((size_t)iz * grid->n[1] + iy) * grid->n[0] + ix];
     if (!(bound > floor)) return 0.0;
