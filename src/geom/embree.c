@@ -132,6 +132,49 @@ int dwvg_mesh_closed(const dwvg_mesh *mesh)
     return closed;
 }
 
+/* *p for a closed mesh without vertex normals whose triangles lie in at most
+ * DWVG_POLYTOPE_PLANES planes (equal geometric normals and offsets, bit for bit), with every
+ * vertex on or below each plane (to 2^-40 of the largest coordinate): convex. Else p->plane_count
+ * stays 0. */
+static void find_polytope(const dwvg_world *world, const dwvg_mesh *mesh, int closed, dwvg_polytope *p)
+{
+    memset(p, 0, sizeof *p);
+    if (!closed || mesh->normals || mesh->triangle_count > DWVG_POLYTOPE_TRIANGLES) return;
+    uint32_t plane_of[DWVG_POLYTOPE_TRIANGLES], count = 0;
+    for (uint32_t t = 0; t < mesh->triangle_count; ++t) {
+        dwvw_vec3 n = dwvg_geometric_normal(mesh, t), a = vertex(mesh, mesh->indices[3u * (size_t)t]);
+        if (n.x == 0.0 && n.y == 0.0 && n.z == 0.0) return;
+        double offset = dwvw_dot(n, a);
+        uint32_t i = 0;
+        while (i < count && !(p->planes[i][0] == n.x && p->planes[i][1] == n.y && p->planes[i][2] == n.z &&
+                              p->planes[i][3] == offset))
+            ++i;
+        if (i == count) {
+            if (count == DWVG_POLYTOPE_PLANES) return;
+            p->planes[count][0] = n.x;
+            p->planes[count][1] = n.y;
+            p->planes[count][2] = n.z;
+            p->planes[count][3] = offset;
+            ++count;
+        }
+        plane_of[t] = i;
+    }
+    double tolerance = 0x1p-23 * world->epsilon;
+    for (uint32_t i = 0; i < count; ++i)
+        for (uint32_t v = 0; v < mesh->vertex_count; ++v) {
+            dwvw_vec3 n = dwvw_v(p->planes[i][0], p->planes[i][1], p->planes[i][2]);
+            if (!(dwvw_dot(n, vertex(mesh, v)) - p->planes[i][3] <= tolerance)) return;
+        }
+    uint32_t k = 0;
+    for (uint32_t i = 0; i < count; ++i) {
+        p->first[i] = k;
+        for (uint32_t t = 0; t < mesh->triangle_count; ++t)
+            if (plane_of[t] == i) p->triangles[k++] = t;
+    }
+    p->first[count] = k;
+    p->plane_count = count;
+}
+
 /* world->tops (embree.h), where the world is small enough: 0, or -1 out of memory. */
 static int make_tops(dwvg_world *world)
 {
@@ -191,7 +234,9 @@ int dwvg_world_build(dwvg_world *world, const dwvg_mesh *meshes, uint32_t count,
     world->mesh_scenes = calloc(count ? count : 1u, sizeof *world->mesh_scenes);
     world->clearance = calloc(count ? count : 1u, sizeof *world->clearance);
     world->closed = calloc(count ? count : 1u, sizeof *world->closed);
-    if (!world->mesh_scenes || !world->clearance || !world->closed) return failed(world, message, size, "listing the meshes");
+    world->polytopes = calloc(count ? count : 1u, sizeof *world->polytopes);
+    if (!world->mesh_scenes || !world->clearance || !world->closed || !world->polytopes)
+        return failed(world, message, size, "listing the meshes");
     world->mesh_count = count;
     RTCScene top = rtcNewScene(device);
     if (!top) return failed(world, message, size, "creating the top-level scene");
@@ -233,7 +278,10 @@ int dwvg_world_build(dwvg_world *world, const dwvg_mesh *meshes, uint32_t count,
     if (atomic_load(&world->embree_error)) return failed(world, message, size, "building the top-level BVH");
     if (make_tops(world) < 0) return failed(world, message, size, "finding the triangles' tops");
     for (uint32_t m = 0; m < count; ++m)
+    {
         if ((world->closed[m] = dwvg_mesh_closed(&meshes[m])) < 0) return failed(world, message, size, "finding closed meshes");
+        find_polytope(world, &meshes[m], world->closed[m], &world->polytopes[m]);
+    }
     return 0;
 }
 
@@ -253,6 +301,8 @@ void dwvg_world_free(dwvg_world *world)
     world->tops = NULL;
     free(world->closed);
     world->closed = NULL;
+    free(world->polytopes);
+    world->polytopes = NULL;
     if (world->top) rtcReleaseScene(world->top);
     if (world->device) rtcReleaseDevice(world->device);
     world->mesh_scenes = NULL;
@@ -307,9 +357,54 @@ int dwvg_intersect(const dwvg_world *world, dwvw_vec3 o, dwvw_vec3 d, double tne
     return trace(world->top, 1, o, d, tnear, tfar, hit);
 }
 
+static int polytope_intersect(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, double tnear,
+                              double tfar, dwvg_hit *hit)
+{
+    const dwvg_polytope *p = &world->polytopes[mesh];
+    double best = INFINITY;
+    uint32_t plane = DWVG_POLYTOPE_PLANES;
+    for (uint32_t i = 0; i < p->plane_count; ++i) {
+        const double *q = p->planes[i];
+        double rate = q[0] * d.x + q[1] * d.y + q[2] * d.z;
+        if (!(rate > 0.0)) continue;
+        double t = (q[3] - (q[0] * o.x + q[1] * o.y + q[2] * o.z)) / rate;
+        if (t < best) {
+            best = t;
+            plane = i;
+        }
+    }
+    if (plane == DWVG_POLYTOPE_PLANES) return 0; /* no plane ahead (d not finite) */
+    double t = best > 0.0 ? best : 0.0;
+    if (!(t >= tnear && t <= tfar)) return 0;
+    /* The triangle of that plane holding the point: the one whose least barycentric is largest. */
+    const dwvg_mesh *m = &world->meshes[mesh];
+    dwvw_vec3 x = dwvw_madd(o, d, t);
+    double chosen = -INFINITY;
+    for (uint32_t k = p->first[plane]; k < p->first[plane + 1]; ++k) {
+        uint32_t prim = p->triangles[k];
+        dwvw_vec3 a, b, c;
+        corners(m, prim, &a, &b, &c);
+        dwvw_vec3 e1 = dwvw_sub(b, a), e2 = dwvw_sub(c, a), w = dwvw_sub(x, a);
+        double d11 = dwvw_dot(e1, e1), d12 = dwvw_dot(e1, e2), d22 = dwvw_dot(e2, e2);
+        double w1 = dwvw_dot(w, e1), w2 = dwvw_dot(w, e2), det = d11 * d22 - d12 * d12;
+        double u = (d22 * w1 - d12 * w2) / det, v = (d11 * w2 - d12 * w1) / det;
+        double least = fmin(1.0 - u - v, fmin(u, v));
+        if (least > chosen) {
+            chosen = least;
+            hit->prim = prim;
+            hit->u = u;
+            hit->v = v;
+        }
+    }
+    hit->mesh = mesh;
+    hit->t = t;
+    return 1;
+}
+
 int dwvg_intersect_mesh(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, double tnear,
                         double tfar, dwvg_hit *hit)
 {
+    if (world->polytopes[mesh].plane_count) return polytope_intersect(world, mesh, o, d, tnear, tfar, hit);
     if (!trace(world->mesh_scenes[mesh], 0, o, d, tnear, tfar, hit)) return 0;
     hit->mesh = mesh;
     return 1;
@@ -351,6 +446,11 @@ static int leaving_by_rays(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, 
 int dwvg_intersect_mesh_leaving(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, uint32_t prim,
                                 double tfar, dwvg_hit *hit, uint32_t *rays)
 {
+    /* A polytope's exit is never the plane o starts on, which the ray leaves downward. */
+    if (world->polytopes[mesh].plane_count) {
+        ++*rays;
+        return polytope_intersect(world, mesh, o, d, 0.0, tfar, hit);
+    }
     if (!world->leaving_filter) return leaving_by_rays(world, mesh, o, d, prim, tfar, hit, rays);
     leaving_context leaving;
     rtcInitIntersectContext(&leaving.context);

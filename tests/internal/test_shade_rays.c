@@ -23,7 +23,10 @@
  *    sample of it) has no sample above it, for suns of 0, 14 and 29 degrees.
  * 7. The ball's radius (dwvg_clear_radius, inline) equals its fmax form bit for bit.
  * 8. dwvg_mesh_closed: a box and a sphere are closed; with a triangle missing, flipped or twice,
- *    of zero area, or a vertex split, a box is not (those walks keep the full probe). */
+ *    of zero area, or a vertex split, a box is not (those walks keep the full probe).
+ * 9. A thin box is a polytope: its walk rays and probes by its planes agree with Embree's (the
+ *    same exits, distances to 1e-6, the exit inside its triangle); a sphere, an open box and a
+ *    box with vertex normals are none. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -75,6 +78,8 @@ static void check_leaving(const char *name, const test_mesh *m)
         return;
     }
     CHECK(world.leaving_filter, "%s: Embree runs no context filters here", name);
+    /* Embree's rays (a box is otherwise intersected by its planes: section 9). */
+    world.polytopes[0].plane_count = 0;
     uint64_t state = 5u;
     int walks = 4000, same = 0, same_unfiltered = 0, found_count = 0, same_cut = 0, found_within = 0;
     uint64_t rays_loop = 0, rays_one = 0;
@@ -407,6 +412,99 @@ static void check_closed(void)
     test_mesh_free(&sphere);
 }
 
+/* --- 9. polytopes ------------------------------------------------------------------------- */
+
+/* A thin box's walk rays by its planes against Embree's: the same found or not, the same plane,
+ * distances within 1e-6 (Embree's are floats), and a triangle that holds the exit point; the
+ * probe past its entry triangle likewise. A sphere, an open box and a box with vertex normals
+ * are no polytopes. */
+static void check_polytopes(void)
+{
+    test_mesh b = test_box(-2.0, -2.0, -0.01, 2.0, 2.0, 0.01);
+    dwvg_mesh box = make_mesh(&b);
+    dwvg_world world;
+    char message[256];
+    if (dwvg_world_build(&world, &box, 1u, message, sizeof message)) {
+        CHECK(0, "world: %s", message);
+        return;
+    }
+    dwvg_polytope planes = world.polytopes[0];
+    CHECK(planes.plane_count == 6u && planes.first[6] == 12u, "box: %u planes", planes.plane_count);
+    uint64_t state = 31u;
+    int rays = 20000, agree = 0, found = 0, inside = 0;
+    for (int i = 0; i < rays; ++i) {
+        dwvw_vec3 o = dwvw_v(-1.99 + 3.98 * brute_uniform(&state), -1.99 + 3.98 * brute_uniform(&state),
+                             -0.0099 + 0.0198 * brute_uniform(&state));
+        dwvw_vec3 d = about(dwvw_v(0.0, 0.0, brute_uniform(&state) < 0.5 ? 1.0 : -1.0), &state);
+        if (i % 3 == 0) d = dwvw_normalize(dwvw_v(brute_uniform(&state) - 0.5, brute_uniform(&state) - 0.5, 1e-3 * (brute_uniform(&state) - 0.5)));
+        double tfar = i % 2 ? INFINITY : 0.05 * brute_uniform(&state);
+        dwvg_hit a, e;
+        world.polytopes[0] = planes;
+        int found_a = dwvg_intersect_mesh(&world, 0u, o, d, 0.0, tfar, &a);
+        world.polytopes[0].plane_count = 0;
+        int found_e = dwvg_intersect_mesh(&world, 0u, o, d, 0.0, tfar, &e);
+        if (found_a != found_e) continue;
+        found += found_a;
+        if (!found_a) {
+            ++agree;
+            continue;
+        }
+        dwvw_vec3 na = dwvg_geometric_normal(&box, a.prim), ne = dwvg_geometric_normal(&box, e.prim);
+        agree += na.x == ne.x && na.y == ne.y && na.z == ne.z && fabs(a.t - e.t) <= 1e-6 * (1.0 + e.t);
+        inside += a.u >= -1e-9 && a.v >= -1e-9 && a.u + a.v <= 1.0 + 1e-9;
+    }
+    world.polytopes[0] = planes;
+    CHECK(agree == rays && inside == found && found > rays / 4,
+          "box: %d of %d rays by the planes as Embree's, %d of %d exits inside their triangle", agree, rays, inside, found);
+    /* The probe from a point of a face, inward. */
+    int probes = 2000, probes_agree = 0;
+    for (int i = 0; i < probes; ++i) {
+        uint32_t prim = (uint32_t)(brute_uniform(&state) * box.triangle_count);
+        double u = brute_uniform(&state), v = brute_uniform(&state);
+        if (u + v > 1.0) {
+            u = 1.0 - u;
+            v = 1.0 - v;
+        }
+        dwvw_vec3 x = dwvg_point(&box, prim, u, v);
+        dwvw_vec3 d = about(dwvw_scale(dwvg_geometric_normal(&box, prim), -1.0), &state);
+        dwvg_hit a, e;
+        uint32_t count = 0;
+        int found_a = dwvg_intersect_mesh_leaving(&world, 0u, x, d, prim, INFINITY, &a, &count);
+        world.polytopes[0].plane_count = 0;
+        int found_e = dwvg_intersect_mesh_leaving(&world, 0u, x, d, prim, INFINITY, &e, &count);
+        world.polytopes[0] = planes;
+        dwvw_vec3 na = dwvg_geometric_normal(&box, a.prim), ne = dwvg_geometric_normal(&box, e.prim);
+        probes_agree += found_a && found_e && na.x == ne.x && na.y == ne.y && na.z == ne.z &&
+                        fabs(a.t - e.t) <= 1e-6 * (1.0 + e.t);
+    }
+    CHECK(probes_agree == probes, "box: %d of %d probes by the planes as Embree's", probes_agree, probes);
+    dwvg_world_free(&world);
+
+    /* No polytopes: a sphere; a box without a triangle; a box with vertex normals. */
+    test_mesh s = test_sphere(0.0, 0.0, 0.0, 1.0, 12, 24);
+    dwvg_mesh sphere = make_mesh(&s), open = make_mesh(&b), smooth;
+    open.triangle_count = 11u;
+    float normals[24];
+    for (int k = 0; k < 24; ++k) normals[k] = b.positions[k] / 2.0f;
+    if (dwvg_mesh_init(&smooth, b.vertex_count, b.triangle_count, 0u, b.positions, b.indices, normals, NULL, identity))
+        exit(2);
+    const dwvg_mesh *others[3] = {&sphere, &open, &smooth};
+    int none = 0;
+    for (int k = 0; k < 3; ++k) {
+        if (dwvg_world_build(&world, others[k], 1u, message, sizeof message)) continue;
+        none += world.polytopes[0].plane_count == 0u;
+        dwvg_world_free(&world);
+    }
+    CHECK(none == 3, "%d of 3 meshes not polytopes", none);
+    open.triangle_count = 12u;
+    dwvg_mesh_free(&sphere);
+    dwvg_mesh_free(&open);
+    dwvg_mesh_free(&smooth);
+    dwvg_mesh_free(&box);
+    test_mesh_free(&s);
+    test_mesh_free(&b);
+}
+
 /* --- 6. suns below the horizon ----------------------------------------------------------- */
 
 /* Wherever dwvl_light_below says a sun's disc lies below a normal's horizon, none of many samples
@@ -525,5 +623,6 @@ int main(void)
     check_suns_below();
     check_clear_radius();
     check_closed();
+    check_polytopes();
     return check_report("test_shade_rays");
 }
