@@ -57,8 +57,9 @@ static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvb_materia
         double distance = dwvw_walk_sample(walk);
         tally->mixture_terms += mixture_terms(walk, terms_per_component, patches);
         int ray_free = 0;
-        /* The ball's radius is below the clearance, which the grid bounds by its largest cell:
-         * a step at least that long needs neither the lookup nor the radius. */
+        /* The ball's radius is below the clearance, which the grid bounds by its largest cell
+         * (planes have no such bound: +inf): a step at least that long needs neither the lookup
+         * nor the radius. */
         if (!first && ball_mode != DWVB_BALL_OFF && (needs_closest || distance < grid->largest)) {
             if (!needs_closest) clearance = dwvg_clearance_above(grid, walk->position, distance);
             ray_free = distance < clearance && distance < dwvg_clear_radius(world, walk->position, clearance);
@@ -68,8 +69,9 @@ static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvb_materia
         tally->ray_free_steps += (uint64_t)ray_free;
         if (!ray_free || ball_mode == DWVB_BALL_CHECKED) {
             /* The first step is the probe: its full distance to the surface locates an opposite
-             * interface. A ray leaving a flat triangle inward cannot meet that triangle again, so a
-             * hit on the entry triangle is rounding and the ray goes on past it. */
+             * interface (full_probe). A ray leaving a flat triangle inward cannot meet that
+             * triangle again, so a hit on the entry triangle is rounding and the ray goes on past
+             * it (dwvg_intersect_mesh_leaving). */
             if (first) {
                 uint32_t rays = 0;
                 found = dwvg_intersect_mesh_leaving(world, mesh, walk->position, walk->direction, entry_prim,
