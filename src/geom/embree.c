@@ -348,11 +348,17 @@ static int trace(RTCScene scene, int instanced, dwvw_vec3 o, dwvw_vec3 d, double
     return 1;
 }
 
+static void polytope_hit(const dwvg_world *world, uint32_t mesh, uint32_t plane, dwvw_vec3 o, dwvw_vec3 d, double t,
+                         dwvg_hit *hit);
+static int polytope_first(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar,
+                          dwvg_hit *hit);
+
 /* A world of one mesh traces that mesh's scene: the top-level scene would only add an instance
  * (the identity transform, which leaves a ray's floats as they are) around the same BVH. */
 int dwvg_intersect(const dwvg_world *world, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar, dwvg_hit *hit)
 {
     if (world->mesh_count == 0) return 0;
+    if (world->mesh_count == 1 && world->polytopes[0].plane_count) return polytope_first(world, 0u, o, d, tnear, tfar, hit);
     if (world->mesh_count == 1) return trace(world->mesh_scenes[0], 0, o, d, tnear, tfar, hit);
     return trace(world->top, 1, o, d, tnear, tfar, hit);
 }
@@ -376,7 +382,16 @@ static int polytope_intersect(const dwvg_world *world, uint32_t mesh, dwvw_vec3 
     if (plane == DWVG_POLYTOPE_PLANES) return 0; /* no plane ahead (d not finite) */
     double t = best > 0.0 ? best : 0.0;
     if (!(t >= tnear && t <= tfar)) return 0;
-    /* The triangle of that plane holding the point: the one whose least barycentric is largest. */
+    polytope_hit(world, mesh, plane, o, d, t, hit);
+    return 1;
+}
+
+/* The hit at distance t along d from o on plane `plane` of polytope `mesh`: the triangle of that
+ * plane holding the point, the one whose least barycentric is largest. */
+static void polytope_hit(const dwvg_world *world, uint32_t mesh, uint32_t plane, dwvw_vec3 o, dwvw_vec3 d, double t,
+                         dwvg_hit *hit)
+{
+    const dwvg_polytope *p = &world->polytopes[mesh];
     const dwvg_mesh *m = &world->meshes[mesh];
     dwvw_vec3 x = dwvw_madd(o, d, t);
     double chosen = -INFINITY;
@@ -398,6 +413,42 @@ static int polytope_intersect(const dwvg_world *world, uint32_t mesh, dwvw_vec3 
     }
     hit->mesh = mesh;
     hit->t = t;
+}
+
+/* A ray from anywhere against a polytope: the first crossing of its surface within [tnear, tfar].
+ * The line is inside between t_in, the last of the planes it enters (n.d < 0), and t_out, the
+ * first it leaves (n.d > 0); it misses where t_in > t_out or it runs outside a plane it is
+ * parallel to. The crossing is t_in where that is at tnear or beyond, else t_out (from inside). */
+static int polytope_first(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar,
+                          dwvg_hit *hit)
+{
+    const dwvg_polytope *p = &world->polytopes[mesh];
+    double t_in = -INFINITY, t_out = INFINITY;
+    uint32_t in = DWVG_POLYTOPE_PLANES, out = DWVG_POLYTOPE_PLANES;
+    for (uint32_t i = 0; i < p->plane_count; ++i) {
+        const double *q = p->planes[i];
+        double rate = q[0] * d.x + q[1] * d.y + q[2] * d.z, gap = q[3] - (q[0] * o.x + q[1] * o.y + q[2] * o.z);
+        if (rate > 0.0) {
+            double t = gap / rate;
+            if (t < t_out) {
+                t_out = t;
+                out = i;
+            }
+        } else if (rate < 0.0) {
+            double t = gap / rate;
+            if (t > t_in) {
+                t_in = t;
+                in = i;
+            }
+        } else if (!(gap >= 0.0)) {
+            return 0; /* parallel outside, or not finite */
+        }
+    }
+    if (!(t_in <= t_out)) return 0;
+    uint32_t plane = t_in >= tnear ? in : out;
+    double t = t_in >= tnear ? t_in : t_out;
+    if (plane == DWVG_POLYTOPE_PLANES || !(t >= tnear && t <= tfar)) return 0;
+    polytope_hit(world, mesh, plane, o, d, t, hit);
     return 1;
 }
 

@@ -59,7 +59,8 @@ typedef struct dwvg_hit {
 int dwvg_world_build(dwvg_world *world, const dwvg_mesh *meshes, uint32_t count, char *message, size_t size);
 void dwvg_world_free(dwvg_world *world);
 
-/* The first surface along unit d from o within (tnear, tfar): 1 and *hit, or 0. */
+/* The first surface along unit d from o within (tnear, tfar): 1 and *hit, or 0. A world that is
+ * one polytope (dwvg_polytope) is met by its planes, as dwvg_intersect_mesh's walk rays are. */
 int dwvg_intersect(const dwvg_world *world, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar, dwvg_hit *hit);
 /* Whether anything blocks the segment (tnear, tfar) along d from o. */
 int dwvg_occluded(const dwvg_world *world, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar);

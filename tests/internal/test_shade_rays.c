@@ -24,9 +24,9 @@
  * 7. The ball's radius (dwvg_clear_radius, inline) equals its fmax form bit for bit.
  * 8. dwvg_mesh_closed: a box and a sphere are closed; with a triangle missing, flipped or twice,
  *    of zero area, or a vertex split, a box is not (those walks keep the full probe).
- * 9. A thin box is a polytope: its walk rays and probes by its planes agree with Embree's (the
- *    same exits, distances to 1e-6, the exit inside its triangle); a sphere, an open box and a
- *    box with vertex normals are none. */
+ * 9. A thin box is a polytope: its walk rays, probes and camera rays (from around it and from
+ *    inside) by its planes agree with Embree's (the same hits, distances to 1e-6, the exit inside
+ *    its triangle); a sphere, an open box and a box with vertex normals are none. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -478,6 +478,30 @@ static void check_polytopes(void)
                         fabs(a.t - e.t) <= 1e-6 * (1.0 + e.t);
     }
     CHECK(probes_agree == probes, "box: %d of %d probes by the planes as Embree's", probes_agree, probes);
+    /* Camera rays (dwvg_intersect) from around the box and from inside it. */
+    int cameras = 20000, cameras_agree = 0, cameras_hit = 0;
+    for (int i = 0; i < cameras; ++i) {
+        dwvw_vec3 o, d;
+        if (i % 4) {
+            o = dwvw_scale(about(dwvw_v(0.0, 0.0, 1.0), &state), 3.0);
+            if (i % 2) o = dwvw_scale(o, -1.0);
+            d = dwvw_normalize(dwvw_sub(dwvw_v(5.0 * brute_uniform(&state) - 2.5, 5.0 * brute_uniform(&state) - 2.5, 0.0), o));
+        } else {
+            o = dwvw_v(3.0 * brute_uniform(&state) - 1.5, 3.0 * brute_uniform(&state) - 1.5, 0.018 * brute_uniform(&state) - 0.009);
+            d = about(dwvw_v(0.0, 0.0, 1.0), &state);
+        }
+        dwvg_hit a, e;
+        int found_a = dwvg_intersect(&world, o, d, 0.0, INFINITY, &a);
+        world.polytopes[0].plane_count = 0;
+        int found_e = dwvg_intersect(&world, o, d, 0.0, INFINITY, &e);
+        world.polytopes[0] = planes;
+        dwvw_vec3 na = dwvg_geometric_normal(&box, found_a ? a.prim : 0u), ne = dwvg_geometric_normal(&box, found_e ? e.prim : 0u);
+        cameras_agree += found_a == found_e && (!found_a || (na.x == ne.x && na.y == ne.y && na.z == ne.z &&
+                                                            fabs(a.t - e.t) <= 1e-6 * (1.0 + e.t)));
+        cameras_hit += found_a;
+    }
+    CHECK(cameras_agree == cameras && cameras_hit > cameras / 4 && cameras_hit < cameras,
+          "box: %d of %d camera rays by the planes as Embree's (%d hit)", cameras_agree, cameras, cameras_hit);
     dwvg_world_free(&world);
 
     /* No polytopes: a sphere; a box without a triangle; a box with vertex normals. */
