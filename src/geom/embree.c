@@ -332,7 +332,9 @@ static int make_ray(struct RTCRayHit *rh, dwvw_vec3 o, dwvw_vec3 d, double tnear
            in_embree_range(rh->ray.dir_x, rh->ray.dir_y, rh->ray.dir_z) && !isnan(tnear) && !isnan(tfar);
 }
 
-static int trace(RTCScene scene, int instanced, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar, dwvg_hit *hit)
+/* Inline: it is every walk ray's way to Embree, and GCC left it out of line once the polytopes
+ * grew this file (some 170 instructions more per sphere walk). */
+static inline int trace(RTCScene scene, int instanced, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar, dwvg_hit *hit)
 {
     struct RTCIntersectContext context;
     rtcInitIntersectContext(&context);
