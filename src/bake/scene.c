@@ -130,7 +130,7 @@ static int make_patches(const dwvb_scene *scene, const dwvl_environment *env, ui
             double radiance[3];
             /* Independent draws; pairs from 2 on (dimensions 4, 5, ...) leave 0 to 2 to the point. */
             dwvk_sampler sampler = {.key = key, .index = 0u, .stratified = 0};
-            dwvl_direct(env, x, ng, ng, NULL, &sampler, 2u, radiance);
+            dwvl_direct(env, x, ng, ng, NULL, INFINITY, &sampler, 2u, radiance);
             /* The Lambertian estimate is irradiance / pi. */
             double e = 3.14159265358979323846 * luminance(radiance);
             if (!(e > 0.0)) continue;

@@ -3,14 +3,17 @@
 #include <math.h>
 
 
-/* The mixture terms of the step just sampled (see dwvb_tally). */
-static uint64_t mixture_terms(const dwvw_walk *walk)
+/* The mixture terms of the step just sampled (see dwvb_tally): `per_component` (the channels
+ * squared) for each component of weight > 0, of which a walk with a single one (the classical
+ * technique at every step) has 1, plus `patches`, the lit patches weighed per step. */
+static uint64_t mixture_terms(const dwvw_walk *walk, uint64_t per_component, uint64_t patches)
 {
-    uint64_t active = 0;
-    for (int k = 0; k < walk->component_count; ++k) active += walk->component_q[k] > 0.0;
-    uint64_t channels = (uint64_t)walk->medium->channels;
-    uint64_t patches = walk->guide->q_incident > 0.0 && walk->guide->patch_count > 1 ? (uint64_t)walk->guide->patch_count : 0u;
-    return active * channels * channels + patches;
+    uint64_t active = 1;
+    if (walk->single_component < 0) {
+        active = 0;
+        for (int k = 0; k < walk->component_count; ++k) active += walk->component_q[k] > 0.0;
+    }
+    return active * per_component + patches;
 }
 
 /* Runs one walk from entry point x (on triangle entry_prim of mesh `mesh`) along unit `direction`
@@ -23,7 +26,7 @@ static uint64_t mixture_terms(const dwvw_walk *walk)
  * length t < that radius stays in the ball: the walk scatters at its end without a ray, exactly as
  * after a ray that met nothing (the same walk and image, bit for bit). Walks meet only their own
  * mesh, so this holds for open meshes too. The first step (the probe, which the backward
- * technique needs in full) is always a ray. */
+ * technique needs in full) is always a ray (its origin is on the surface: no ball there). */
 static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvb_material *material, uint32_t entry_prim, dwvw_vec3 x, dwvw_vec3 direction, dwvw_vec3 entry_normal, uint64_t key,
                     const dwvk_sampler *sampler, uint32_t walk_pair, dwvw_walk *walk, dwvg_hit *exit, dwvb_tally *tally)
 {
@@ -36,6 +39,13 @@ static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvb_materia
     int needs_closest = shader->needs_closest[mesh];
     dwvb_ball_mode ball_mode = shader->scene->ball_mode;
     int first = 1;
+    /* The first step's ray goes on past the sampled distance only where its answer is used: the
+     * backward technique's opposite interface, and on an open mesh the warning below (a closed
+     * one always has a far side: dwvg_mesh_closed). Elsewhere it stops there as every later step's
+     * does, which changes no walk (a hit beyond the step is not an exit) and is shorter to trace. */
+    int full_probe = walk->guide->q_backward > 0.0 || !world->closed[mesh];
+    uint64_t terms_per_component = (uint64_t)walk->medium->channels * (uint64_t)walk->medium->channels;
+    uint64_t patches = walk->guide->q_incident > 0.0 && walk->guide->patch_count > 1 ? (uint64_t)walk->guide->patch_count : 0u;
     while (walk->status == DWVW_RUNNING) {
         double clearance = 0.0;
         if (needs_closest) {
@@ -45,32 +55,38 @@ static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvb_materia
                 dwvw_walk_set_closest(walk, dwvg_geometric_normal(m, closest.prim));
         }
         double distance = dwvw_walk_sample(walk);
-        tally->mixture_terms += mixture_terms(walk);
+        tally->mixture_terms += mixture_terms(walk, terms_per_component, patches);
         int ray_free = 0;
-        if (!first && ball_mode != DWVB_BALL_OFF && (needs_closest || grid->lower)) {
-            if (!needs_closest) clearance = dwvg_clearance_at(grid, walk->position);
-            ray_free = distance < dwvg_clear_radius(world, walk->position, clearance);
+        /* The ball's radius is below the clearance, which the grid bounds by its largest cell
+         * (planes have no such bound: +inf): a step at least that long needs neither the lookup
+         * nor the radius. */
+        if (!first && ball_mode != DWVB_BALL_OFF && (needs_closest || distance < grid->largest)) {
+            if (!needs_closest) clearance = dwvg_clearance_above(grid, walk->position, distance);
+            ray_free = distance < clearance && distance < dwvg_clear_radius(world, walk->position, clearance);
         }
         dwvg_hit hit;
         int found = 0;
         tally->ray_free_steps += (uint64_t)ray_free;
         if (!ray_free || ball_mode == DWVB_BALL_CHECKED) {
             /* The first step is the probe: its full distance to the surface locates an opposite
-             * interface. A ray leaving a flat triangle inward cannot meet that triangle again, so a
-             * hit on the entry triangle is rounding and the ray goes on past it. */
-            double tnear = 0.0, tfar = first ? INFINITY : distance;
-            for (;;) {
+             * interface (full_probe). A ray leaving a flat triangle inward cannot meet that
+             * triangle again, so a hit on the entry triangle is rounding and the ray goes on past
+             * it (dwvg_intersect_mesh_leaving). */
+            if (first) {
+                uint32_t rays = 0;
+                found = dwvg_intersect_mesh_leaving(world, mesh, walk->position, walk->direction, entry_prim,
+                                                    full_probe ? INFINITY : distance, &hit, &rays);
+                tally->rays += rays;
+            } else {
                 ++tally->rays;
-                found = dwvg_intersect_mesh(world, mesh, walk->position, walk->direction, tnear, tfar, &hit);
-                if (!(found && first && hit.prim == entry_prim)) break;
-                tnear = nextafterf((float)hit.t, INFINITY);
+                found = dwvg_intersect_mesh(world, mesh, walk->position, walk->direction, 0.0, distance, &hit);
             }
             /* Checked mode: a ray-free step whose ray meets the surface would be a wrong walk. */
             if (ray_free && found) ++tally->ray_free_misses;
         }
         /* A closed mesh surrounds every point inside: a probe that meets nothing means the
-         * mesh is open there (or the ray slipped through), and the walk may wander off. */
-        if (first && !found) ++tally->warnings;
+         * mesh is open there, and the walk may wander off. */
+        if (first && full_probe && !found) ++tally->warnings;
         first = 0;
         dwvw_vec3 normal = dwvw_v(0.0, 0.0, 0.0);
         if (found) {
@@ -135,6 +151,7 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, 
         ++tally->warnings;
         return;
     }
+    int ng_flipped = 0;
     if (dwvw_dot(view, ng) > 0.0) {
         /* The back of a face. A diffuse surface is two-sided; a subsurface one is seen from inside
          * its medium (an open or inside-out mesh): no walk is defined there. */
@@ -143,6 +160,7 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, 
             return;
         }
         ng = dwvw_scale(ng, -1.0);
+        ng_flipped = 1;
     }
     dwvw_vec3 x = dwvg_point(mesh, hit->prim, hit->u, hit->v);
     dwvw_vec3 n = dwvg_shading_normal(mesh, hit->prim, hit->u, hit->v, ng);
@@ -152,22 +170,24 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, 
     double cutoff = scene->terminator_offsets[hit->mesh];
     dwvl_terminator terminator = {mesh, hit->prim, hit->u, hit->v, cutoff};
     const dwvl_terminator *smooth = mesh->normals && cutoff > 0.0 ? &terminator : NULL;
+    /* The world's top along ng is known for the outward side of the triangle only. */
+    double top = ng_flipped ? INFINITY : dwvg_world_top(&scene->geometry, hit->mesh, hit->prim);
     if (material->principled_v1) {
         /* The Lambertian lobe and the retro-reflection lobe from the same light samples. */
         retro_lobe lobe = {n, dwvw_scale(view, -1.0), -dwvw_dot(n, view), material->roughness};
         double direct[3], retro[3];
-        dwvl_direct_lobe(&shader->env, x, n, ng, smooth, sampler, pair + DWVB_SHADE_PAIRS, retro_factor, &lobe, direct, retro);
+        dwvl_direct_lobe(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, retro_factor, &lobe, direct, retro);
         for (int c = 0; c < 3; ++c) rgb[c] += material->diffuse_albedo[c] * direct[c] + material->retro_albedo[c] * retro[c];
     } else if (material->principled_diffuse) {
         retro_lobe lobe = {n, dwvw_scale(view, -1.0), -dwvw_dot(n, view), material->roughness};
         double diffuse[3];
-        dwvl_direct_lobe(&shader->env, x, n, ng, smooth, sampler, pair + DWVB_SHADE_PAIRS, principled_diffuse_factor, &lobe,
+        dwvl_direct_lobe(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, principled_diffuse_factor, &lobe,
                          NULL, diffuse);
         for (int c = 0; c < 3; ++c) rgb[c] += material->diffuse_albedo[c] * diffuse[c];
     } else if (material->diffuse_albedo[0] > 0.0 || material->diffuse_albedo[1] > 0.0 ||
                material->diffuse_albedo[2] > 0.0) {
         double direct[3];
-        dwvl_direct(&shader->env, x, n, ng, smooth, sampler, pair + DWVB_SHADE_PAIRS, direct);
+        dwvl_direct(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, direct);
         for (int c = 0; c < 3; ++c) rgb[c] += material->diffuse_albedo[c] * direct[c];
     }
     if (!material->subsurface) return;
@@ -190,12 +210,13 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, 
     /* Cycles shades the exit as a surface point of its triangle: the same terminator offset. */
     dwvl_terminator exit_terminator = {mesh, exit.prim, exit.u, exit.v, cutoff};
     const dwvl_terminator *exit_smooth = mesh->normals && cutoff > 0.0 ? &exit_terminator : NULL;
+    double exit_top = dwvg_world_top(&scene->geometry, hit->mesh, exit.prim);
     double direct[3];
     if (material->principled_v1)
-        dwvl_direct_lobe(&shader->env, walk.position, exit_n, exit_ng, exit_smooth, sampler, pair + DWVB_SHADE_PAIRS + light_pairs,
+        dwvl_direct_lobe(&shader->env, walk.position, exit_n, exit_ng, exit_smooth, exit_top, sampler, pair + DWVB_SHADE_PAIRS + light_pairs,
                          exit_factor, &exit_n, NULL, direct);
     else
-        dwvl_direct(&shader->env, walk.position, exit_n, exit_ng, exit_smooth, sampler, pair + DWVB_SHADE_PAIRS + light_pairs, direct);
+        dwvl_direct(&shader->env, walk.position, exit_n, exit_ng, exit_smooth, exit_top, sampler, pair + DWVB_SHADE_PAIRS + light_pairs, direct);
     int grey = material->medium.channels == 1;
     for (int c = 0; c < 3; ++c) rgb[c] += walk.weight[grey ? 0 : c] * material->walk_scale[c] * direct[c];
 }

@@ -29,9 +29,10 @@ typedef struct dwvb_tally {
     /* Work the walks' mixtures did: per step, the components with weight > 0 times the channels
      * squared (the exponentials of the spectral MIS weight), plus the lit patches weighed. */
     uint64_t mixture_terms;
-    /* Embree rays the walks cast, closest-point queries they made, their steps taken without a
-     * ray (inside a ball clear of the mesh), and (checked ball mode only) those of them whose ray
-     * would have met the surface. */
+    /* Rays the walks cast (Embree's; a polytope's, dwvg_polytope, are its planes' exits and count
+     * too), closest-point queries they made, their steps taken without a ray (inside a ball
+     * clear of the mesh), and (checked ball mode only) those of them whose ray would have met
+     * the surface. */
     uint64_t rays, point_queries, ray_free_steps, ray_free_misses;
     double truncated[3];
 } dwvb_tally;

@@ -189,9 +189,67 @@ static void exact_near(dwvg_clearance *grid, const dwvg_mesh *mesh, uint32_t t, 
             }
 }
 
+/* The planes of the mesh's triangles into grid->planes, if there are at most
+ * DWVG_CLEARANCE_MAX_PLANES of them and every triangle has one (finite corners, area > 0): 1, else
+ * 0 with none kept. A plane is kept once; a triangle whose computed plane equals a kept one, or
+ * its reverse, bit for bit, lies in that very plane. */
+static int find_planes(dwvg_clearance *grid, const dwvg_mesh *mesh)
+{
+    uint32_t count = 0;
+    double area[DWVG_CLEARANCE_MAX_PLANES];
+    for (uint32_t t = 0; t < mesh->triangle_count; ++t) {
+        double lo[3], hi[3];
+        if (!finite_triangle(mesh, t, lo, hi)) return 0;
+        const uint32_t *corner = mesh->indices + 3u * (size_t)t;
+        dwvw_vec3 p[3];
+        for (int k = 0; k < 3; ++k) {
+            const float *q = mesh->positions + 3u * (size_t)corner[k];
+            p[k] = dwvw_v(q[0], q[1], q[2]);
+        }
+        dwvw_vec3 e1 = dwvw_sub(p[1], p[0]), e2 = dwvw_sub(p[2], p[0]);
+        dwvw_vec3 n = dwvw_v(e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x);
+        double length = dwvw_length(n);
+        if (!(length > 0.0 && isfinite(length))) return 0;
+        n = dwvw_scale(n, 1.0 / length);
+        double d = dwvw_dot(n, p[0]);
+        uint32_t known = count;
+        for (uint32_t i = 0; i < count && known == count; ++i) {
+            const double *q = grid->planes[i];
+            if ((q[0] == n.x && q[1] == n.y && q[2] == n.z && q[3] == d) ||
+                (q[0] == -n.x && q[1] == -n.y && q[2] == -n.z && q[3] == -d))
+                known = i;
+        }
+        if (known == count) {
+            if (count == DWVG_CLEARANCE_MAX_PLANES) return 0;
+            double *q = grid->planes[count];
+            q[0] = n.x;
+            q[1] = n.y;
+            q[2] = n.z;
+            q[3] = d;
+            area[count++] = 0.0;
+        }
+        area[known] += 0.5 * length;
+    }
+    if (count == 0) return 0;
+    /* Largest area first (insertion sort, stable): a walk is most often nearest those. */
+    for (uint32_t i = 1; i < count; ++i)
+        for (uint32_t j = i; j > 0 && area[j] > area[j - 1]; --j) {
+            double a = area[j], q[4];
+            area[j] = area[j - 1];
+            area[j - 1] = a;
+            memcpy(q, grid->planes[j], sizeof q);
+            memcpy(grid->planes[j], grid->planes[j - 1], sizeof q);
+            memcpy(grid->planes[j - 1], q, sizeof q);
+        }
+    grid->plane_count = count;
+    grid->largest = INFINITY;
+    return 1;
+}
+
 int dwvg_clearance_build(dwvg_clearance *grid, const dwvg_mesh *mesh, double cell_size, double largest_cell)
 {
     memset(grid, 0, sizeof *grid);
+    if (find_planes(grid, mesh)) return 0;
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (uint32_t t = 0; t < mesh->triangle_count; ++t) {
         double tlo[3], thi[3];
@@ -212,8 +270,10 @@ int dwvg_clearance_build(dwvg_clearance *grid, const dwvg_mesh *mesh, double cel
     }
     if (!(h <= largest_cell)) return 1;
     grid->cell = h;
+    grid->inverse_cell = 1.0 / h;
     for (int a = 0; a < 3; ++a) {
         grid->n[a] = (uint32_t)(floor((hi[a] - lo[a]) / h) + 3.0);
+        grid->cells[a] = grid->n[a];
         grid->origin[a] = lo[a] - h;
     }
     size_t count = (size_t)grid->n[0] * grid->n[1] * grid->n[2];
@@ -275,6 +335,8 @@ int dwvg_clearance_build(dwvg_clearance *grid, const dwvg_mesh *mesh, double cel
     double slack = CELL_SLACK * h;
     for (size_t i = 0; i < count; ++i)
         grid->lower[i] = fmaxf(float_below(sqrt(squared[i]) * h - half_diagonal), float_below((double)grid->lower[i] - slack));
+    grid->largest = 0.0;
+    for (size_t i = 0; i < count; ++i) grid->largest = fmax(grid->largest, (double)grid->lower[i]);
     free(squared);
     free(f);
     free(z);

@@ -102,6 +102,109 @@ static int failed(dwvg_world *world, char *message, size_t size, const char *wha
     return -1;
 }
 
+static int edge_order(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+int dwvg_mesh_closed(const dwvg_mesh *mesh)
+{
+    size_t edges = 3u * (size_t)mesh->triangle_count;
+    if (edges == 0) return 0;
+    uint64_t *directed = malloc(edges * sizeof *directed);
+    if (!directed) return -1;
+    for (uint32_t t = 0; t < mesh->triangle_count; ++t) {
+        const uint32_t *i = mesh->indices + 3u * (size_t)t;
+        for (int k = 0; k < 3; ++k) directed[3u * (size_t)t + (size_t)k] = (uint64_t)i[k] << 32 | i[(k + 1) % 3];
+    }
+    qsort(directed, edges, sizeof *directed, edge_order);
+    /* Closed: no directed edge twice, and each one's reverse present (then, with the first, its
+     * undirected edge has exactly two triangles, one each way). */
+    int closed = 1;
+    for (size_t e = 0; e < edges && closed; ++e) {
+        uint64_t edge = directed[e], reverse = edge << 32 | edge >> 32;
+        closed = (e + 1 == edges || directed[e + 1] != edge) && (edge >> 32) != (edge & 0xffffffffu) &&
+                 bsearch(&reverse, directed, edges, sizeof *directed, edge_order) != NULL;
+    }
+    free(directed);
+    for (uint32_t t = 0; t < mesh->triangle_count && closed; ++t) closed = dwvg_triangle_area(mesh, t) > 0.0;
+    return closed;
+}
+
+/* *p for a closed mesh without vertex normals whose triangles lie in at most
+ * DWVG_POLYTOPE_PLANES planes (equal geometric normals and offsets, bit for bit), with every
+ * vertex on or below each plane (to 2^-40 of the largest coordinate): convex. Else p->plane_count
+ * stays 0. */
+static void find_polytope(const dwvg_world *world, const dwvg_mesh *mesh, int closed, dwvg_polytope *p)
+{
+    memset(p, 0, sizeof *p);
+    if (!closed || mesh->normals || mesh->triangle_count > DWVG_POLYTOPE_TRIANGLES) return;
+    uint32_t plane_of[DWVG_POLYTOPE_TRIANGLES], count = 0;
+    for (uint32_t t = 0; t < mesh->triangle_count; ++t) {
+        dwvw_vec3 n = dwvg_geometric_normal(mesh, t), a = vertex(mesh, mesh->indices[3u * (size_t)t]);
+        if (n.x == 0.0 && n.y == 0.0 && n.z == 0.0) return;
+        double offset = dwvw_dot(n, a);
+        uint32_t i = 0;
+        while (i < count && !(p->planes[i][0] == n.x && p->planes[i][1] == n.y && p->planes[i][2] == n.z &&
+                              p->planes[i][3] == offset))
+            ++i;
+        if (i == count) {
+            if (count == DWVG_POLYTOPE_PLANES) return;
+            p->planes[count][0] = n.x;
+            p->planes[count][1] = n.y;
+            p->planes[count][2] = n.z;
+            p->planes[count][3] = offset;
+            ++count;
+        }
+        plane_of[t] = i;
+    }
+    double tolerance = 0x1p-23 * world->epsilon;
+    for (uint32_t i = 0; i < count; ++i)
+        for (uint32_t v = 0; v < mesh->vertex_count; ++v) {
+            dwvw_vec3 n = dwvw_v(p->planes[i][0], p->planes[i][1], p->planes[i][2]);
+            if (!(dwvw_dot(n, vertex(mesh, v)) - p->planes[i][3] <= tolerance)) return;
+        }
+    uint32_t k = 0;
+    for (uint32_t i = 0; i < count; ++i) {
+        p->first[i] = k;
+        for (uint32_t t = 0; t < mesh->triangle_count; ++t)
+            if (plane_of[t] == i) p->triangles[k++] = t;
+    }
+    p->first[count] = k;
+    p->plane_count = count;
+}
+
+/* world->tops (embree.h), where the world is small enough: 0, or -1 out of memory. */
+static int make_tops(dwvg_world *world)
+{
+    double vertices = 0.0, triangles = 0.0;
+    for (uint32_t m = 0; m < world->mesh_count; ++m) {
+        vertices += world->meshes[m].vertex_count;
+        triangles += world->meshes[m].triangle_count;
+    }
+    if (vertices * triangles > DWVG_TOPS_WORK) return 0;
+    world->tops = calloc(world->mesh_count, sizeof *world->tops);
+    if (!world->tops) return -1;
+    for (uint32_t m = 0; m < world->mesh_count; ++m) {
+        const dwvg_mesh *mesh = &world->meshes[m];
+        world->tops[m] = malloc((mesh->triangle_count ? mesh->triangle_count : 1u) * sizeof **world->tops);
+        if (!world->tops[m]) return -1;
+        for (uint32_t t = 0; t < mesh->triangle_count; ++t) {
+            dwvw_vec3 n = dwvg_geometric_normal(mesh, t);
+            double top = -INFINITY;
+            for (uint32_t o = 0; o < world->mesh_count && top < INFINITY; ++o)
+                for (uint32_t v = 0; v < world->meshes[o].vertex_count; ++v) {
+                    /* A non-finite vertex (Embree skips its triangles) counts as unbounded. */
+                    double h = dwvw_dot(n, vertex(&world->meshes[o], v));
+                    top = h > top ? h : isnan(h) ? INFINITY : top;
+                }
+            world->tops[m][t] = n.x == 0.0 && n.y == 0.0 && n.z == 0.0 ? INFINITY : top;
+        }
+    }
+    return 0;
+}
+
 int dwvg_world_build(dwvg_world *world, const dwvg_mesh *meshes, uint32_t count, char *message, size_t size)
 {
     memset(world, 0, sizeof *world);
@@ -125,11 +228,15 @@ int dwvg_world_build(dwvg_world *world, const dwvg_mesh *meshes, uint32_t count,
         return -1;
     }
     world->device = device;
+    world->leaving_filter = rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED) != 0;
     rtcSetDeviceErrorFunction(device, embree_error, world);
     rtcSetDeviceMemoryMonitorFunction(device, embree_memory, world);
     world->mesh_scenes = calloc(count ? count : 1u, sizeof *world->mesh_scenes);
     world->clearance = calloc(count ? count : 1u, sizeof *world->clearance);
-    if (!world->mesh_scenes || !world->clearance) return failed(world, message, size, "listing the meshes");
+    world->closed = calloc(count ? count : 1u, sizeof *world->closed);
+    world->polytopes = calloc(count ? count : 1u, sizeof *world->polytopes);
+    if (!world->mesh_scenes || !world->clearance || !world->closed || !world->polytopes)
+        return failed(world, message, size, "listing the meshes");
     world->mesh_count = count;
     RTCScene top = rtcNewScene(device);
     if (!top) return failed(world, message, size, "creating the top-level scene");
@@ -142,7 +249,10 @@ int dwvg_world_build(dwvg_world *world, const dwvg_mesh *meshes, uint32_t count,
         RTCScene scene = rtcNewScene(device);
         if (!scene) return failed(world, message, size, "creating a mesh scene");
         world->mesh_scenes[m] = scene;
-        rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+        /* The context filter lets a walk's probe pass over the triangle it starts on in one ray
+         * (dwvg_intersect_mesh_leaving); other rays set none, and Embree then calls nothing. */
+        rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST |
+                                    (world->leaving_filter ? RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION : 0));
         RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
         if (!geometry) return failed(world, message, size, "creating a triangle geometry");
         rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, mesh->positions, 0,
@@ -166,6 +276,12 @@ int dwvg_world_build(dwvg_world *world, const dwvg_mesh *meshes, uint32_t count,
     }
     rtcCommitScene(top);
     if (atomic_load(&world->embree_error)) return failed(world, message, size, "building the top-level BVH");
+    if (make_tops(world) < 0) return failed(world, message, size, "finding the triangles' tops");
+    for (uint32_t m = 0; m < count; ++m)
+    {
+        if ((world->closed[m] = dwvg_mesh_closed(&meshes[m])) < 0) return failed(world, message, size, "finding closed meshes");
+        find_polytope(world, &meshes[m], world->closed[m], &world->polytopes[m]);
+    }
     return 0;
 }
 
@@ -179,6 +295,14 @@ void dwvg_world_free(dwvg_world *world)
         for (uint32_t m = 0; m < world->mesh_count; ++m) dwvg_clearance_free(&world->clearance[m]);
     free(world->clearance);
     world->clearance = NULL;
+    if (world->tops)
+        for (uint32_t m = 0; m < world->mesh_count; ++m) free(world->tops[m]);
+    free(world->tops);
+    world->tops = NULL;
+    free(world->closed);
+    world->closed = NULL;
+    free(world->polytopes);
+    world->polytopes = NULL;
     if (world->top) rtcReleaseScene(world->top);
     if (world->device) rtcReleaseDevice(world->device);
     world->mesh_scenes = NULL;
@@ -208,7 +332,9 @@ static int make_ray(struct RTCRayHit *rh, dwvw_vec3 o, dwvw_vec3 d, double tnear
            in_embree_range(rh->ray.dir_x, rh->ray.dir_y, rh->ray.dir_z) && !isnan(tnear) && !isnan(tfar);
 }
 
-static int trace(RTCScene scene, int instanced, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar, dwvg_hit *hit)
+/* Inline: it is every walk ray's way to Embree, and GCC left it out of line once the polytopes
+ * grew this file (some 170 instructions more per sphere walk). */
+static inline int trace(RTCScene scene, int instanced, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar, dwvg_hit *hit)
 {
     struct RTCIntersectContext context;
     rtcInitIntersectContext(&context);
@@ -224,17 +350,180 @@ static int trace(RTCScene scene, int instanced, dwvw_vec3 o, dwvw_vec3 d, double
     return 1;
 }
 
+static void polytope_hit(const dwvg_world *world, uint32_t mesh, uint32_t plane, dwvw_vec3 o, dwvw_vec3 d, double t,
+                         dwvg_hit *hit);
+static int polytope_first(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar,
+                          dwvg_hit *hit);
+
+/* A world of one mesh traces that mesh's scene: the top-level scene would only add an instance
+ * (the identity transform, which leaves a ray's floats as they are) around the same BVH. */
 int dwvg_intersect(const dwvg_world *world, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar, dwvg_hit *hit)
 {
     if (world->mesh_count == 0) return 0;
+    if (world->mesh_count == 1 && world->polytopes[0].plane_count) return polytope_first(world, 0u, o, d, tnear, tfar, hit);
+    if (world->mesh_count == 1) return trace(world->mesh_scenes[0], 0, o, d, tnear, tfar, hit);
     return trace(world->top, 1, o, d, tnear, tfar, hit);
+}
+
+static int polytope_intersect(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, double tnear,
+                              double tfar, dwvg_hit *hit)
+{
+    const dwvg_polytope *p = &world->polytopes[mesh];
+    double best = INFINITY;
+    uint32_t plane = DWVG_POLYTOPE_PLANES;
+    for (uint32_t i = 0; i < p->plane_count; ++i) {
+        const double *q = p->planes[i];
+        double rate = q[0] * d.x + q[1] * d.y + q[2] * d.z;
+        if (!(rate > 0.0)) continue;
+        double t = (q[3] - (q[0] * o.x + q[1] * o.y + q[2] * o.z)) / rate;
+        if (t < best) {
+            best = t;
+            plane = i;
+        }
+    }
+    if (plane == DWVG_POLYTOPE_PLANES) return 0; /* no plane ahead (d not finite) */
+    double t = best > 0.0 ? best : 0.0;
+    if (!(t >= tnear && t <= tfar)) return 0;
+    polytope_hit(world, mesh, plane, o, d, t, hit);
+    return 1;
+}
+
+/* The hit at distance t along d from o on plane `plane` of polytope `mesh`: the triangle of that
+ * plane holding the point, the one whose least barycentric is largest. */
+static void polytope_hit(const dwvg_world *world, uint32_t mesh, uint32_t plane, dwvw_vec3 o, dwvw_vec3 d, double t,
+                         dwvg_hit *hit)
+{
+    const dwvg_polytope *p = &world->polytopes[mesh];
+    const dwvg_mesh *m = &world->meshes[mesh];
+    dwvw_vec3 x = dwvw_madd(o, d, t);
+    double chosen = -INFINITY;
+    for (uint32_t k = p->first[plane]; k < p->first[plane + 1]; ++k) {
+        uint32_t prim = p->triangles[k];
+        dwvw_vec3 a, b, c;
+        corners(m, prim, &a, &b, &c);
+        dwvw_vec3 e1 = dwvw_sub(b, a), e2 = dwvw_sub(c, a), w = dwvw_sub(x, a);
+        double d11 = dwvw_dot(e1, e1), d12 = dwvw_dot(e1, e2), d22 = dwvw_dot(e2, e2);
+        double w1 = dwvw_dot(w, e1), w2 = dwvw_dot(w, e2), det = d11 * d22 - d12 * d12;
+        double u = (d22 * w1 - d12 * w2) / det, v = (d11 * w2 - d12 * w1) / det;
+        double least = fmin(1.0 - u - v, fmin(u, v));
+        if (least > chosen) {
+            chosen = least;
+            hit->prim = prim;
+            hit->u = u;
+            hit->v = v;
+        }
+    }
+    hit->mesh = mesh;
+    hit->t = t;
+}
+
+/* A ray from anywhere against a polytope: the first crossing of its surface within [tnear, tfar].
+ * The line is inside between t_in, the last of the planes it enters (n.d < 0), and t_out, the
+ * first it leaves (n.d > 0); it misses where t_in > t_out or it runs outside a plane it is
+ * parallel to. The crossing is t_in where that is at tnear or beyond, else t_out (from inside). */
+static int polytope_first(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar,
+                          dwvg_hit *hit)
+{
+    const dwvg_polytope *p = &world->polytopes[mesh];
+    double t_in = -INFINITY, t_out = INFINITY;
+    uint32_t in = DWVG_POLYTOPE_PLANES, out = DWVG_POLYTOPE_PLANES;
+    for (uint32_t i = 0; i < p->plane_count; ++i) {
+        const double *q = p->planes[i];
+        double rate = q[0] * d.x + q[1] * d.y + q[2] * d.z, gap = q[3] - (q[0] * o.x + q[1] * o.y + q[2] * o.z);
+        if (rate > 0.0) {
+            double t = gap / rate;
+            if (t < t_out) {
+                t_out = t;
+                out = i;
+            }
+        } else if (rate < 0.0) {
+            double t = gap / rate;
+            if (t > t_in) {
+                t_in = t;
+                in = i;
+            }
+        } else if (!(gap >= 0.0)) {
+            return 0; /* parallel outside, or not finite */
+        }
+    }
+    if (!(t_in <= t_out)) return 0;
+    uint32_t plane = t_in >= tnear ? in : out;
+    double t = t_in >= tnear ? t_in : t_out;
+    if (plane == DWVG_POLYTOPE_PLANES || !(t >= tnear && t <= tfar)) return 0;
+    polytope_hit(world, mesh, plane, o, d, t, hit);
+    return 1;
 }
 
 int dwvg_intersect_mesh(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, double tnear,
                         double tfar, dwvg_hit *hit)
 {
+    if (world->polytopes[mesh].plane_count) return polytope_intersect(world, mesh, o, d, tnear, tfar, hit);
     if (!trace(world->mesh_scenes[mesh], 0, o, d, tnear, tfar, hit)) return 0;
     hit->mesh = mesh;
+    return 1;
+}
+
+/* An intersect context that rejects the hits on one triangle and keeps where it met them. Embree
+ * hands the filter the context's address, so the context comes first. */
+typedef struct leaving_context {
+    struct RTCIntersectContext context;
+    uint32_t prim;
+    float t; /* the distance Embree found on triangle prim; +inf if none */
+} leaving_context;
+
+static void leaving_filter(const struct RTCFilterFunctionNArguments *args)
+{
+    /* Ray and hit 0 of Embree's structure-of-arrays layout (rtcore_ray.h's RTCHitN_primID and
+     * RTCRayN_tfar, C++ only): rtcIntersect1 hands one (N = 1). */
+    leaving_context *leaving = (leaving_context *)args->context;
+    unsigned int n = args->N;
+    if (((const unsigned int *)args->hit)[5u * n] != leaving->prim) return;
+    leaving->t = ((const float *)args->ray)[8u * n];
+    args->valid[0] = 0;
+}
+
+/* The loop that dwvg_intersect_mesh_leaving stands for: one ray after another, each from just
+ * past the last hit on `prim`. */
+static int leaving_by_rays(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, uint32_t prim, double tfar,
+                           dwvg_hit *hit, uint32_t *rays)
+{
+    double tnear = 0.0;
+    for (;;) {
+        ++*rays;
+        int found = dwvg_intersect_mesh(world, mesh, o, d, tnear, tfar, hit);
+        if (!(found && hit->prim == prim)) return found;
+        tnear = nextafterf((float)hit->t, INFINITY);
+    }
+}
+
+int dwvg_intersect_mesh_leaving(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, uint32_t prim,
+                                double tfar, dwvg_hit *hit, uint32_t *rays)
+{
+    /* A polytope's exit is never the plane o starts on, which the ray leaves downward. */
+    if (world->polytopes[mesh].plane_count) {
+        ++*rays;
+        return polytope_intersect(world, mesh, o, d, 0.0, tfar, hit);
+    }
+    if (!world->leaving_filter) return leaving_by_rays(world, mesh, o, d, prim, tfar, hit, rays);
+    leaving_context leaving;
+    rtcInitIntersectContext(&leaving.context);
+    leaving.context.filter = leaving_filter;
+    leaving.prim = prim;
+    leaving.t = INFINITY;
+    struct RTCRayHit rh;
+    ++*rays;
+    if (!make_ray(&rh, o, d, 0.0, tfar)) return 0;
+    rtcIntersect1(world->mesh_scenes[mesh], &leaving.context, &rh);
+    int found = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+    /* Another triangle met at the very distance of prim: which of the two the first of the rays
+     * would have returned is up to Embree's traversal order, so they are cast. */
+    if (found && rh.ray.tfar == leaving.t) return leaving_by_rays(world, mesh, o, d, prim, tfar, hit, rays);
+    if (!found) return 0;
+    hit->mesh = mesh;
+    hit->prim = rh.hit.primID;
+    hit->t = rh.ray.tfar;
+    hit->u = rh.hit.u;
+    hit->v = rh.hit.v;
     return 1;
 }
 
@@ -245,7 +534,7 @@ int dwvg_occluded(const dwvg_world *world, dwvw_vec3 o, dwvw_vec3 d, double tnea
     rtcInitIntersectContext(&context);
     struct RTCRayHit rh;
     if (!make_ray(&rh, o, d, tnear, tfar)) return 0;
-    rtcOccluded1(world->top, &context, &rh.ray);
+    rtcOccluded1(world->mesh_count == 1 ? world->mesh_scenes[0] : world->top, &context, &rh.ray);
     return rh.ray.tfar < 0.0f; /* Embree marks an occluded ray with tfar = -inf */
 }
 
@@ -311,12 +600,4 @@ int dwvg_closest_mesh(const dwvg_world *world, uint32_t mesh, dwvw_vec3 p, dwvg_
 int dwvg_world_build_clearance(dwvg_world *world, uint32_t mesh, double cell_size, double largest_cell)
 {
     return dwvg_clearance_build(&world->clearance[mesh], &world->meshes[mesh], cell_size, largest_cell) < 0 ? -1 : 0;
-}
-
-double dwvg_clear_radius(const dwvg_world *world, dwvw_vec3 center, double clearance)
-{
-    double largest = fmax(fabs(center.x), fmax(fabs(center.y), fabs(center.z))) + clearance;
-    double margin = world->epsilon + 0x1p-17 * largest;
-    double radius = clearance - margin;
-    return radius > 0.0 && radius < INFINITY ? radius : 0.0;
 }

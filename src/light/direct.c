@@ -11,7 +11,20 @@ typedef struct shadow_origins {
     const dwvl_terminator *terminator; /* NULL: a flat-shaded point */
     dwvw_vec3 n, ng, flat, lift;
     int have_lift;
+    double clear; /* ng.origin above this, rising along ng: the ray meets nothing (clear_of) */
 } shadow_origins;
+
+/* Whether a shadow ray from `origin` along unit d is known to meet nothing: it starts above the
+ * world's highest point along ng (the `top` of dwvl_direct) and rises. The margin above the top is
+ * 2^-19 of (the world's largest coordinate + the origin's), a sixteenth of the float ulps of
+ * that sum: Embree traces the ray rounded to float (the origin within half an ulp, the direction
+ * within 2^-24, which lowers it by at most 2^-23 of the world's diameter before it is past the
+ * world) with a watertight test that errs by a few ulps. The flat origin is 2^-17 of the largest
+ * coordinate above its plane (the epsilon), which is the top of a convex world: it clears. */
+static int clear_of(const shadow_origins *o, dwvw_vec3 origin, dwvw_vec3 d)
+{
+    return dwvw_dot(d, o->ng) > 0.0 && dwvw_dot(origin, o->ng) > o->clear;
+}
 
 /* The share of the lift a shadow ray along unit `light` takes. */
 static double lift_amount(const shadow_origins *o, dwvw_vec3 light)
@@ -45,13 +58,21 @@ static int shadow_ray_allowed(const shadow_origins *o, dwvw_vec3 light)
 }
 
 void dwvl_direct_lobe(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng,
-                      const dwvl_terminator *terminator, const dwvk_sampler *sampler, uint32_t pair,
+                      const dwvl_terminator *terminator, double top, const dwvk_sampler *sampler, uint32_t pair,
                       dwvl_lobe_factor factor, const void *context, double lambert[3], double lobe[3])
 {
     double plain[3] = {0.0, 0.0, 0.0}, weighted[3] = {0.0, 0.0, 0.0};
     double eps = env->geometry ? env->geometry->epsilon : 0.0;
-    shadow_origins origins = {terminator, n, ng, dwvw_madd(x, ng, eps), dwvw_v(0.0, 0.0, 0.0), 0};
+    shadow_origins origins = {terminator, n, ng, dwvw_madd(x, ng, eps), dwvw_v(0.0, 0.0, 0.0), 0, INFINITY};
+    if (top < INFINITY) {
+        /* eps is 2^-17 of the largest coordinate: the margin is 2^-19 of it and of the origin's. */
+        double coordinate = fmax(fabs(x.x), fmax(fabs(x.y), fabs(x.z))) + eps;
+        origins.clear = top + 0.25 * eps + 0x1p-19 * coordinate;
+    }
     for (uint32_t i = 0; i < env->light_count; ++i) {
+        /* A sun below the shading normal's horizon gives nothing: its pair is not drawn (each
+         * light has its own pair, which nothing else uses). */
+        if (dwvl_light_below(&env->lights[i], n)) continue;
         dwvl_sample s;
         double u[2];
         dwvk_sampler_pair(sampler, pair + i, u);
@@ -73,7 +94,8 @@ void dwvl_direct_lobe(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwv
             }
             /* The segment stops short of the light by the offset, so that an area light lying on
              * a surface does not shadow itself. */
-            if (dwvg_occluded(env->geometry, origin, toward, 0.0, distance - 2.0 * eps)) continue;
+            if (!clear_of(&origins, origin, toward) && dwvg_occluded(env->geometry, origin, toward, 0.0, distance - 2.0 * eps))
+                continue;
         }
         double f = factor ? factor(context, s.direction) : 0.0;
         for (int c = 0; c < 3; ++c) {
@@ -88,9 +110,12 @@ void dwvl_direct_lobe(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwv
         dwvk_sampler_pair(sampler, pair + env->light_count, u);
         double mu = sqrt(u[0]);
         dwvw_vec3 w = dwvw_direction_about(n, mu, 1.0 - mu, 1.0 + mu, u[1]);
-        if (shadow_ray_allowed(&origins, w) &&
-            !(env->geometry &&
-              dwvg_occluded(env->geometry, shadow_origin(&origins, lift_amount(&origins, w)), w, 0.0, INFINITY))) {
+        int blocked = !shadow_ray_allowed(&origins, w);
+        if (!blocked && env->geometry) {
+            dwvw_vec3 origin = shadow_origin(&origins, lift_amount(&origins, w));
+            blocked = !clear_of(&origins, origin, w) && dwvg_occluded(env->geometry, origin, w, 0.0, INFINITY);
+        }
+        if (!blocked) {
             double f = factor ? factor(context, w) : 0.0;
             for (int c = 0; c < 3; ++c) {
                 plain[c] += env->world[c];
@@ -105,7 +130,7 @@ void dwvl_direct_lobe(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwv
 }
 
 void dwvl_direct(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng,
-                 const dwvl_terminator *terminator, const dwvk_sampler *sampler, uint32_t pair, double out[3])
+                 const dwvl_terminator *terminator, double top, const dwvk_sampler *sampler, uint32_t pair, double out[3])
 {
-    dwvl_direct_lobe(env, x, n, ng, terminator, sampler, pair, NULL, NULL, out, NULL);
+    dwvl_direct_lobe(env, x, n, ng, terminator, top, sampler, pair, NULL, NULL, out, NULL);
 }

@@ -26,14 +26,17 @@ static inline uint32_t dwvl_direct_pairs(const dwvl_environment *env)
 
 /* (1/pi) integral of L_in cos over the hemisphere of the shading normal `n` at x, estimated with
  * the uniform pairs of `sampler` starting at pair `pair`; `ng` is the unit geometric normal on
- * the same side (shadow rays leave from x + epsilon ng).
+ * the same side (shadow rays leave from x + epsilon ng). `top`: the largest ng.y over the points
+ * y of the world (dwvg_world_top for the outward normal of x's triangle), +inf if not known; a
+ * shadow ray from above it (by a margin for Embree's rounding) along a direction that rises along
+ * ng is not cast: it cannot meet anything (a convex world's every outward shadow ray).
  * `terminator` (NULL: a flat-shaded point) moves each shadow ray's origin by its share of the
  * smooth surface's lift (terminator.h), as Cycles does for smooth-shaded triangles; a light at a
  * finite distance is then aimed at from the moved origin. With a terminator whose cutoff is
  * above 0, light that n faces but the flat triangle does not (ng.light <= 0) is also tested, from
  * the smooth surface, as Cycles does; without one it is taken as shadowed. */
 void dwvl_direct(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng,
-                 const dwvl_terminator *terminator, const dwvk_sampler *sampler, uint32_t pair, double out[3]);
+                 const dwvl_terminator *terminator, double top, const dwvk_sampler *sampler, uint32_t pair, double out[3]);
 
 /* A BRDF's factor beside the Lambertian 1/pi for light arriving along unit `light` (toward the
  * light): the BRDF is (1/pi) factor(context, light). */
@@ -43,7 +46,7 @@ typedef double (*dwvl_lobe_factor)(const void *context, dwvw_vec3 light);
  * `factor`: lambert gets what dwvl_direct gives (NULL: not wanted), lobe the same integral with
  * (1/pi) factor(light) cos as the BRDF term. */
 void dwvl_direct_lobe(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng,
-                      const dwvl_terminator *terminator, const dwvk_sampler *sampler, uint32_t pair,
+                      const dwvl_terminator *terminator, double top, const dwvk_sampler *sampler, uint32_t pair,
                       dwvl_lobe_factor factor, const void *context, double lambert[3], double lobe[3]);
 
 #endif

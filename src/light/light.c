@@ -22,6 +22,7 @@ void dwvl_light_init(dwvl_light *light, const dwv_light_desc_t *desc)
     light->radius = 0.0;
     light->area = 0.0;
     light->one_minus_cos_half = 0.0;
+    light->chord = 0.0;
     light->position = light->direction = light->axis_x = light->axis_y = dwvw_v(0.0, 0.0, 0.0);
     for (int c = 0; c < 3; ++c) light->emission[c] = desc->color[c] * desc->strength;
     switch (desc->kind) {
@@ -30,6 +31,8 @@ void dwvl_light_init(dwvl_light *light, const dwv_light_desc_t *desc)
         light->direction = dwvw_scale(d, -1.0 / dwvw_length(d));
         double s = sin(0.25 * desc->angle);
         light->one_minus_cos_half = 2.0 * s * s;
+        /* |w - direction|^2 = 2 (1 - cos) for a unit w at angle theta <= angle / 2 from it. */
+        light->chord = sqrt(2.0 * light->one_minus_cos_half);
         break;
     }
     case DWV_LIGHT_POINT:

@@ -22,6 +22,8 @@ typedef struct dwvl_light {
     double emission[3];        /* sun: irradiance S c; point: intensity P c / (4 pi); area: radiance */
     dwvw_vec3 direction;       /* sun: unit, toward the sun; area: unit emission direction (local -z) */
     double one_minus_cos_half; /* sun: 1 - cos(angle / 2), from 2 sin^2(angle / 4) */
+    double chord;              /* sun: sqrt(2 (1 - cos(angle / 2))), the farthest any direction of
+                                  the disc is from `direction` (dwvl_light_below) */
     dwvw_vec3 position;        /* point: centre; area: centre */
     double radius;             /* point */
     dwvw_vec3 axis_x, axis_y;  /* area: full extents in the world (size x the transform's axes) */
@@ -36,6 +38,15 @@ typedef struct dwvl_sample {
 
 /* Converts a validated description. */
 void dwvl_light_init(dwvl_light *light, const dwv_light_desc_t *desc);
+/* Whether every direction the light can be sampled in lies strictly below the plane of unit
+ * normal n (n.direction < 0 for all of them), known without sampling: a sun whose disc lies
+ * below, by a margin of 1e-9 for the rounding of a sampled direction (about 1e-16); 0 for the
+ * other lights. Such a light gives a surface facing n nothing. */
+static inline int dwvl_light_below(const dwvl_light *light, dwvw_vec3 n)
+{
+    return light->kind == DWV_LIGHT_SUN && dwvw_dot(n, light->direction) + light->chord < -1e-9;
+}
+
 /* Samples the light as seen from x with two uniform numbers. */
 void dwvl_light_sample(const dwvl_light *light, dwvw_vec3 x, double u1, double u2, dwvl_sample *sample);
 

@@ -174,8 +174,8 @@ static void test_direct_lobe(void)
     fixed_normal normal = {n};
     double plain[3], lambert[3], lobe[3];
     dwvk_sampler sampler = {.key = 99u, .index = 0u, .stratified = 0};
-    dwvl_direct(&env, x, n, n, NULL, &sampler, 0u, plain);
-    dwvl_direct_lobe(&env, x, n, n, NULL, &sampler, 0u, exit_lobe, &normal, lambert, lobe);
+    dwvl_direct(&env, x, n, n, NULL, INFINITY, &sampler, 0u, plain);
+    dwvl_direct_lobe(&env, x, n, n, NULL, INFINITY, &sampler, 0u, exit_lobe, &normal, lambert, lobe);
     double f = dwvb_principled_exit_factor(0.8);
     for (int c = 0; c < 3; ++c) {
         CHECK(plain[c] > 0.0 && lambert[c] == plain[c], "channel %d: Lambertian part %g equals dwvl_direct's %g", c,

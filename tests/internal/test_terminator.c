@@ -256,8 +256,8 @@ static void test_sphere_terminator(void)
             if (!(cos_n > 0.0)) continue;
             dwvl_terminator terminator = {&mesh, prim, b[1], b[2], CYCLES_GEOMETRY_OFFSET};
             double flat[3], smooth[3];
-            dwvl_direct(&env, x, n, ng, NULL, &sampler, 0u, flat);
-            dwvl_direct(&env, x, n, ng, &terminator, &sampler, 0u, smooth);
+            dwvl_direct(&env, x, n, ng, NULL, INFINITY, &sampler, 0u, flat);
+            dwvl_direct(&env, x, n, ng, &terminator, INFINITY, &sampler, 0u, smooth);
             if (cos_g <= 0.0) {
                 ++below;
                 below_lit_flat += flat[0] > 0.0;
