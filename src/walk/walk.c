@@ -1,6 +1,7 @@
 #include "walk.h"
 
 #include <float.h>
+#include <string.h>
 
 void dwvw_medium_init(dwvw_medium *medium, int channels, const double *sigma_t, const double *albedo, double g)
 {
@@ -87,6 +88,7 @@ void dwvw_walk_begin(dwvw_walk *walk, const dwvw_medium *medium, const dwvw_guid
     walk->guide = guide;
     walk->key = key;
     walk->sampler = NULL;
+    walk->index_reversed = 0u;
     walk->first_pair = 0u;
     walk->stratified_events = 0u;
     walk->max_events = max_events;
@@ -103,13 +105,19 @@ void dwvw_walk_begin(dwvw_walk *walk, const dwvw_medium *medium, const dwvw_guid
     walk->closest_normal = normal;
     walk->step_distance = 0.0;
     walk->component_count = 0;
+    /* Closest aims at a new point, and several patches are weighed anew, at every event; backward
+     * from the event after its probe found the opposite interface (dwvw_walk_complete). Otherwise
+     * the components depend on nothing that moves: build_components gives the same at every event. */
+    walk->components_vary = guide->q_closest > 0.0 || (guide->q_incident > 0.0 && guide->patch_count > 1);
     walk->single_component = -1;
+    walk->frames_made = 0u;
 }
 
 void dwvw_walk_stratify(dwvw_walk *walk, const dwvk_sampler *sampler, uint32_t first_pair, uint32_t events)
 {
     uint32_t room = (UINT32_MAX - first_pair) / DWVW_PAIRS_PER_EVENT; /* events whose pairs fit in 32 bits */
     walk->sampler = sampler;
+    walk->index_reversed = sampler == NULL ? 0u : dwvk_sampler_index_reversed(sampler);
     walk->first_pair = first_pair;
     walk->stratified_events = sampler == NULL ? 0u : events < room ? events : room;
 }
@@ -215,6 +223,23 @@ static int pick(const double *p, int n, double u, double *rest)
     return last;
 }
 
+static int same_bits(dwvw_vec3 a, dwvw_vec3 b)
+{
+    return memcmp(&a, &b, sizeof a) == 0;
+}
+
+/* dwvw_frame_about(axis), made once per walk and axis (kept in the walk's few slots, the oldest
+ * replaced): the frame is a function of the axis's bits, so a kept one is the same bit for bit. */
+static const dwvw_frame *frame_about_axis(dwvw_walk *walk, dwvw_vec3 axis)
+{
+    uint32_t kept = walk->frames_made < DWVW_FRAME_CACHE ? walk->frames_made : DWVW_FRAME_CACHE;
+    for (uint32_t i = 0; i < kept; ++i)
+        if (same_bits(walk->frames[i].n, axis)) return &walk->frames[i];
+    dwvw_frame *slot = &walk->frames[walk->frames_made++ % DWVW_FRAME_CACHE];
+    *slot = dwvw_frame_about(axis);
+    return slot;
+}
+
 double dwvw_walk_sample(dwvw_walk *walk)
 {
     const dwvw_medium *m = walk->medium;
@@ -223,7 +248,7 @@ double dwvw_walk_sample(dwvw_walk *walk)
     const int stratified = walk->events < walk->stratified_events;
     const uint32_t pair = walk->first_pair + DWVW_PAIRS_PER_EVENT * walk->events;
     double flight[2] = {0.0, 0.0};
-    if (stratified) dwvk_sampler_pair(walk->sampler, pair + DWVW_PAIR_FLIGHT, flight);
+    if (stratified) dwvk_sampler_pair_at(walk->sampler, walk->index_reversed, pair + DWVW_PAIR_FLIGHT, flight);
     double *choice = stratified ? &flight[1] : NULL;
 
     /* Channel: proportional to throughput x albedo (Cycles), to throughput where all albedos are 0. */
@@ -240,7 +265,7 @@ double dwvw_walk_sample(dwvw_walk *walk)
         walk->channel_p[0] = 1.0;
     }
 
-    build_components(walk);
+    if (walk->component_count == 0 || walk->components_vary) build_components(walk);
     int chosen = walk->single_component >= 0
                      ? walk->single_component
                      : pick(walk->component_q, walk->component_count,
@@ -251,13 +276,12 @@ double dwvw_walk_sample(dwvw_walk *walk)
     float g = (float)m->g;
     if (walk->events > 0) {
         /* The first step keeps the entry direction: only its distance is sampled. */
-        dwvk_uniform_pair_f u = stratified ? dwvk_sampler_pair_f(walk->sampler, pair + DWVW_PAIR_DIRECTION)
+        dwvk_uniform_pair_f u = stratified ? dwvk_sampler_pair_at_f(walk->sampler, walk->index_reversed, pair + DWVW_PAIR_DIRECTION)
                                            : dwvk_rng_uniform_pair_f(walk->key, dim + DWVW_DIM_DIRECTION);
         if (chosen == 0) {
             walk->direction = dwvw_classical_direction(previous, g, u);
         } else {
-            dwvw_frame frame = dwvw_frame_about(walk->component_axis[chosen]);
-            walk->direction = dwvw_guided_direction(&frame, &m->dwivedi_event, u);
+            walk->direction = dwvw_guided_direction(frame_about_axis(walk, walk->component_axis[chosen]), &m->dwivedi_event, u);
         }
         /* HG at g = 0 is the isotropic 1/(4 pi): skip its square root and division. */
         walk->phase = g == 0.0f ? DWVK_INV_FOUR_PI : dwvk_hg_pdf_f(g, (float)dwvw_cosine(previous, walk->direction));
@@ -287,6 +311,7 @@ dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 h
         for (int c = 1; c < m->channels; ++c) sigma_min = fmin(sigma_min, m->sigma_t[c]);
         if (hit_distance <= fmax(walk->step_distance, 10.0 / sigma_min)) {
             walk->have_opposite = 1;
+            walk->components_vary = 1; /* the backward fraction now follows the depth */
             walk->opposite_depth = -hit_distance * dwvw_dot(walk->direction, walk->entry_normal);
         }
     }
@@ -328,20 +353,37 @@ dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 h
                 if (walk->channel_p[c] > 0.0 && sigma < rate) rate = sigma;
             }
         }
-        /* The channel whose extinction is the rate has exp(0) = 1 exactly (dwvk_exp_fast(0) is 1):
-         * skip the call, one of the `channels` exponentials of a classical event. */
+        /* An extinction equal to the rate has exp(0) = 1 exactly (dwvk_exp_fast(0) is 1): skip the
+         * call, one of the `channels` exponentials of a classical event. Channels with equal
+         * extinctions (grey extinction, coloured albedo: a leaf) have equal arguments: one call
+         * serves them all. Both leave every value as it was, bit for bit. */
         double channel_factor[DWVW_MAX_CHANNELS], denominator = 0.0;
-        for (int c = 0; c < channels; ++c)
-            channel_factor[c] = m->sigma_t[c] == rate ? 1.0 : dwvk_exp_fast((rate - m->sigma_t[c]) * t);
+        for (int c = 0; c < channels; ++c) {
+            double sigma = m->sigma_t[c];
+            channel_factor[c] = sigma == rate                       ? 1.0
+                                : c > 0 && sigma == m->sigma_t[c - 1] ? channel_factor[c - 1]
+                                                                      : dwvk_exp_fast((rate - sigma) * t);
+        }
         if (rate < INFINITY) {
             for (int k = 0; k < components; ++k) {
                 if (!(qp[k] > 0.0)) continue;
                 double stretch = walk->component_stretch[k];
+                double last_sigma = -1.0, last_decay = 0.0; /* the exponential last made (no sigma is < 0) */
                 for (int c = 0; c < channels; ++c) {
                     if (!(walk->channel_p[c] > 0.0)) continue;
                     double sigma = m->sigma_t[c] * stretch;
                     double density = exited ? 1.0 : sigma;
-                    double decay = stretch == 1.0 ? channel_factor[c] : dwvk_exp_fast((rate - sigma) * t);
+                    double decay;
+                    if (stretch == 1.0) {
+                        decay = channel_factor[c];
+                    } else if (sigma == rate) {
+                        decay = 1.0;
+                    } else if (sigma == last_sigma) {
+                        decay = last_decay;
+                    } else {
+                        decay = last_decay = dwvk_exp_fast((rate - sigma) * t);
+                        last_sigma = sigma;
+                    }
                     denominator += qp[k] * walk->channel_p[c] * density * decay;
                 }
             }

@@ -11,7 +11,8 @@
  * 3. The two coordinates of different pairs of one pixel are not the same numbers.
  * 4. Beyond 2^32 samples, and for unstratified samplers, the pairs are rng.h's draws.
  * 5. The loop-free Sobol coordinate equals the definition (dwvk_sobol_second, reversed) for every
- *    index below 2^20 and for 2^20 hashed 32-bit ones; the pair equals the scrambles written out
+ *    index below 2^20 and for 2^20 hashed 32-bit ones; the paired 64-bit reversal equals two
+ *    32-bit ones (2^20 hashed words); the pair equals the scrambles written out
  *    (owen_scramble(reverse(i)), owen_scramble(sobol_second(i))) for a sample of indices.
  * 6. The single-precision pairs the walk draws (dwvk_sampler_pair_f): the top 24 bits of the
  *    double pair, truncated (so they stay below 1 where rounding to float would give 1: planted,
@@ -125,6 +126,14 @@ int main(void)
         same &= dwvk_sobol_second_reversed(hashed) == dwvk_reverse_bits32(dwvk_sobol_second(hashed));
     }
     CHECK(same, "the loop-free Sobol coordinate differs from the definition");
+    same = 1;
+    for (uint32_t i = 0; i < (1u << 20); ++i) {
+        uint64_t x = dwvk_mix64(i);
+        uint64_t both = dwvk_reverse_bits32_pair(x);
+        same &= (uint32_t)(both >> 32) == dwvk_reverse_bits32((uint32_t)x);
+        same &= (uint32_t)both == dwvk_reverse_bits32((uint32_t)(x >> 32));
+    }
+    CHECK(same, "the paired reversal differs from two reversals");
     same = 1;
     for (uint32_t i = 0; i < 4096; ++i) {
         s.index = (uint64_t)i * 1048573u;
