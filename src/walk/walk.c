@@ -254,12 +254,13 @@ double dwvw_walk_sample(dwvw_walk *walk)
     /* Channel: proportional to throughput x albedo (Cycles), to throughput where all albedos are 0. */
     int channel = 0;
     if (m->channels > 1) {
-        double total = 0.0;
-        for (int c = 0; c < m->channels; ++c) total += (walk->channel_p[c] = walk->weight[c] * m->albedo[c]);
+        /* RGB (a medium has 1 or 3 channels): written for three, so that the loops unroll. */
+        double p[DWVW_MAX_CHANNELS], total = 0.0;
+        for (int c = 0; c < DWVW_MAX_CHANNELS; ++c) total += (p[c] = walk->weight[c] * m->albedo[c]);
         if (!(total > 0.0))
-            for (int c = 0; c < m->channels; ++c) total += (walk->channel_p[c] = walk->weight[c]);
-        for (int c = 0; c < m->channels; ++c) walk->channel_p[c] /= total;
-        channel = pick(walk->channel_p, m->channels,
+            for (int c = 0; c < DWVW_MAX_CHANNELS; ++c) total += (p[c] = walk->weight[c]);
+        for (int c = 0; c < DWVW_MAX_CHANNELS; ++c) walk->channel_p[c] = p[c] /= total;
+        channel = pick(p, DWVW_MAX_CHANNELS,
                        stratified ? *choice : dwvk_rng_uniform_d(walk->key, dim + DWVW_DIM_CHANNEL), choice);
     } else {
         walk->channel_p[0] = 1.0;
@@ -302,6 +303,119 @@ double dwvw_walk_sample(dwvw_walk *walk)
     return walk->step_distance;
 }
 
+/* The weight update of an RGB walk (a medium has 1 or 3 channels) over components first .. end - 1,
+ * qp[k] = Q_k p_k.
+ *
+ * exp((sigma_c' - sigma_c s_k) t) = exp((r - sigma_c s_k) t) exp((sigma_c' - r) t): with r the
+ * smallest active sigma_c s_k, the sum D = sum_k,c Q_k p_k P_c pdist_{k,c} exp((r - sigma_c s_k) t)
+ * is shared by every channel c' (its largest term has exp(0) = 1 and nothing overflows), and each
+ * channel's ratio is f_c' exp((r - sigma_c') t) / D, which underflows to 0 only where the weight
+ * is negligible. The classical component (s = 1) reuses those channel factors, so a classical
+ * walk needs 3 exponentials per event, a mixture 3 more per guided component (components x 9
+ * without the factoring).
+ *
+ * An argument of 0 (an extinction equal to the rate) has exp(0) = 1 exactly (dwvk_exp_fast(0) is
+ * 1): the call is skipped, one of the 3 exponentials of a classical event. Channels with equal
+ * extinctions (grey extinction, coloured albedo: a leaf) have equal arguments: one call serves
+ * them all. Both leave every value as it was, bit for bit. */
+static void rgb_weight_update(dwvw_walk *walk, const double *qp, int first, int end, double t, int exited)
+{
+    const dwvw_medium *m = walk->medium;
+    const int channels = m->channels;
+    double rate = INFINITY; /* (extinctions are finite and positive: no NaN to order) */
+    for (int k = first; k < end; ++k) {
+        if (!(qp[k] > 0.0)) continue;
+        for (int c = 0; c < channels; ++c) {
+            double sigma = m->sigma_t[c] * walk->component_stretch[k];
+            if (walk->channel_p[c] > 0.0 && sigma < rate) rate = sigma;
+        }
+    }
+    double channel_factor[DWVW_MAX_CHANNELS], denominator = 0.0;
+    for (int c = 0; c < channels; ++c) {
+        double sigma = m->sigma_t[c];
+        channel_factor[c] = sigma == rate                        ? 1.0
+                            : c > 0 && sigma == m->sigma_t[c - 1] ? channel_factor[c - 1]
+                                                                  : dwvk_exp_fast((rate - sigma) * t);
+    }
+    if (rate < INFINITY) {
+        for (int k = first; k < end; ++k) {
+            if (!(qp[k] > 0.0)) continue;
+            double stretch = walk->component_stretch[k];
+            double last_sigma = -1.0, last_decay = 0.0; /* the exponential last made (no sigma is < 0) */
+            for (int c = 0; c < channels; ++c) {
+                if (!(walk->channel_p[c] > 0.0)) continue;
+                double sigma = m->sigma_t[c] * stretch;
+                double density = exited ? 1.0 : sigma;
+                double decay;
+                if (stretch == 1.0) {
+                    decay = channel_factor[c];
+                } else if (sigma == rate) {
+                    decay = 1.0;
+                } else if (sigma == last_sigma) {
+                    decay = last_decay;
+                } else {
+                    decay = last_decay = dwvk_exp_fast((rate - sigma) * t);
+                    last_sigma = sigma;
+                }
+                denominator += qp[k] * walk->channel_p[c] * density * decay;
+            }
+        }
+    }
+    for (int cw = 0; cw < channels; ++cw) {
+        if (walk->weight[cw] == 0.0) continue;
+        double f = walk->phase * (exited ? 1.0 : m->sigma_t[cw] * m->albedo[cw]);
+        double ratio = f * channel_factor[cw] / denominator;
+        walk->weight[cw] *= isfinite(ratio) ? ratio : 0.0;
+    }
+}
+
+/* exp(x) where x equals 0 (then 1, as dwvk_exp_fast(0)) or an earlier argument (then its value):
+ * `same` says which of those holds, `earlier` its value. */
+static inline double exp_shared(double x, int zero, int same, double earlier)
+{
+    return zero ? 1.0 : same ? earlier : dwvk_exp_fast(x);
+}
+
+/* rgb_weight_update for one component (Q p = qp, stretch s) and three channels, written out: the
+ * same operations in the same order, without the loops. */
+static void rgb_weight_update_single(dwvw_walk *walk, double qp, double stretch, double t, int exited)
+{
+    const dwvw_medium *m = walk->medium;
+    const double s0 = m->sigma_t[0], s1 = m->sigma_t[1], s2 = m->sigma_t[2];
+    const double p0 = walk->channel_p[0], p1 = walk->channel_p[1], p2 = walk->channel_p[2];
+    const int on0 = p0 > 0.0, on1 = p1 > 0.0, on2 = p2 > 0.0;
+    const double x0 = s0 * stretch, x1 = s1 * stretch, x2 = s2 * stretch;
+    double rate = INFINITY;
+    if (qp > 0.0) {
+        if (on0 && x0 < rate) rate = x0;
+        if (on1 && x1 < rate) rate = x1;
+        if (on2 && x2 < rate) rate = x2;
+    }
+    const double f0 = exp_shared((rate - s0) * t, s0 == rate, 0, 0.0);
+    const double f1 = exp_shared((rate - s1) * t, s1 == rate, s1 == s0, f0);
+    const double f2 = exp_shared((rate - s2) * t, s2 == rate, s2 == s1, f1);
+    double denominator = 0.0;
+    if (rate < INFINITY) {
+        double d0 = f0, d1 = f1, d2 = f2;
+        if (stretch != 1.0) {
+            /* only the active channels' (an inactive one's argument may be positive) */
+            d0 = on0 ? exp_shared((rate - x0) * t, x0 == rate, 0, 0.0) : 0.0;
+            d1 = on1 ? exp_shared((rate - x1) * t, x1 == rate, on0 && x1 == x0, d0) : 0.0;
+            d2 = on2 ? exp_shared((rate - x2) * t, x2 == rate, on1 && x2 == x1, d1) : 0.0;
+        }
+        if (on0) denominator += qp * p0 * (exited ? 1.0 : x0) * d0;
+        if (on1) denominator += qp * p1 * (exited ? 1.0 : x1) * d1;
+        if (on2) denominator += qp * p2 * (exited ? 1.0 : x2) * d2;
+    }
+    const double phase = walk->phase, factor[3] = {f0, f1, f2};
+    for (int c = 0; c < 3; ++c) {
+        if (walk->weight[c] == 0.0) continue;
+        double f = phase * (exited ? 1.0 : m->sigma_t[c] * m->albedo[c]);
+        double ratio = f * factor[c] / denominator;
+        walk->weight[c] *= isfinite(ratio) ? ratio : 0.0;
+    }
+}
+
 dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 hit_normal)
 {
     const dwvw_medium *m = walk->medium;
@@ -321,14 +435,19 @@ dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 h
     /* weight_c' *= f_c' / p with p = sum_k Q_k p_k sum_c P_c pdist_{k,c}(t); f_c' and each pdist
      * share the factor exp(-sigma t), so the ratio is formed from exp(sigma_c' t - sigma_c s_k t)
      * and neither underflows alone. pdist is sigma s exp(-sigma s t) for a scattering event and
-     * exp(-sigma s t) for leaving at t. */
-    const int components = walk->component_count, channels = m->channels;
+     * exp(-sigma s t) for leaving at t. A walk with one component of weight > 0 has nothing to add
+     * from the others (Q = 0): its sums run over that one. */
+    int first = 0, end = walk->component_count;
+    if (walk->single_component >= 0) {
+        first = walk->single_component;
+        end = first + 1;
+    }
     double qp[DWVW_MAX_COMPONENTS];
-    for (int k = 0; k < components; ++k) qp[k] = walk->component_q[k] * walk->component_pdf[k];
-    if (channels == 1) {
+    for (int k = first; k < end; ++k) qp[k] = walk->component_q[k] * walk->component_pdf[k];
+    if (m->channels == 1) {
         /* Grey medium: one channel, P = 1. */
         double sigma_t = m->sigma_t[0], denominator = 0.0;
-        for (int k = 0; k < components; ++k) {
+        for (int k = first; k < end; ++k) {
             if (!(qp[k] > 0.0)) continue;
             double stretch = walk->component_stretch[k];
             /* The classical component (stretch 1) has exp(0) = 1: skip the call. */
@@ -337,63 +456,10 @@ dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 h
         }
         double ratio = walk->phase * (exited ? 1.0 : m->albedo[0]) / denominator;
         walk->weight[0] *= isfinite(ratio) ? ratio : 0.0;
+    } else if (walk->single_component >= 0) {
+        rgb_weight_update_single(walk, qp[first], walk->component_stretch[first], t, exited);
     } else {
-        /* exp((sigma_c' - sigma_c s_k) t) = exp((r - sigma_c s_k) t) exp((sigma_c' - r) t): with r the
-         * smallest active sigma_c s_k, the sum D = sum_k,c Q_k p_k P_c pdist_{k,c} exp((r - sigma_c
-         * s_k) t) is shared by every channel c' (its largest term has exp(0) = 1 and nothing
-         * overflows), and each channel's ratio is f_c' exp((r - sigma_c') t) / D, which underflows
-         * to 0 only where the weight is negligible. The classical component (s = 1) reuses those
-         * channel factors, so a classical walk needs `channels` exponentials per event, a mixture
-         * `channels` more per guided component (components x channels^2 without the factoring). */
-        double rate = INFINITY; /* (extinctions are finite and positive: no NaN to order) */
-        for (int k = 0; k < components; ++k) {
-            if (!(qp[k] > 0.0)) continue;
-            for (int c = 0; c < channels; ++c) {
-                double sigma = m->sigma_t[c] * walk->component_stretch[k];
-                if (walk->channel_p[c] > 0.0 && sigma < rate) rate = sigma;
-            }
-        }
-        /* An extinction equal to the rate has exp(0) = 1 exactly (dwvk_exp_fast(0) is 1): skip the
-         * call, one of the `channels` exponentials of a classical event. Channels with equal
-         * extinctions (grey extinction, coloured albedo: a leaf) have equal arguments: one call
-         * serves them all. Both leave every value as it was, bit for bit. */
-        double channel_factor[DWVW_MAX_CHANNELS], denominator = 0.0;
-        for (int c = 0; c < channels; ++c) {
-            double sigma = m->sigma_t[c];
-            channel_factor[c] = sigma == rate                       ? 1.0
-                                : c > 0 && sigma == m->sigma_t[c - 1] ? channel_factor[c - 1]
-                                                                      : dwvk_exp_fast((rate - sigma) * t);
-        }
-        if (rate < INFINITY) {
-            for (int k = 0; k < components; ++k) {
-                if (!(qp[k] > 0.0)) continue;
-                double stretch = walk->component_stretch[k];
-                double last_sigma = -1.0, last_decay = 0.0; /* the exponential last made (no sigma is < 0) */
-                for (int c = 0; c < channels; ++c) {
-                    if (!(walk->channel_p[c] > 0.0)) continue;
-                    double sigma = m->sigma_t[c] * stretch;
-                    double density = exited ? 1.0 : sigma;
-                    double decay;
-                    if (stretch == 1.0) {
-                        decay = channel_factor[c];
-                    } else if (sigma == rate) {
-                        decay = 1.0;
-                    } else if (sigma == last_sigma) {
-                        decay = last_decay;
-                    } else {
-                        decay = last_decay = dwvk_exp_fast((rate - sigma) * t);
-                        last_sigma = sigma;
-                    }
-                    denominator += qp[k] * walk->channel_p[c] * density * decay;
-                }
-            }
-        }
-        for (int cw = 0; cw < channels; ++cw) {
-            if (walk->weight[cw] == 0.0) continue;
-            double f = walk->phase * (exited ? 1.0 : m->sigma_t[cw] * m->albedo[cw]);
-            double ratio = f * channel_factor[cw] / denominator;
-            walk->weight[cw] *= isfinite(ratio) ? ratio : 0.0;
-        }
+        rgb_weight_update(walk, qp, first, end, t, exited);
     }
     walk->position = dwvw_madd(walk->position, walk->direction, t);
     if (exited) {
