@@ -247,9 +247,11 @@ double dwvw_walk_sample(dwvw_walk *walk)
     /* A stratified event's flight pair: the distance's uniform and the choice (walk.h). */
     const int stratified = walk->events < walk->stratified_events;
     const uint32_t pair = walk->first_pair + DWVW_PAIRS_PER_EVENT * walk->events;
-    double flight[2] = {0.0, 0.0};
-    if (stratified) dwvk_sampler_pair_at(walk->sampler, walk->index_reversed, pair + DWVW_PAIR_FLIGHT, flight);
-    double *choice = stratified ? &flight[1] : NULL;
+    double flight_choice = 0.0;
+    float flight_distance = stratified ? dwvk_sampler_pair_at_fd(walk->sampler, walk->index_reversed,
+                                                                 pair + DWVW_PAIR_FLIGHT, &flight_choice)
+                                       : 0.0f;
+    double *choice = stratified ? &flight_choice : NULL;
 
     /* Channel: proportional to throughput x albedo (Cycles), to throughput where all albedos are 0. */
     int channel = 0;
@@ -298,7 +300,7 @@ double dwvw_walk_sample(dwvw_walk *walk)
         walk->component_stretch[k] = stretch;
         walk->component_pdf[k] = walk->events > 0 ? m->guided_pdf_scale / stretch : 1.0;
     }
-    float u_distance = stratified ? dwvk_uniform_f_from_d(flight[0]) : dwvk_rng_uniform_f(walk->key, dim + DWVW_DIM_DISTANCE);
+    float u_distance = stratified ? flight_distance : dwvk_rng_uniform_f(walk->key, dim + DWVW_DIM_DISTANCE);
     walk->step_distance = dwvw_flight(m->sigma_t[channel] * walk->component_stretch[chosen], u_distance);
     return walk->step_distance;
 }
