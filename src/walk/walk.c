@@ -363,11 +363,11 @@ static void rgb_weight_update(dwvw_walk *walk, const double *qp, int first, int 
             }
         }
     }
+    /* as in rgb_weight_update_single: the ratio is >= 0 or NaN, and a weight of 0 stays 0 */
     for (int cw = 0; cw < channels; ++cw) {
-        if (walk->weight[cw] == 0.0) continue;
         double f = walk->phase * (exited ? 1.0 : m->sigma_t[cw] * m->albedo[cw]);
         double ratio = f * channel_factor[cw] / denominator;
-        walk->weight[cw] *= isfinite(ratio) ? ratio : 0.0;
+        walk->weight[cw] *= ratio <= DBL_MAX ? ratio : 0.0;
     }
 }
 
@@ -409,12 +409,13 @@ static void rgb_weight_update_single(dwvw_walk *walk, double qp, double stretch,
         if (on1) denominator += qp * p1 * (exited ? 1.0 : x1) * d1;
         if (on2) denominator += qp * p2 * (exited ? 1.0 : x2) * d2;
     }
+    /* The ratio is >= 0 or NaN (every factor is >= 0): `ratio <= DBL_MAX` is isfinite(ratio). A
+     * weight of 0 stays 0 either way (0 x a finite ratio, or 0 x 0), so it needs no test. */
     const double phase = walk->phase, factor[3] = {f0, f1, f2};
     for (int c = 0; c < 3; ++c) {
-        if (walk->weight[c] == 0.0) continue;
         double f = phase * (exited ? 1.0 : m->sigma_t[c] * m->albedo[c]);
         double ratio = f * factor[c] / denominator;
-        walk->weight[c] *= isfinite(ratio) ? ratio : 0.0;
+        walk->weight[c] *= ratio <= DBL_MAX ? ratio : 0.0;
     }
 }
 
@@ -456,8 +457,8 @@ dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 h
             double decay = stretch == 1.0 ? 1.0 : dwvk_exp_fast(sigma_t * (1.0 - stretch) * t);
             denominator += qp[k] * (exited ? 1.0 : stretch) * decay;
         }
-        double ratio = walk->phase * (exited ? 1.0 : m->albedo[0]) / denominator;
-        walk->weight[0] *= isfinite(ratio) ? ratio : 0.0;
+        double ratio = walk->phase * (exited ? 1.0 : m->albedo[0]) / denominator; /* >= 0 or NaN */
+        walk->weight[0] *= ratio <= DBL_MAX ? ratio : 0.0;
     } else if (walk->single_component >= 0) {
         rgb_weight_update_single(walk, qp[first], walk->component_stretch[first], t, exited);
     } else {
