@@ -138,7 +138,7 @@ typedef struct dwvw_walk {
     double phase;                                   /* phase function value of the step */
     /* Frames about the guided axes met so far (an axis repeats from event to event for every
      * technique but closest): dwvw_frame_about is a function of the axis's bits alone. */
-    int frames_made;                                /* frames made so far; the slot of the next */
+    uint32_t frames_made;                           /* frames made so far; the slot of the next */
     dwvw_frame frames[DWVW_FRAME_CACHE];
 } dwvw_walk;
 
