@@ -3,8 +3,9 @@
  * bounds are measured against double-precision libm in tests/internal/test_fastmath.c.
  *
  * The polynomials of expm1 and the azimuth are Cephes' single-precision ones (S. L. Moshier,
- * Cephes Math Library 2.2, expf.c / sinf.c), with the range reductions written here; log is
- * table-driven, with a table from tools/gen_log_table.py. Plain C: no
+ * Cephes Math Library 2.2, expf.c / sinf.c), with the range reductions written here; log and the
+ * double exp are table-driven, with tables from tools/gen_log_table.py and tools/gen_exp_table.py.
+ * Plain C: no
  * compiler extension, no reliance on -ffast-math (the reductions depend on IEEE rounding). */
 #ifndef DWV_KERNEL_FASTMATH_H
 #define DWV_KERNEL_FASTMATH_H
@@ -13,6 +14,7 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "exp_table.h"
 #include "log_table.h"
 
 static inline uint32_t dwvk_float_bits(float x)
@@ -48,14 +50,20 @@ static inline float dwvk_expm1_fast_f(float x)
     return scale * p + (scale - 1.0f);
 }
 
-/* exp(x) in double precision, relative error below 6e-16 (about 3 ulps; measured 4.7e-16 against
- * glibc, tests/internal/test_fastmath.c) for x in [-708, 709.78], 0 below -745 and +infinity
- * above 709.78, NaN for NaN. x = k ln2 + r, |r| <= ln2/2, ln2 in two parts (k ln2_hi exact for |k| < 2^11); exp(r) by
- * its Taylor series to r^12 (truncation r^13/13! < 2e-16); 2^k from the bits (|k| <= 1022
- * after the range checks, which split 2^k in two below -1022 so that the result may be
- * subnormal). For the walk's per-event weights (the general path and the mixture fast path use
- * this same function, so their weights agree to the last bit). */
-static inline double dwvk_exp_fast(double x)
+/* 2^e as a double, e integer in [-1022, 1023]: its bits. */
+static inline double dwvk_pow2i(int64_t e)
+{
+    uint64_t bits = (uint64_t)(e + 1023) << 52;
+    double scale;
+    memcpy(&scale, &bits, sizeof scale);
+    return scale;
+}
+
+/* The part of dwvk_exp_fast outside |x| <= 708.39: +infinity above 709.78, NaN for NaN, 0 below
+ * -745.2, and in between 2^k exp(r) with 2^k split in two where it is not a normal double (as
+ * libm, subnormal results from -708.4 on). exp(r) by its Taylor series to r^12 on |r| <= ln2/2
+ * (truncation r^13/13! < 2e-16). */
+static inline double dwvk_exp_fast_edges(double x)
 {
     if (!(x < 709.782712893384)) return x > 0.0 ? INFINITY : x; /* +inf, or NaN */
     if (x < -745.2) return 0.0;
@@ -67,19 +75,36 @@ static inline double dwvk_exp_fast(double x)
                r * (2.4801587301587302e-5 + r * (2.7557319223985893e-6 + r * (2.7557319223985888e-7 +
                r * (2.5052108385441720e-8 + r * 2.0876756987868100e-9)))))))))));
     int64_t ki = (int64_t)k;
-    if (ki < -1022) { /* 2^k = 2^(k + 1000) 2^-1000, both normal */
-        uint64_t bits = (uint64_t)(ki + 1000 + 1023) << 52;
-        double scale;
-        memcpy(&scale, &bits, sizeof scale);
-        return p * scale * 0x1p-1000;
-    }
-    if (ki > 1023) { /* x in (709.09, 709.78): 2^k = 2^(k - 1) 2 */
-        uint64_t bits = (uint64_t)(ki - 1 + 1023) << 52;
-        double scale;
-        memcpy(&scale, &bits, sizeof scale);
-        return p * scale * 2.0;
-    }
-    uint64_t bits = (uint64_t)(ki + 1023) << 52;
+    if (ki < -1022) return p * dwvk_pow2i(ki + 1000) * 0x1p-1000; /* 2^k = 2^(k + 1000) 2^-1000 */
+    if (ki > 1023) return p * dwvk_pow2i(ki - 1) * 2.0;            /* x in (709.09, 709.78) */
+    return p * dwvk_pow2i(ki);
+}
+
+/* exp(x) in double precision, relative error below 5e-16 (measured 3.6e-16 against long double in
+ * tests/internal/test_fastmath.c) for x in [-708, 709.78], 0 below -745.2 and +infinity above
+ * 709.78, NaN for NaN; exp(0) = 1 exactly. Table-driven: x = k ln2/64 + r with |r| <= ln2/128
+ * (plus rounding), ln2/64 in two parts (k ln2/64_hi exact for |k| < 2^17), then
+ * exp(x) = 2^floor(k/64) 2^((k mod 64)/64) exp(r), the middle factor from a table of 64 doubles
+ * (src/kernel/exp_table.h, tools/gen_exp_table.py) and exp(r) by its Taylor series to r^5
+ * (truncation r^6/720 < 4e-17 relative). Errors: the table 0.5 ulp, the series' evaluation about
+ * 0.5 ulp (1 + a sum below 0.006), the product 0.5 ulp. About half the instructions of a
+ * series to r^12 on |r| <= ln2/2, the form it replaces (6e-16). For |x| <= 708.39 the power of
+ * two is a normal double and goes into the table entry's exponent; the rest takes
+ * dwvk_exp_fast_edges. The walk's weights and the estimator's fast path use this same function,
+ * so their weights agree to the last bit. */
+static inline double dwvk_exp_fast(double x)
+{
+    if (!(fabs(x) <= 708.39)) return dwvk_exp_fast_edges(x);
+    const double shift = 0x1.8p52;
+    double kd = (x * DWVK_EXP_N_OVER_LN2 + shift) - shift; /* |k| <= 65408 */
+    double r = (x - kd * DWVK_EXP_LN2_N_HI) - kd * DWVK_EXP_LN2_N_LO;
+    double p = 1.0 + r * (1.0 + r * (0.5 + r * (1.6666666666666666e-1 + r * (4.1666666666666664e-2 +
+               r * 8.3333333333333332e-3))));
+    /* k + 2^17 >= 0, so that floor(k / 64) is a shift of an unsigned number */
+    uint64_t k = (uint64_t)((int64_t)kd + ((int64_t)1 << 17));
+    int64_t e = (int64_t)(k >> DWVK_EXP_TABLE_BITS) - ((int64_t)1 << (17 - DWVK_EXP_TABLE_BITS)); /* in [-1022, 1022] */
+    /* the table entry is in [1, 2): adding e to its exponent field multiplies it by 2^e (mod 2^64) */
+    uint64_t bits = DWVK_EXP_TABLE[k & (DWVK_EXP_TABLE_SIZE - 1)] + ((uint64_t)e << 52);
     double scale;
     memcpy(&scale, &bits, sizeof scale);
     return p * scale;

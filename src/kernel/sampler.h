@@ -92,27 +92,77 @@ static inline uint32_t dwvk_owen_scramble(uint32_t x, uint32_t seed)
     return dwvk_reverse_bits32(dwvk_laine_karras(dwvk_reverse_bits32(x), seed));
 }
 
-/* The two uniforms on [0, 1) of pair `pair` (dimensions 2 pair and 2 pair + 1 of the sample). */
-static inline void dwvk_sampler_pair(const dwvk_sampler *sampler, uint32_t pair, double u[2])
+/* dwvk_reverse_bits32 of both 32-bit halves of x at once, the halves swapped:
+ * (reverse(low) << 32) | reverse(high), the 64-bit reversal (bit i goes to 63 - i). */
+static inline uint64_t dwvk_reverse_bits32_pair(uint64_t x)
 {
-    if (sampler->stratified && sampler->index < 0x100000000ull) {
-        uint64_t seeds = dwvk_rng_u64(sampler->key, pair); /* two 32-bit scramble seeds */
-        /* The index itself is shuffled per pair by the same nested scramble (Burley 2020, Sec. 4):
-         * the first 2^m indices go to one aligned block of 2^m points of the sequence, still a
-         * net, but to a different block and order for each pair. */
-        uint32_t i = dwvk_owen_scramble((uint32_t)sampler->index, (uint32_t)dwvk_mix64(seeds));
-        /* The coordinates are owen_scramble(reverse(i)) and owen_scramble(sobol_second(i)); the
-         * scramble reverses its input first, so the two reversals cancel (walks draw two pairs
-         * per event: this is on their path). */
-        uint32_t first = dwvk_reverse_bits32(dwvk_laine_karras(i, (uint32_t)seeds));
-        uint32_t second = dwvk_reverse_bits32(dwvk_laine_karras(dwvk_sobol_second_reversed(i), (uint32_t)(seeds >> 32)));
-        u[0] = (double)first * 0x1.0p-32;
-        u[1] = (double)second * 0x1.0p-32;
-        return;
-    }
+    x = ((x >> 1) & 0x5555555555555555ull) | ((x & 0x5555555555555555ull) << 1);
+    x = ((x >> 2) & 0x3333333333333333ull) | ((x & 0x3333333333333333ull) << 2);
+    x = ((x >> 4) & 0x0f0f0f0f0f0f0f0full) | ((x & 0x0f0f0f0f0f0f0f0full) << 4);
+#if defined(__GNUC__)
+    return __builtin_bswap64(x);
+#else
+    x = ((x >> 8) & 0x00ff00ff00ff00ffull) | ((x & 0x00ff00ff00ff00ffull) << 8);
+    x = ((x >> 16) & 0x0000ffff0000ffffull) | ((x & 0x0000ffff0000ffffull) << 16);
+    return (x >> 32) | (x << 32);
+#endif
+}
+
+/* The reversed bits of a sample's index, the same for all its pairs: what dwvk_sampler_pair_at
+ * takes, so that a caller drawing several pairs of one sample (a walk, two per event) reverses
+ * the index once. */
+static inline uint32_t dwvk_sampler_index_reversed(const dwvk_sampler *sampler)
+{
+    return dwvk_reverse_bits32((uint32_t)sampler->index);
+}
+
+/* The stratified pair's two 32-bit coordinates, first in the high half, where the sample is
+ * stratified and its index below 2^32 (returns 1); else 0 and the pair is rng.h's
+ * (dwvk_sampler_pair_at). index_reversed = dwvk_sampler_index_reversed(sampler). */
+static inline int dwvk_sampler_pair_bits(const dwvk_sampler *sampler, uint32_t index_reversed, uint32_t pair,
+                                         uint64_t *both)
+{
+    if (!(sampler->stratified && sampler->index < 0x100000000ull)) return 0;
+    uint64_t seeds = dwvk_rng_u64(sampler->key, pair); /* two 32-bit scramble seeds */
+    /* The index itself is shuffled per pair by the same nested scramble (Burley 2020, Sec. 4): the
+     * first 2^m indices go to one aligned block of 2^m points of the sequence, still a net, but
+     * to a different block and order for each pair. dwvk_owen_scramble(index, .) with the index's
+     * reversal done by the caller. */
+    uint32_t i = dwvk_reverse_bits32(dwvk_laine_karras(index_reversed, (uint32_t)dwvk_mix64(seeds)));
+    /* The coordinates are owen_scramble(reverse(i)) and owen_scramble(sobol_second(i)); the
+     * scramble reverses its input first, so the two reversals cancel (walks draw two pairs per
+     * event: this is on their path), and the two output reversals are one 64-bit one. */
+    uint64_t hashed = ((uint64_t)dwvk_laine_karras(dwvk_sobol_second_reversed(i), (uint32_t)(seeds >> 32)) << 32) |
+                      dwvk_laine_karras(i, (uint32_t)seeds);
+    *both = dwvk_reverse_bits32_pair(hashed);
+    return 1;
+}
+
+/* The unstratified pair (independent draws of rng.h): the sample's own key, or for stratified
+ * samples past 2^32 a key of their own. */
+static inline void dwvk_sampler_pair_independent(const dwvk_sampler *sampler, uint32_t pair, double u[2])
+{
     uint64_t key = sampler->stratified ? dwvk_rng_key(sampler->key, 0u, sampler->index) : sampler->key;
     u[0] = dwvk_rng_uniform_d(key, 2u * pair);
     u[1] = dwvk_rng_uniform_d(key, 2u * pair + 1u);
+}
+
+/* dwvk_sampler_pair with the index's reversed bits given (dwvk_sampler_index_reversed). */
+static inline void dwvk_sampler_pair_at(const dwvk_sampler *sampler, uint32_t index_reversed, uint32_t pair, double u[2])
+{
+    uint64_t both;
+    if (dwvk_sampler_pair_bits(sampler, index_reversed, pair, &both)) {
+        u[0] = (double)(uint32_t)(both >> 32) * 0x1.0p-32;
+        u[1] = (double)(uint32_t)both * 0x1.0p-32;
+        return;
+    }
+    dwvk_sampler_pair_independent(sampler, pair, u);
+}
+
+/* The two uniforms on [0, 1) of pair `pair` (dimensions 2 pair and 2 pair + 1 of the sample). */
+static inline void dwvk_sampler_pair(const dwvk_sampler *sampler, uint32_t pair, double u[2])
+{
+    dwvk_sampler_pair_at(sampler, dwvk_sampler_index_reversed(sampler), pair, u);
 }
 
 /* A uniform on [0, 1) as a float on the 2^-24 grid: its top 24 bits, truncated. */
@@ -124,12 +174,41 @@ static inline float dwvk_uniform_f_from_d(double u)
 /* The same pair as single-precision uniforms on the 2^-24 grid (the walk's per-event sampling
  * runs in single precision): the top 24 bits, truncated, so that a uniform on a finer dyadic grid
  * stays uniform and never rounds up to 1 (a float conversion by rounding would). */
-static inline dwvk_uniform_pair_f dwvk_sampler_pair_f(const dwvk_sampler *sampler, uint32_t pair)
+static inline dwvk_uniform_pair_f dwvk_sampler_pair_at_f(const dwvk_sampler *sampler, uint32_t index_reversed,
+                                                           uint32_t pair)
 {
+    uint64_t both;
+    if (dwvk_sampler_pair_bits(sampler, index_reversed, pair, &both)) {
+        /* dwvk_uniform_f_from_d of x 2^-32 is x's top 24 bits: (x >> 8) 2^-24, without the double */
+        dwvk_uniform_pair_f f = {(float)(int32_t)(both >> 40) * 0x1.0p-24f,
+                                 (float)(int32_t)((uint32_t)both >> 8) * 0x1.0p-24f};
+        return f;
+    }
     double u[2];
-    dwvk_sampler_pair(sampler, pair, u);
+    dwvk_sampler_pair_independent(sampler, pair, u);
     dwvk_uniform_pair_f f = {dwvk_uniform_f_from_d(u[0]), dwvk_uniform_f_from_d(u[1])};
     return f;
+}
+
+/* The pair as the walk's flight takes it: the first number as dwvk_sampler_pair_at_f's (a float
+ * on the 2^-24 grid), the second as dwvk_sampler_pair_at's (a double). */
+static inline float dwvk_sampler_pair_at_fd(const dwvk_sampler *sampler, uint32_t index_reversed, uint32_t pair,
+                                            double *second)
+{
+    uint64_t both;
+    if (dwvk_sampler_pair_bits(sampler, index_reversed, pair, &both)) {
+        *second = (double)(uint32_t)both * 0x1.0p-32;
+        return (float)(int32_t)(both >> 40) * 0x1.0p-24f;
+    }
+    double u[2];
+    dwvk_sampler_pair_independent(sampler, pair, u);
+    *second = u[1];
+    return dwvk_uniform_f_from_d(u[0]);
+}
+
+static inline dwvk_uniform_pair_f dwvk_sampler_pair_f(const dwvk_sampler *sampler, uint32_t pair)
+{
+    return dwvk_sampler_pair_at_f(sampler, dwvk_sampler_index_reversed(sampler), pair);
 }
 
 #endif

@@ -1,6 +1,7 @@
 #include "walk.h"
 
 #include <float.h>
+#include <string.h>
 
 void dwvw_medium_init(dwvw_medium *medium, int channels, const double *sigma_t, const double *albedo, double g)
 {
@@ -87,6 +88,7 @@ void dwvw_walk_begin(dwvw_walk *walk, const dwvw_medium *medium, const dwvw_guid
     walk->guide = guide;
     walk->key = key;
     walk->sampler = NULL;
+    walk->index_reversed = 0u;
     walk->first_pair = 0u;
     walk->stratified_events = 0u;
     walk->max_events = max_events;
@@ -103,13 +105,19 @@ void dwvw_walk_begin(dwvw_walk *walk, const dwvw_medium *medium, const dwvw_guid
     walk->closest_normal = normal;
     walk->step_distance = 0.0;
     walk->component_count = 0;
+    /* Closest aims at a new point, and several patches are weighed anew, at every event; backward
+     * from the event after its probe found the opposite interface (dwvw_walk_complete). Otherwise
+     * the components depend on nothing that moves: build_components gives the same at every event. */
+    walk->components_vary = guide->q_closest > 0.0 || (guide->q_incident > 0.0 && guide->patch_count > 1);
     walk->single_component = -1;
+    walk->frames_made = 0u;
 }
 
 void dwvw_walk_stratify(dwvw_walk *walk, const dwvk_sampler *sampler, uint32_t first_pair, uint32_t events)
 {
     uint32_t room = (UINT32_MAX - first_pair) / DWVW_PAIRS_PER_EVENT; /* events whose pairs fit in 32 bits */
     walk->sampler = sampler;
+    walk->index_reversed = sampler == NULL ? 0u : dwvk_sampler_index_reversed(sampler);
     walk->first_pair = first_pair;
     walk->stratified_events = sampler == NULL ? 0u : events < room ? events : room;
 }
@@ -215,6 +223,23 @@ static int pick(const double *p, int n, double u, double *rest)
     return last;
 }
 
+static int same_bits(dwvw_vec3 a, dwvw_vec3 b)
+{
+    return memcmp(&a, &b, sizeof a) == 0;
+}
+
+/* dwvw_frame_about(axis), made once per walk and axis (kept in the walk's few slots, the oldest
+ * replaced): the frame is a function of the axis's bits, so a kept one is the same bit for bit. */
+static const dwvw_frame *frame_about_axis(dwvw_walk *walk, dwvw_vec3 axis)
+{
+    uint32_t kept = walk->frames_made < DWVW_FRAME_CACHE ? walk->frames_made : DWVW_FRAME_CACHE;
+    for (uint32_t i = 0; i < kept; ++i)
+        if (same_bits(walk->frames[i].n, axis)) return &walk->frames[i];
+    dwvw_frame *slot = &walk->frames[walk->frames_made++ % DWVW_FRAME_CACHE];
+    *slot = dwvw_frame_about(axis);
+    return slot;
+}
+
 double dwvw_walk_sample(dwvw_walk *walk)
 {
     const dwvw_medium *m = walk->medium;
@@ -222,25 +247,28 @@ double dwvw_walk_sample(dwvw_walk *walk)
     /* A stratified event's flight pair: the distance's uniform and the choice (walk.h). */
     const int stratified = walk->events < walk->stratified_events;
     const uint32_t pair = walk->first_pair + DWVW_PAIRS_PER_EVENT * walk->events;
-    double flight[2] = {0.0, 0.0};
-    if (stratified) dwvk_sampler_pair(walk->sampler, pair + DWVW_PAIR_FLIGHT, flight);
-    double *choice = stratified ? &flight[1] : NULL;
+    double flight_choice = 0.0;
+    float flight_distance = stratified ? dwvk_sampler_pair_at_fd(walk->sampler, walk->index_reversed,
+                                                                 pair + DWVW_PAIR_FLIGHT, &flight_choice)
+                                       : 0.0f;
+    double *choice = stratified ? &flight_choice : NULL;
 
     /* Channel: proportional to throughput x albedo (Cycles), to throughput where all albedos are 0. */
     int channel = 0;
     if (m->channels > 1) {
-        double total = 0.0;
-        for (int c = 0; c < m->channels; ++c) total += (walk->channel_p[c] = walk->weight[c] * m->albedo[c]);
+        /* RGB (a medium has 1 or 3 channels): written for three, so that the loops unroll. */
+        double p[DWVW_MAX_CHANNELS], total = 0.0;
+        for (int c = 0; c < DWVW_MAX_CHANNELS; ++c) total += (p[c] = walk->weight[c] * m->albedo[c]);
         if (!(total > 0.0))
-            for (int c = 0; c < m->channels; ++c) total += (walk->channel_p[c] = walk->weight[c]);
-        for (int c = 0; c < m->channels; ++c) walk->channel_p[c] /= total;
-        channel = pick(walk->channel_p, m->channels,
+            for (int c = 0; c < DWVW_MAX_CHANNELS; ++c) total += (p[c] = walk->weight[c]);
+        for (int c = 0; c < DWVW_MAX_CHANNELS; ++c) walk->channel_p[c] = p[c] /= total;
+        channel = pick(p, DWVW_MAX_CHANNELS,
                        stratified ? *choice : dwvk_rng_uniform_d(walk->key, dim + DWVW_DIM_CHANNEL), choice);
     } else {
         walk->channel_p[0] = 1.0;
     }
 
-    build_components(walk);
+    if (walk->component_count == 0 || walk->components_vary) build_components(walk);
     int chosen = walk->single_component >= 0
                      ? walk->single_component
                      : pick(walk->component_q, walk->component_count,
@@ -251,13 +279,12 @@ double dwvw_walk_sample(dwvw_walk *walk)
     float g = (float)m->g;
     if (walk->events > 0) {
         /* The first step keeps the entry direction: only its distance is sampled. */
-        dwvk_uniform_pair_f u = stratified ? dwvk_sampler_pair_f(walk->sampler, pair + DWVW_PAIR_DIRECTION)
+        dwvk_uniform_pair_f u = stratified ? dwvk_sampler_pair_at_f(walk->sampler, walk->index_reversed, pair + DWVW_PAIR_DIRECTION)
                                            : dwvk_rng_uniform_pair_f(walk->key, dim + DWVW_DIM_DIRECTION);
         if (chosen == 0) {
             walk->direction = dwvw_classical_direction(previous, g, u);
         } else {
-            dwvw_frame frame = dwvw_frame_about(walk->component_axis[chosen]);
-            walk->direction = dwvw_guided_direction(&frame, &m->dwivedi_event, u);
+            walk->direction = dwvw_guided_direction(frame_about_axis(walk, walk->component_axis[chosen]), &m->dwivedi_event, u);
         }
         /* HG at g = 0 is the isotropic 1/(4 pi): skip its square root and division. */
         walk->phase = g == 0.0f ? DWVK_INV_FOUR_PI : dwvk_hg_pdf_f(g, (float)dwvw_cosine(previous, walk->direction));
@@ -273,9 +300,124 @@ double dwvw_walk_sample(dwvw_walk *walk)
         walk->component_stretch[k] = stretch;
         walk->component_pdf[k] = walk->events > 0 ? m->guided_pdf_scale / stretch : 1.0;
     }
-    float u_distance = stratified ? dwvk_uniform_f_from_d(flight[0]) : dwvk_rng_uniform_f(walk->key, dim + DWVW_DIM_DISTANCE);
+    float u_distance = stratified ? flight_distance : dwvk_rng_uniform_f(walk->key, dim + DWVW_DIM_DISTANCE);
     walk->step_distance = dwvw_flight(m->sigma_t[channel] * walk->component_stretch[chosen], u_distance);
     return walk->step_distance;
+}
+
+/* exp(x) where x equals 0 (then 1, as dwvk_exp_fast(0)) or an earlier argument (then its value):
+ * `same` says which of those holds, `earlier` its value. */
+static inline double exp_shared(double x, int zero, int same, double earlier)
+{
+    return zero ? 1.0 : same ? earlier : dwvk_exp_fast(x);
+}
+
+/* rgb_weight_update (below) for one component (Q p = qp, stretch s), written out: the same
+ * operations in the same order, without the loops over components. Through add_component_terms
+ * and arrays, as the general form, it took ~35 instructions more per event (callgrind, slab). */
+static void rgb_weight_update_single(dwvw_walk *walk, double qp, double stretch, double t, int exited)
+{
+    const dwvw_medium *m = walk->medium;
+    const double s0 = m->sigma_t[0], s1 = m->sigma_t[1], s2 = m->sigma_t[2];
+    const double p0 = walk->channel_p[0], p1 = walk->channel_p[1], p2 = walk->channel_p[2];
+    const int on0 = p0 > 0.0, on1 = p1 > 0.0, on2 = p2 > 0.0;
+    const double x0 = s0 * stretch, x1 = s1 * stretch, x2 = s2 * stretch;
+    double rate = INFINITY;
+    if (qp > 0.0) {
+        if (on0 && x0 < rate) rate = x0;
+        if (on1 && x1 < rate) rate = x1;
+        if (on2 && x2 < rate) rate = x2;
+    }
+    const double f0 = exp_shared((rate - s0) * t, s0 == rate, 0, 0.0);
+    const double f1 = exp_shared((rate - s1) * t, s1 == rate, s1 == s0, f0);
+    const double f2 = exp_shared((rate - s2) * t, s2 == rate, s2 == s1, f1);
+    double denominator = 0.0;
+    if (rate < INFINITY) {
+        double d0 = f0, d1 = f1, d2 = f2;
+        if (stretch != 1.0) {
+            /* only the active channels' (an inactive one's argument may be positive) */
+            d0 = on0 ? exp_shared((rate - x0) * t, x0 == rate, 0, 0.0) : 0.0;
+            d1 = on1 ? exp_shared((rate - x1) * t, x1 == rate, on0 && x1 == x0, d0) : 0.0;
+            d2 = on2 ? exp_shared((rate - x2) * t, x2 == rate, on1 && x2 == x1, d1) : 0.0;
+        }
+        if (on0) denominator += qp * p0 * (exited ? 1.0 : x0) * d0;
+        if (on1) denominator += qp * p1 * (exited ? 1.0 : x1) * d1;
+        if (on2) denominator += qp * p2 * (exited ? 1.0 : x2) * d2;
+    }
+    /* The ratio is >= 0 or NaN (every factor is >= 0): `ratio <= DBL_MAX` is isfinite(ratio). A
+     * weight of 0 stays 0 either way (0 x a finite ratio, or 0 x 0), so it needs no test. */
+    const double phase = walk->phase, factor[3] = {f0, f1, f2};
+    for (int c = 0; c < 3; ++c) {
+        double f = phase * (exited ? 1.0 : m->sigma_t[c] * m->albedo[c]);
+        double ratio = f * factor[c] / denominator;
+        walk->weight[c] *= ratio <= DBL_MAX ? ratio : 0.0;
+    }
+}
+
+/* One component's terms of the shared sum D (rgb_weight_update), added to `denominator` in
+ * channel order: Q p = qp, stretch s, the rate r and the channel factors f_c = exp((r - sigma_c) t)
+ * (the classical component's decays). */
+static double add_component_terms(double denominator, const double sigma_t[3], const double p[3], double qp,
+                                  double stretch, double rate, const double f[3], double t, int exited)
+{
+    const int on0 = p[0] > 0.0, on1 = p[1] > 0.0, on2 = p[2] > 0.0;
+    const double x0 = sigma_t[0] * stretch, x1 = sigma_t[1] * stretch, x2 = sigma_t[2] * stretch;
+    double d0 = f[0], d1 = f[1], d2 = f[2];
+    if (stretch != 1.0) {
+        d0 = on0 ? exp_shared((rate - x0) * t, x0 == rate, 0, 0.0) : 0.0;
+        d1 = on1 ? exp_shared((rate - x1) * t, x1 == rate, on0 && x1 == x0, d0) : 0.0;
+        d2 = on2 ? exp_shared((rate - x2) * t, x2 == rate, on1 && x2 == x1, d1) : 0.0;
+    }
+    if (on0) denominator += qp * p[0] * (exited ? 1.0 : x0) * d0;
+    if (on1) denominator += qp * p[1] * (exited ? 1.0 : x1) * d1;
+    if (on2) denominator += qp * p[2] * (exited ? 1.0 : x2) * d2;
+    return denominator;
+}
+
+/* The weight update of an RGB walk (a medium has 1 or 3 channels) over components first .. end - 1,
+ * qp[k] = Q_k p_k.
+ *
+ * exp((sigma_c' - sigma_c s_k) t) = exp((r - sigma_c s_k) t) exp((sigma_c' - r) t): with r the
+ * smallest active sigma_c s_k, the sum D = sum_k,c Q_k p_k P_c pdist_{k,c} exp((r - sigma_c s_k) t)
+ * is shared by every channel c' (its largest term has exp(0) = 1 and nothing overflows), and each
+ * channel's ratio is f_c' exp((r - sigma_c') t) / D, which underflows to 0 only where the weight
+ * is negligible. The classical component (s = 1) reuses those channel factors, so a classical
+ * walk needs 3 exponentials per event, a mixture 3 more per guided component (components x 9
+ * without the factoring).
+ *
+ * An argument of 0 (an extinction equal to the rate) has exp(0) = 1 exactly (dwvk_exp_fast(0) is
+ * 1): the call is skipped, one of the 3 exponentials of a classical event. Channels with equal
+ * extinctions (grey extinction, coloured albedo: a leaf) have equal arguments: one call serves
+ * them all. Both leave every value as it was, bit for bit. */
+static void rgb_weight_update(dwvw_walk *walk, const double *qp, int first, int end, double t, int exited)
+{
+    const dwvw_medium *m = walk->medium;
+    const double sigma_t[3] = {m->sigma_t[0], m->sigma_t[1], m->sigma_t[2]};
+    const double p[3] = {walk->channel_p[0], walk->channel_p[1], walk->channel_p[2]};
+    double rate = INFINITY; /* (extinctions are finite and positive: no NaN to order) */
+    for (int k = first; k < end; ++k) {
+        if (!(qp[k] > 0.0)) continue;
+        for (int c = 0; c < 3; ++c) {
+            double sigma = sigma_t[c] * walk->component_stretch[k];
+            if (p[c] > 0.0 && sigma < rate) rate = sigma;
+        }
+    }
+    double f[3];
+    f[0] = exp_shared((rate - sigma_t[0]) * t, sigma_t[0] == rate, 0, 0.0);
+    f[1] = exp_shared((rate - sigma_t[1]) * t, sigma_t[1] == rate, sigma_t[1] == sigma_t[0], f[0]);
+    f[2] = exp_shared((rate - sigma_t[2]) * t, sigma_t[2] == rate, sigma_t[2] == sigma_t[1], f[1]);
+    double denominator = 0.0;
+    if (rate < INFINITY)
+        for (int k = first; k < end; ++k)
+            if (qp[k] > 0.0)
+                denominator = add_component_terms(denominator, sigma_t, p, qp[k], walk->component_stretch[k], rate, f, t,
+                                                  exited);
+    /* as in rgb_weight_update_single: the ratio is >= 0 or NaN, and a weight of 0 stays 0 */
+    for (int c = 0; c < 3; ++c) {
+        double numerator = walk->phase * (exited ? 1.0 : sigma_t[c] * m->albedo[c]);
+        double ratio = numerator * f[c] / denominator;
+        walk->weight[c] *= ratio <= DBL_MAX ? ratio : 0.0;
+    }
 }
 
 dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 hit_normal)
@@ -287,6 +429,7 @@ dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 h
         for (int c = 1; c < m->channels; ++c) sigma_min = fmin(sigma_min, m->sigma_t[c]);
         if (hit_distance <= fmax(walk->step_distance, 10.0 / sigma_min)) {
             walk->have_opposite = 1;
+            walk->components_vary = 1; /* the backward fraction now follows the depth */
             walk->opposite_depth = -hit_distance * dwvw_dot(walk->direction, walk->entry_normal);
         }
     }
@@ -296,62 +439,31 @@ dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 h
     /* weight_c' *= f_c' / p with p = sum_k Q_k p_k sum_c P_c pdist_{k,c}(t); f_c' and each pdist
      * share the factor exp(-sigma t), so the ratio is formed from exp(sigma_c' t - sigma_c s_k t)
      * and neither underflows alone. pdist is sigma s exp(-sigma s t) for a scattering event and
-     * exp(-sigma s t) for leaving at t. */
-    const int components = walk->component_count, channels = m->channels;
+     * exp(-sigma s t) for leaving at t. A walk with one component of weight > 0 has nothing to add
+     * from the others (Q = 0): its sums run over that one. */
+    int first = 0, end = walk->component_count;
+    if (walk->single_component >= 0) {
+        first = walk->single_component;
+        end = first + 1;
+    }
     double qp[DWVW_MAX_COMPONENTS];
-    for (int k = 0; k < components; ++k) qp[k] = walk->component_q[k] * walk->component_pdf[k];
-    if (channels == 1) {
+    for (int k = first; k < end; ++k) qp[k] = walk->component_q[k] * walk->component_pdf[k];
+    if (m->channels == 1) {
         /* Grey medium: one channel, P = 1. */
         double sigma_t = m->sigma_t[0], denominator = 0.0;
-        for (int k = 0; k < components; ++k) {
+        for (int k = first; k < end; ++k) {
             if (!(qp[k] > 0.0)) continue;
             double stretch = walk->component_stretch[k];
             /* The classical component (stretch 1) has exp(0) = 1: skip the call. */
             double decay = stretch == 1.0 ? 1.0 : dwvk_exp_fast(sigma_t * (1.0 - stretch) * t);
             denominator += qp[k] * (exited ? 1.0 : stretch) * decay;
         }
-        double ratio = walk->phase * (exited ? 1.0 : m->albedo[0]) / denominator;
-        walk->weight[0] *= isfinite(ratio) ? ratio : 0.0;
+        double ratio = walk->phase * (exited ? 1.0 : m->albedo[0]) / denominator; /* >= 0 or NaN */
+        walk->weight[0] *= ratio <= DBL_MAX ? ratio : 0.0;
+    } else if (walk->single_component >= 0) {
+        rgb_weight_update_single(walk, qp[first], walk->component_stretch[first], t, exited);
     } else {
-        /* exp((sigma_c' - sigma_c s_k) t) = exp((r - sigma_c s_k) t) exp((sigma_c' - r) t): with r the
-         * smallest active sigma_c s_k, the sum D = sum_k,c Q_k p_k P_c pdist_{k,c} exp((r - sigma_c
-         * s_k) t) is shared by every channel c' (its largest term has exp(0) = 1 and nothing
-         * overflows), and each channel's ratio is f_c' exp((r - sigma_c') t) / D, which underflows
-         * to 0 only where the weight is negligible. The classical component (s = 1) reuses those
-         * channel factors, so a classical walk needs `channels` exponentials per event, a mixture
-         * `channels` more per guided component (components x channels^2 without the factoring). */
-        double rate = INFINITY; /* (extinctions are finite and positive: no NaN to order) */
-        for (int k = 0; k < components; ++k) {
-            if (!(qp[k] > 0.0)) continue;
-            for (int c = 0; c < channels; ++c) {
-                double sigma = m->sigma_t[c] * walk->component_stretch[k];
-                if (walk->channel_p[c] > 0.0 && sigma < rate) rate = sigma;
-            }
-        }
-        /* The channel whose extinction is the rate has exp(0) = 1 exactly (dwvk_exp_fast(0) is 1):
-         * skip the call, one of the `channels` exponentials of a classical event. */
-        double channel_factor[DWVW_MAX_CHANNELS], denominator = 0.0;
-        for (int c = 0; c < channels; ++c)
-            channel_factor[c] = m->sigma_t[c] == rate ? 1.0 : dwvk_exp_fast((rate - m->sigma_t[c]) * t);
-        if (rate < INFINITY) {
-            for (int k = 0; k < components; ++k) {
-                if (!(qp[k] > 0.0)) continue;
-                double stretch = walk->component_stretch[k];
-                for (int c = 0; c < channels; ++c) {
-                    if (!(walk->channel_p[c] > 0.0)) continue;
-                    double sigma = m->sigma_t[c] * stretch;
-                    double density = exited ? 1.0 : sigma;
-                    double decay = stretch == 1.0 ? channel_factor[c] : dwvk_exp_fast((rate - sigma) * t);
-                    denominator += qp[k] * walk->channel_p[c] * density * decay;
-                }
-            }
-        }
-        for (int cw = 0; cw < channels; ++cw) {
-            if (walk->weight[cw] == 0.0) continue;
-            double f = walk->phase * (exited ? 1.0 : m->sigma_t[cw] * m->albedo[cw]);
-            double ratio = f * channel_factor[cw] / denominator;
-            walk->weight[cw] *= isfinite(ratio) ? ratio : 0.0;
-        }
+        rgb_weight_update(walk, qp, first, end, t, exited);
     }
     walk->position = dwvw_madd(walk->position, walk->direction, t);
     if (exited) {

@@ -32,6 +32,7 @@
 #define DWVW_MAX_CHANNELS 3
 #define DWVW_MAX_PATCHES 16
 #define DWVW_MAX_COMPONENTS (4 + DWVW_MAX_PATCHES)
+#define DWVW_FRAME_CACHE 4 /* a walk's frames kept: backward's two axes and a patch's, with room */
 /* Random-number dimensions of event e start at 2 + 6e (0 and 1 are the entry's): +0 the channel,
  * +1 the component (each drawn only where there is a choice), +2 the cosine and the azimuth (one
  * 64-bit draw, two 24-bit uniforms), +4 the distance, +5 the Russian roulette after the event;
@@ -110,6 +111,7 @@ typedef struct dwvw_walk {
     const dwvw_guide *guide;
     uint64_t key;          /* counter-based RNG key of this walk */
     const dwvk_sampler *sampler;  /* NULL, or the pixel's sampler for the first events */
+    uint32_t index_reversed;      /* dwvk_sampler_index_reversed(sampler), once per walk */
     uint32_t first_pair;          /* the sampler's pair of event 0 (DWVW_PAIR_* above) */
     uint32_t stratified_events;   /* events 0 .. this - 1 are drawn from the sampler */
     uint32_t max_events;
@@ -125,7 +127,8 @@ typedef struct dwvw_walk {
     dwvw_vec3 closest_normal;
     int closest_known;
     double step_distance;
-    int component_count;
+    int component_count;                            /* 0 until the first step builds them */
+    int components_vary;                            /* rebuilt at every event (else kept) */
     int single_component;                           /* the only component with q > 0, else -1 */
     double component_q[DWVW_MAX_COMPONENTS];
     dwvw_vec3 component_axis[DWVW_MAX_COMPONENTS]; /* unused for component 0 (classical) */
@@ -133,6 +136,10 @@ typedef struct dwvw_walk {
     double component_stretch[DWVW_MAX_COMPONENTS];
     double channel_p[DWVW_MAX_CHANNELS];
     double phase;                                   /* phase function value of the step */
+    /* Frames about the guided axes met so far (an axis repeats from event to event for every
+     * technique but closest): dwvw_frame_about is a function of the axis's bits alone. */
+    uint32_t frames_made;                           /* frames made so far; the slot of the next */
+    dwvw_frame frames[DWVW_FRAME_CACHE];
 } dwvw_walk;
 
 /* Fills a medium; the caller validated the values. */

@@ -11,11 +11,14 @@
  * 3. The two coordinates of different pairs of one pixel are not the same numbers.
  * 4. Beyond 2^32 samples, and for unstratified samplers, the pairs are rng.h's draws.
  * 5. The loop-free Sobol coordinate equals the definition (dwvk_sobol_second, reversed) for every
- *    index below 2^20 and for 2^20 hashed 32-bit ones; the pair equals the scrambles written out
+ *    index below 2^20 and for 2^20 hashed 32-bit ones; the paired 64-bit reversal equals two
+ *    32-bit ones (2^20 hashed words); the pair equals the scrambles written out
  *    (owen_scramble(reverse(i)), owen_scramble(sobol_second(i))) for a sample of indices.
  * 6. The single-precision pairs the walk draws (dwvk_sampler_pair_f): the top 24 bits of the
  *    double pair, truncated (so they stay below 1 where rounding to float would give 1: planted,
- *    a rounded conversion of the largest uniform is 1), and still nets for 2^m points, m <= 10. */
+ *    a rounded conversion of the largest uniform is 1), and still nets for 2^m points, m <= 10;
+ *    the walk's other forms (dwvk_sampler_pair_at_f, _at_fd, _at with the index reversed once)
+ *    equal the double pair's conversions, stratified, past 2^32 and unstratified. */
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -126,6 +129,14 @@ int main(void)
     }
     CHECK(same, "the loop-free Sobol coordinate differs from the definition");
     same = 1;
+    for (uint32_t i = 0; i < (1u << 20); ++i) {
+        uint64_t x = dwvk_mix64(i);
+        uint64_t both = dwvk_reverse_bits32_pair(x);
+        same &= (uint32_t)(both >> 32) == dwvk_reverse_bits32((uint32_t)x);
+        same &= (uint32_t)both == dwvk_reverse_bits32((uint32_t)(x >> 32));
+    }
+    CHECK(same, "the paired reversal differs from two reversals");
+    same = 1;
     for (uint32_t i = 0; i < 4096; ++i) {
         s.index = (uint64_t)i * 1048573u;
         double d[2];
@@ -153,6 +164,29 @@ int main(void)
             CHECK(0, "sample %u: the float pair is not the truncated double pair", i);
             break;
         }
+    }
+    /* The walk's forms (float pair, float-and-double pair, index reversed once) against the double
+     * pair, stratified and past 2^32 and unstratified (rng.h's draws). */
+    const dwvk_sampler forms[] = {{.key = dwvk_rng_key(3u, 9u, 0u), .index = 0, .stratified = 1},
+                                  {.key = dwvk_rng_key(3u, 9u, 0u), .index = 0x100000000ull, .stratified = 1},
+                                  {.key = 12345u, .index = 0, .stratified = 0}};
+    for (size_t k = 0; k < sizeof forms / sizeof forms[0]; ++k) {
+        int agree = 1;
+        for (uint32_t i = 0; i < 4096; ++i) {
+            dwvk_sampler f = forms[k];
+            f.index += i;
+            uint32_t reversed = dwvk_sampler_index_reversed(&f);
+            double d[2], second;
+            dwvk_sampler_pair(&f, 3u, d);
+            dwvk_uniform_pair_f pf = dwvk_sampler_pair_at_f(&f, reversed, 3u);
+            float first = dwvk_sampler_pair_at_fd(&f, reversed, 3u, &second);
+            double again[2];
+            dwvk_sampler_pair_at(&f, reversed, 3u, again);
+            agree &= pf.a == dwvk_uniform_f_from_d(d[0]) && pf.b == dwvk_uniform_f_from_d(d[1]);
+            agree &= first == dwvk_uniform_f_from_d(d[0]) && second == d[1];
+            agree &= again[0] == d[0] && again[1] == d[1];
+        }
+        CHECK(agree, "sampler %zu: the walk's forms of the pair differ from the double pair", k);
     }
     return check_report("test_sampler");
 }

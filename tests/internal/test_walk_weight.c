@@ -8,7 +8,8 @@
  * The walk factors the exponentials (one shared sum, one factor per channel) so that nothing
  * overflows; long double's range (exponents to -11000) lets the direct form be evaluated as is,
  * also on stiff steps (sigma t of hundreds) where doubles would underflow. Random states: 1 to
- * DWVW_MAX_COMPONENTS components, stretches of Dwivedi sampling's range, channels with P = 0.
+ * DWVW_MAX_COMPONENTS components, stretches of Dwivedi sampling's range, channels with P = 0,
+ * channels of equal extinction, and one component alone (the walk's single-component path).
  * A planted change (one sigma 1e-6 off in the direct form) must be caught by the same bound. */
 #include <math.h>
 #include <stdint.h>
@@ -46,6 +47,12 @@ static void make_case(uint64_t index, step_case *s)
         sigma[c] = pow(10.0, 3.0 * uniform(key, &dim) - 1.0);
         albedo[c] = uniform(key, &dim);
     }
+    /* now and then equal extinctions in some channels (a leaf: grey extinction, coloured albedo),
+     * whose exponentials the walk shares */
+    double shape = uniform(key, &dim);
+    if (shape < 0.15) sigma[1] = sigma[2] = sigma[0];
+    else if (shape < 0.25) sigma[2] = sigma[1];
+    else if (shape < 0.3) sigma[2] = sigma[0];
     memset(s, 0, sizeof *s);
     dwvw_medium_init(&s->medium, 3, sigma, albedo, 0.0);
     s->guide.q_classical = 1.0; /* q_backward = 0: no first-step probe */
@@ -68,6 +75,13 @@ static void make_case(uint64_t index, step_case *s)
         w->component_stretch[k] = k == 0 ? 1.0 : 0.05 + 4.0 * uniform(key, &dim);
     }
     w->component_q[0] = 0.05 + uniform(key, &dim); /* at least one component with Q > 0 */
+    if (uniform(key, &dim) < 0.4) {
+        /* one component alone (classical, or one guided axis), as dwvw_walk_sample marks it: the
+         * walk's single-component path */
+        int only = (int)(uniform(key, &dim) * w->component_count) % w->component_count;
+        for (int k = 0; k < w->component_count; ++k) w->component_q[k] = k == only ? 0.05 + uniform(key, &dim) : 0.0;
+        w->single_component = only;
+    }
     for (int c = 0; c < 3; ++c) {
         w->channel_p[c] = uniform(key, &dim) < 0.1 ? 0.0 : uniform(key, &dim);
         w->weight[c] = START_WEIGHT;
