@@ -158,24 +158,33 @@ static double cell_visits(const dwvg_clearance *grid, const dwvg_mesh *mesh, dou
     return visits;
 }
 
+/* Triangle t's corners into p and its unit normal (p1 - p0) x (p2 - p0) / |...| into *n; returns
+ * |(p1 - p0) x (p2 - p0)| (twice the area), or 0 with *n = 0 where that is zero or not finite (no
+ * plane). */
+static double triangle_plane(const dwvg_mesh *mesh, uint32_t t, dwvw_vec3 p[3], dwvw_vec3 *n)
+{
+    const uint32_t *corner = mesh->indices + 3u * (size_t)t;
+    for (int k = 0; k < 3; ++k) {
+        const float *q = mesh->positions + 3u * (size_t)corner[k];
+        p[k] = dwvw_v(q[0], q[1], q[2]);
+    }
+    dwvw_vec3 e1 = dwvw_sub(p[1], p[0]), e2 = dwvw_sub(p[2], p[0]);
+    dwvw_vec3 c = dwvw_v(e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x);
+    double length = dwvw_length(c);
+    int flat = length > 0.0 && isfinite(length);
+    *n = flat ? dwvw_scale(c, 1.0 / length) : dwvw_v(0.0, 0.0, 0.0);
+    return flat ? length : 0.0;
+}
+
 /* Lowers grid->lower to the centres' distances to triangle t, over its bounding box grown by
  * `band`. */
 static void exact_near(dwvg_clearance *grid, const dwvg_mesh *mesh, uint32_t t, double band)
 {
     double tlo[3], thi[3];
     if (!finite_triangle(mesh, t, tlo, thi)) return;
-    const uint32_t *corner = mesh->indices + 3u * (size_t)t;
-    dwvw_vec3 p[3];
-    for (int k = 0; k < 3; ++k) {
-        const float *q = mesh->positions + 3u * (size_t)corner[k];
-        p[k] = dwvw_v(q[0], q[1], q[2]);
-    }
     /* The distance to a triangle is at least that to its plane: a cheap test first. */
-    dwvw_vec3 e1 = dwvw_sub(p[1], p[0]), e2 = dwvw_sub(p[2], p[0]);
-    dwvw_vec3 n = dwvw_v(e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x);
-    double length = dwvw_length(n);
-    int flat = length > 0.0 && isfinite(length);
-    n = flat ? dwvw_scale(n, 1.0 / length) : dwvw_v(0.0, 0.0, 0.0);
+    dwvw_vec3 p[3], n;
+    int flat = triangle_plane(mesh, t, p, &n) > 0.0;
     uint32_t first[3], last[3];
     for (int a = 0; a < 3; ++a) cell_range(grid, a, tlo[a] - band, thi[a] + band, &first[a], &last[a]);
     for (uint32_t iz = first[2]; iz <= last[2]; ++iz)
@@ -200,17 +209,9 @@ static int find_planes(dwvg_clearance *grid, const dwvg_mesh *mesh)
     for (uint32_t t = 0; t < mesh->triangle_count; ++t) {
         double lo[3], hi[3];
         if (!finite_triangle(mesh, t, lo, hi)) return 0;
-        const uint32_t *corner = mesh->indices + 3u * (size_t)t;
-        dwvw_vec3 p[3];
-        for (int k = 0; k < 3; ++k) {
-            const float *q = mesh->positions + 3u * (size_t)corner[k];
-            p[k] = dwvw_v(q[0], q[1], q[2]);
-        }
-        dwvw_vec3 e1 = dwvw_sub(p[1], p[0]), e2 = dwvw_sub(p[2], p[0]);
-        dwvw_vec3 n = dwvw_v(e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x);
-        double length = dwvw_length(n);
-        if (!(length > 0.0 && isfinite(length))) return 0;
-        n = dwvw_scale(n, 1.0 / length);
+        dwvw_vec3 p[3], n;
+        double length = triangle_plane(mesh, t, p, &n);
+        if (!(length > 0.0)) return 0;
         double d = dwvw_dot(n, p[0]);
         uint32_t known = count;
         for (uint32_t i = 0; i < count && known == count; ++i) {
