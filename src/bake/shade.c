@@ -39,11 +39,12 @@ static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvb_materia
     int needs_closest = shader->needs_closest[mesh];
     dwvb_ball_mode ball_mode = shader->scene->ball_mode;
     int first = 1;
-    /* The first step's ray goes on past the sampled distance only where its answer is used: the
-     * backward technique's opposite interface, and on an open mesh the warning below (a closed
-     * one always has a far side: dwvg_mesh_closed). Elsewhere it stops there as every later step's
-     * does, which changes no walk (a hit beyond the step is not an exit) and is shorter to trace. */
-    int full_probe = walk->guide->q_backward > 0.0 || !world->closed[mesh];
+    /* The first step's ray goes on past the sampled distance only as far as its answer is used:
+     * to the backward technique's reach for an opposite interface (dwvw_walk_probe_reach), and on
+     * an open mesh all the way, for the warning below (a closed one always has a far side:
+     * dwvg_mesh_closed). A hit beyond that changes no walk (it is no exit and no opposite
+     * interface), and a shorter ray is cheaper to trace. */
+    int full_probe = !world->closed[mesh];
     uint64_t terms_per_component = (uint64_t)walk->medium->channels * (uint64_t)walk->medium->channels;
     uint64_t patches = walk->guide->q_incident > 0.0 && walk->guide->patch_count > 1 ? (uint64_t)walk->guide->patch_count : 0u;
     while (walk->status == DWVW_RUNNING) {
@@ -68,14 +69,15 @@ static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvb_materia
         int found = 0;
         tally->ray_free_steps += (uint64_t)ray_free;
         if (!ray_free || ball_mode == DWVB_BALL_CHECKED) {
-            /* The first step is the probe: its full distance to the surface locates an opposite
-             * interface (full_probe). A ray leaving a flat triangle inward cannot meet that
+            /* The first step is the probe, as far as its reach above. A ray leaving a flat
+             * triangle inward cannot meet that
              * triangle again, so a hit on the entry triangle is rounding and the ray goes on past
              * it (dwvg_intersect_mesh_leaving). */
             if (first) {
                 uint32_t rays = 0;
                 found = dwvg_intersect_mesh_leaving(world, mesh, walk->position, walk->direction, entry_prim,
-                                                    full_probe ? INFINITY : distance, &hit, &rays);
+                                                    full_probe ? INFINITY : dwvw_walk_probe_reach(walk), &hit,
+                                                    &rays);
                 tally->rays += rays;
             } else {
                 ++tally->rays;

@@ -420,14 +420,23 @@ static void rgb_weight_update(dwvw_walk *walk, const double *qp, int first, int 
     }
 }
 
+double dwvw_walk_probe_reach(const dwvw_walk *walk)
+{
+    if (!(walk->guide->q_backward > 0.0)) return walk->step_distance;
+    /* An opposite interface counts within 10 mean free paths of the thinnest channel (Cycles'
+     * reach), or within the step. */
+    const dwvw_medium *m = walk->medium;
+    double sigma_min = m->sigma_t[0];
+    for (int c = 1; c < m->channels; ++c) sigma_min = fmin(sigma_min, m->sigma_t[c]);
+    return fmax(walk->step_distance, 10.0 / sigma_min);
+}
+
 dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 hit_normal)
 {
     const dwvw_medium *m = walk->medium;
     if (walk->events == 0 && walk->guide->q_backward > 0.0 && hit_distance < INFINITY) {
-        /* The first step's probe: an opposite interface within 10 mean free paths (Cycles' reach). */
-        double sigma_min = m->sigma_t[0];
-        for (int c = 1; c < m->channels; ++c) sigma_min = fmin(sigma_min, m->sigma_t[c]);
-        if (hit_distance <= fmax(walk->step_distance, 10.0 / sigma_min)) {
+        /* The first step's probe: an opposite interface within its reach. */
+        if (hit_distance <= dwvw_walk_probe_reach(walk)) {
             walk->have_opposite = 1;
             walk->components_vary = 1; /* the backward fraction now follows the depth */
             walk->opposite_depth = -hit_distance * dwvw_dot(walk->direction, walk->entry_normal);

@@ -170,6 +170,11 @@ double dwvw_walk_sample(dwvw_walk *walk);
  * answer (not cut at the sampled distance), which locates the opposite interface. Returns the
  * new status. */
 dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 hit_normal);
+/* After dwvw_walk_sample on the first step: the distance up to which the probe's answer is used,
+ * the sampled distance (an exit) or, for the backward technique, the reach within which an
+ * opposite interface counts if that is longer. A probe that looks no further and reports a hit
+ * beyond it as none leaves the walk the same. */
+double dwvw_walk_probe_reach(const dwvw_walk *walk);
 
 /* ---- the per-event pieces, shared by dwvw_walk_sample and the estimator's fast path ----------- */
 
