@@ -7,7 +7,10 @@
  *
  * usage: dwivedi_bake_counts SCENE.json|default TECHNIQUE WIDTH HEIGHT SPP SEED REPEATS
  * prints one JSON object: the counts of the first bake (every repeat bakes the same image) and
- * the seconds of each repeat. */
+ * the seconds of each repeat (REPEATS 0 to 1000; 0 bakes once). Exit 2 for bad arguments, 1 for a
+ * scene or a bake that failed, with a message on stderr and nothing on stdout. */
+#include <errno.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -15,12 +18,18 @@
 #include "api/image_handle.h"
 #include "dwivedi.h"
 
-static unsigned long parse(const char *text, const char *what)
+#define MAX_REPEATS 1000u
+
+/* A whole number in [0, max] written in decimal digits only (no sign, no blanks), else exit 2
+ * with a message; the library checks what it accepts of each (dimensions, samples). */
+static unsigned long long parse(const char *text, const char *what, unsigned long long max)
 {
     char *end = NULL;
-    unsigned long value = strtoul(text, &end, 10);
-    if (end == text || *end != '\0') {
-        fprintf(stderr, "dwivedi_bake_counts: %s must be a whole number, not '%s'\n", what, text);
+    errno = 0;
+    unsigned long long value = text[0] >= '0' && text[0] <= '9' ? strtoull(text, &end, 10) : 0;
+    if (end == NULL || end == text || *end != '\0' || errno == ERANGE || value > max) {
+        fprintf(stderr, "dwivedi_bake_counts: %s must be a whole number from 0 to %llu, not '%s'\n", what, max,
+                text);
         exit(2);
     }
     return value;
@@ -45,33 +54,44 @@ int main(int argc, char **argv)
         return 2;
     }
     options.target = DWV_BAKE_CAMERA;
-    options.width = (uint32_t)parse(argv[3], "WIDTH");
-    options.height = (uint32_t)parse(argv[4], "HEIGHT");
-    options.samples = parse(argv[5], "SPP");
-    options.seed = parse(argv[6], "SEED");
+    options.width = (uint32_t)parse(argv[3], "WIDTH", UINT32_MAX);
+    options.height = (uint32_t)parse(argv[4], "HEIGHT", UINT32_MAX);
+    options.samples = parse(argv[5], "SPP", UINT64_MAX);
+    options.seed = parse(argv[6], "SEED", UINT64_MAX);
     options.threads = 1;
     options.time_limit = 0.0;
     options.target_error = 0.0;
-    unsigned long repeats = parse(argv[7], "REPEATS");
-    printf("{\"scene\": \"%s\", \"technique\": \"%s\", \"seconds\": [", argv[1], argv[2]);
-    for (unsigned long k = 0; k < (repeats ? repeats : 1); ++k) {
+    unsigned long long repeats = parse(argv[7], "REPEATS", MAX_REPEATS);
+    if (repeats == 0) repeats = 1;
+    /* Everything is printed after the last bake, so that a failed one leaves no partial JSON. */
+    double seconds[MAX_REPEATS];
+    dwv_bake_stats_t stats = DWV_BAKE_STATS_INIT;
+    unsigned long long rays = 0, point_queries = 0, mixture_terms = 0;
+    for (unsigned long long k = 0; k < repeats; ++k) {
         dwv_image_t *image = NULL;
         if (dwv_bake(scene, &options, &image) != DWV_SUCCESS) {
             fprintf(stderr, "dwivedi_bake_counts: bake: %s\n", dwv_last_error_message());
+            dwv_scene_release(scene);
             return 1;
         }
-        dwv_bake_stats_t stats = DWV_BAKE_STATS_INIT;
-        dwv_image_stats(image, &stats);
-        const dwvb_image *counts = dwv_image_object(image);
-        printf("%s%.9g", k ? ", " : "", stats.seconds);
-        if (k + 1 >= repeats)
-            printf("], \"samples\": %llu, \"walks\": %llu, \"events\": %llu, \"rays\": %llu, \"point_queries\": %llu, "
-                   "\"mixture_terms\": %llu, \"mean_rgb\": [%.9g, %.9g, %.9g]}\n",
-                   (unsigned long long)stats.samples, (unsigned long long)stats.walks, (unsigned long long)stats.events,
-                   (unsigned long long)counts->rays, (unsigned long long)counts->point_queries,
-                   (unsigned long long)counts->mixture_terms, stats.mean_rgb[0], stats.mean_rgb[1], stats.mean_rgb[2]);
+        dwv_bake_stats_t s = DWV_BAKE_STATS_INIT;
+        dwv_image_stats(image, &s);
+        seconds[k] = s.seconds;
+        if (k == 0) { /* every repeat bakes the same image: its counts are the first's */
+            const dwvb_image *counts = dwv_image_object(image);
+            stats = s;
+            rays = counts->rays;
+            point_queries = counts->point_queries;
+            mixture_terms = counts->mixture_terms;
+        }
         dwv_image_release(image);
     }
     dwv_scene_release(scene);
+    printf("{\"scene\": \"%s\", \"technique\": \"%s\", \"seconds\": [", argv[1], argv[2]);
+    for (unsigned long long k = 0; k < repeats; ++k) printf("%s%.9g", k ? ", " : "", seconds[k]);
+    printf("], \"samples\": %llu, \"walks\": %llu, \"events\": %llu, \"rays\": %llu, \"point_queries\": %llu, "
+           "\"mixture_terms\": %llu, \"mean_rgb\": [%.9g, %.9g, %.9g]}\n",
+           (unsigned long long)stats.samples, (unsigned long long)stats.walks, (unsigned long long)stats.events, rays,
+           point_queries, mixture_terms, stats.mean_rgb[0], stats.mean_rgb[1], stats.mean_rgb[2]);
     return 0;
 }

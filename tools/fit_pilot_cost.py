@@ -40,6 +40,7 @@ import json
 import math
 import os
 import re
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -193,6 +194,16 @@ def main(argv=None) -> int:
     unknown = [s for s in scenes if s not in SCENES]
     if unknown:
         parser.error(f"unknown scenes {unknown} (known: {', '.join(SCENES)})")
+    unknown = [t for t in techniques if t not in TECHNIQUES]
+    if unknown:
+        parser.error(f"unknown techniques {unknown} (known: {', '.join(TECHNIQUES)})")
+    for name in ("repeats", "size", "spp"):
+        if getattr(args, name) < 1:
+            parser.error(f"--{name} must be at least 1, not {getattr(args, name)}")
+    if args.seed < 0:
+        parser.error(f"--seed must be at least 0, not {args.seed}")
+    if args.measure == "instructions" and shutil.which("valgrind") is None:
+        parser.error("--measure instructions needs valgrind (apt-get install valgrind)")
     unit = "ns" if args.measure == "time" else "instructions"
     results = {}
     rounds = args.repeats if args.measure == "time" else 1
@@ -207,7 +218,11 @@ def main(argv=None) -> int:
         for _ in range(rounds):
             for name in scenes:
                 for technique in techniques:
-                    row = measure(tool, paths[name], technique, args, workdir)
+                    try:
+                        row = measure(tool, paths[name], technique, args, workdir)
+                    except subprocess.CalledProcessError as error:
+                        print(f"fit_pilot_cost: {name} {technique}: {error.stderr.strip() or error}", file=sys.stderr)
+                        return 1
                     key = (name, technique)
                     if key in results and results[key]["cost"] <= row["cost"]:
                         continue

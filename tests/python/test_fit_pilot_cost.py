@@ -89,5 +89,44 @@ class EndToEnd(unittest.TestCase):
             self.assertEqual(r["point_queries"] > 0, r["technique"] == "closest", what)
 
 
+class BadInput(unittest.TestCase):
+    """Bad arguments end with a message and a non-zero exit, and the counting program prints
+    nothing on stdout then (the tool parses its stdout as JSON)."""
+
+    def test_counting_program(self):
+        counts = os.path.join(environment("DWIVEDI_BUILD_DIR"), "dwivedi_bake_counts")
+        good = ["default", "classical", "8", "8", "2", "1", "1"]
+        # (exit code, argument index, value): WIDTH is argument 2, REPEATS 6, TECHNIQUE 1, SCENE 0
+        cases = [(2, 2, "-1"), (2, 2, "4294967296"), (2, 2, "8x"), (2, 2, ""), (2, 6, "1001"), (2, 1, "nosuch"),
+                 (1, 2, "0"), (1, 0, "/no/such/scene.json")]
+        for code, index, value in cases:
+            argv = list(good)
+            argv[index] = value
+            run = subprocess.run([counts] + argv, capture_output=True, text=True, timeout=60)
+            self.assertEqual(run.returncode, code, (argv, run.stderr))
+            self.assertEqual(run.stdout, "", argv)
+            self.assertIn("dwivedi_bake_counts: ", run.stderr, argv)
+        run = subprocess.run([counts] + good[:-1] + ["3"], capture_output=True, text=True, timeout=60)
+        self.assertEqual(run.returncode, 0, run.stderr)
+        self.assertEqual(len(json.loads(run.stdout)["seconds"]), 3)
+
+    def test_fit_tool(self):
+        source, build = environment("DWIVEDI_SOURCE_DIR"), environment("DWIVEDI_BUILD_DIR")
+        tool = [sys.executable, os.path.join(source, "tools", "fit_pilot_cost.py"), "--build", build,
+                "--measure", "time", "--scenes", "default", "--techniques", "classical"]
+        for extra, message in ((["--spp", "0"], "--spp must be at least 1"),
+                               (["--repeats", "0"], "--repeats must be at least 1"),
+                               (["--seed", "-1"], "--seed must be at least 0"),
+                               (["--techniques", "nosuch"], "unknown techniques"),
+                               (["--scenes", "nosuch"], "unknown scenes")):
+            run = subprocess.run(tool + extra, capture_output=True, text=True, timeout=60)
+            self.assertEqual(run.returncode, 2, extra)
+            self.assertIn(message, run.stderr, extra)
+        # A bake the library refuses: its message, exit 1.
+        run = subprocess.run(tool + ["--size", "20000", "--repeats", "1"], capture_output=True, text=True, timeout=60)
+        self.assertEqual(run.returncode, 1, run.stderr)
+        self.assertIn("each side must be 1 to 16384", run.stderr)
+
+
 if __name__ == "__main__":
     unittest.main()
