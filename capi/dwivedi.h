@@ -550,7 +550,8 @@ enum {
     DWV_FEATURE_GUIDED = 1u << 5,            /* Dwivedi guiding (else classical: albedo too low) */
     DWV_FEATURE_WORLD_LIGHT = 1u << 6,       /* the world is sampled (not black) */
     DWV_FEATURE_DIRECT_LIGHTS = 1u << 7,     /* next-event estimation to lights */
-    DWV_FEATURE_DIFFUSE_SURFACES = 1u << 8   /* plain diffuse surfaces shaded */
+    DWV_FEATURE_DIFFUSE_SURFACES = 1u << 8,  /* plain diffuse surfaces shaded */
+    DWV_FEATURE_CHANNEL_WALKS = 1u << 9      /* one walk per colour channel (DWV_CHANNEL_WALKS_SEPARATE) */
 };
 /* The lower-case name of one feature bit ("embree", "closest_point"...), or NULL. */
 DWV_API const char *dwv_feature_name(uint32_t feature);
@@ -586,6 +587,22 @@ typedef struct dwv_bake_progress_t {
  * non-zero return cancels the bake. It must not call into the same bake but dwv_bake_cancel. */
 typedef int32_t (*dwv_progress_callback_t)(void *user, const dwv_bake_progress_t *progress);
 
+/* How a bake's walks carry the three colour channels of a medium whose channels differ.
+ * SHARED: one walk carries them all; the channel that drives each free flight is drawn, and
+ * every channel is weighted by spectral MIS (balance heuristic over the channels, as Cycles).
+ * SEPARATE: one walk per channel, each in that channel's own medium and with that channel's own
+ * Dwivedi distribution; no channel's weight carries another's pdf, at the cost of more walks.
+ * AUTO (0, the default): SHARED for an explicit technique; with DWV_TECHNIQUE_AUTO the pilot
+ * chooses per mesh, with the technique. Grey media (all channels alike) always walk once. */
+typedef uint32_t dwv_channel_walks_t;
+enum {
+    DWV_CHANNEL_WALKS_AUTO = 0,
+    DWV_CHANNEL_WALKS_SHARED = 1,
+    DWV_CHANNEL_WALKS_SEPARATE = 2
+};
+DWV_API const char *dwv_channel_walks_name(dwv_channel_walks_t channel_walks);
+DWV_API dwv_result_t dwv_channel_walks_from_name(const char *name, dwv_channel_walks_t *channel_walks);
+
 typedef struct dwv_bake_options_t {
     uint32_t struct_size;     /* sizeof(dwv_bake_options_t): set by DWV_BAKE_OPTIONS_INIT */
     dwv_bake_target_t target;
@@ -600,7 +617,7 @@ typedef struct dwv_bake_options_t {
     uint32_t max_events;      /* cap on scattering events per walk; 0: 10^6 */
     uint64_t seed;
     uint32_t tile_size;       /* pixels per tile side, 0: 32, or down to 8 on small images (16 tiles per thread) */
-    uint32_t reserved;
+    uint32_t channel_walks;   /* dwv_channel_walks_t, DWV_CHANNEL_WALKS_*; a reserved 0 (AUTO) in older headers */
     dwv_progress_callback_t progress;  /* optional */
     void *progress_user;
 } dwv_bake_options_t;

@@ -5,7 +5,8 @@
  * callgrind's instruction count in bake.c's `worker`. The counts are internal (the image object,
  * src/bake/image.h), not part of the C API, hence a program linked against the static archive.
  *
- * usage: dwivedi_bake_counts SCENE.json|default TECHNIQUE WIDTH HEIGHT SPP SEED REPEATS
+ * usage: dwivedi_bake_counts SCENE.json|default TECHNIQUE[/CHANNELS] WIDTH HEIGHT SPP SEED REPEATS
+ * (CHANNELS: a dwv_channel_walks_t name, auto, shared or separate; default auto)
  * prints one JSON object: the counts of the first bake (every repeat bakes the same image) and
  * the seconds of each repeat (REPEATS 0 to 1000; 0 bakes once). Exit 2 for bad arguments, 1 for a
  * scene or a bake that failed, with a message on stderr and nothing on stdout. */
@@ -38,7 +39,7 @@ static unsigned long long parse(const char *text, const char *what, unsigned lon
 int main(int argc, char **argv)
 {
     if (argc != 8) {
-        fprintf(stderr, "usage: dwivedi_bake_counts SCENE.json|default TECHNIQUE WIDTH HEIGHT SPP SEED REPEATS\n");
+        fprintf(stderr, "usage: dwivedi_bake_counts SCENE.json|default TECHNIQUE[/CHANNELS] WIDTH HEIGHT SPP SEED REPEATS\n");
         return 2;
     }
     dwv_scene_t *scene = NULL;
@@ -49,8 +50,16 @@ int main(int argc, char **argv)
         fprintf(stderr, "dwivedi_bake_counts: %s: %s\n", argv[1], dwv_last_error_message());
         return 1;
     }
-    if (dwv_technique_from_name(argv[2], &options.technique) != DWV_SUCCESS) {
+    char technique[64];
+    const char *slash = strchr(argv[2], '/');
+    size_t length = slash ? (size_t)(slash - argv[2]) : strlen(argv[2]);
+    if (length >= sizeof technique) length = sizeof technique - 1u; /* too long for any name: refused below */
+    memcpy(technique, argv[2], length);
+    technique[length] = '\0';
+    if (dwv_technique_from_name(technique, &options.technique) != DWV_SUCCESS ||
+        (slash && dwv_channel_walks_from_name(slash + 1, &options.channel_walks) != DWV_SUCCESS)) {
         fprintf(stderr, "dwivedi_bake_counts: %s\n", dwv_last_error_message());
+        dwv_scene_release(scene);
         return 2;
     }
     options.target = DWV_BAKE_CAMERA;

@@ -2,15 +2,16 @@
 """Refits the cost model of auto's pilot (PILOT_COST_* in src/bake/bake.c).
 
 The pilot prices a sample as
-    cost = c_sample + c_event x events + c_guided x guided events + c_ray x rays
+    cost = c_sample + c_walk x walks + c_event x events + c_guided x guided events + c_ray x rays
            + c_query x closest-point queries + c_term x mixture terms
-where guided events are the events of walks with a guided component (every technique but
+where walks are one per sample that walks when the channels walk together and one per walking
+channel when they walk apart (TECHNIQUE/separate: dwv_channel_walks_t), guided events are the events of walks with a guided component (every technique but
 classical: their events sample and weigh a Dwivedi direction, which a classical event does not)
 and keeps, per mesh, the candidate technique with the least variance x cost. This tool bakes
 scenes x techniques on one thread with build/dwivedi_bake_counts (which prints those counts; the
 C API does not), measures each bake's cost, and fits the six coefficients by least squares on
 relative residuals (each bake weighs alike, whatever its size), with every coefficient >= 0
-(all subsets of the columns are tried: exact non-negative least squares for six unknowns).
+(all subsets of the columns are tried: exact non-negative least squares for seven unknowns).
 
 Costs, by --measure:
   instructions  callgrind's instruction count inside bake.c's `worker` (the bake's samples,
@@ -30,7 +31,8 @@ come from python_shim/dwivedi/report.py, which needs no library to import).
 
 usage: tools/fit_pilot_cost.py [--build build] [--measure instructions|time] [--repeats 5]
                                [--size 32] [--spp 16] [--scenes sphere,slab,leaf,default]
-                               [--techniques classical,poe,backward,incident,closest,cycles]
+                               [--techniques classical,poe,backward,incident,closest,cycles,
+                                             classical/separate,backward/separate,incident/separate]
 """
 from __future__ import annotations
 
@@ -50,9 +52,10 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "python_shim"))
 from dwivedi import report  # noqa: E402  (geometry only: loads no library)
 
-COUNTS = ("samples", "events", "guided_events", "rays", "point_queries", "mixture_terms")
-NAMES = ("SAMPLE", "EVENT", "GUIDED_EVENT", "RAY", "QUERY", "TERM")
-TECHNIQUES = ("classical", "poe", "backward", "incident", "closest", "cycles")
+COUNTS = ("samples", "walks", "events", "guided_events", "rays", "point_queries", "mixture_terms")
+NAMES = ("SAMPLE", "WALK", "EVENT", "GUIDED_EVENT", "RAY", "QUERY", "TERM")
+TECHNIQUES = ("classical", "poe", "backward", "incident", "closest", "cycles", "classical/separate",
+              "backward/separate", "incident/separate")
 
 
 def _mesh(points, triangles, material, normals=False):
@@ -119,7 +122,7 @@ def measure(tool: Path, scene: str, technique: str, args, workdir: str) -> dict:
         row = json.loads(out)
         row["cost"] = row["seconds"][0] * 1e9
         return row
-    prefix = os.path.join(workdir, f"cg.{Path(scene).stem}.{technique}")
+    prefix = os.path.join(workdir, f"cg.{Path(scene).stem}.{technique.replace('/', '-')}")
     out = subprocess.run(["valgrind", "--tool=callgrind", "--toggle-collect=worker",
                           f"--callgrind-out-file={prefix}.%p"] + command + ["1"],
                          check=True, capture_output=True, text=True).stdout
@@ -227,12 +230,13 @@ def main(argv=None) -> int:
                     if key in results and results[key]["cost"] <= row["cost"]:
                         continue
                     row["scene"], row["technique"] = name, technique
-                    row["guided_events"] = 0 if technique == "classical" else row["events"]
+                    row["guided_events"] = 0 if technique.split("/")[0] == "classical" else row["events"]
                     results[key] = row
         results = list(results.values())
         for row in results:
             name, technique, per = row["scene"], row["technique"], row["samples"]
-            print(f"{name:8s} {technique:10s} per sample: {unit} {row['cost'] / per:10.0f}  events {row['events'] / per:7.3f}"
+            print(f"{name:8s} {technique:18s} per sample: {unit} {row['cost'] / per:10.0f}  walks {row['walks'] / per:6.3f}"
+                  f"  events {row['events'] / per:7.3f}"
                   f"  guided {row['guided_events'] / per:7.3f}"
                   f"  rays {row['rays'] / per:7.3f}  queries {row['point_queries'] / per:7.3f}"
                   f"  terms {row['mixture_terms'] / per:8.2f}")
@@ -241,7 +245,7 @@ def main(argv=None) -> int:
     print(f"\nfit ({unit}, relative least squares, coefficients >= 0): rms relative residual {rms:.3f}")
     for r, (x, y) in zip(results, rows):
         model = sum(f * xi for f, xi in zip(coef, x))
-        print(f"  {r['scene']:8s} {r['technique']:10s} measured {y / x[0]:10.0f}  model {model / x[0]:10.0f}"
+        print(f"  {r['scene']:8s} {r['technique']:18s} measured {y / x[0]:10.0f}  model {model / x[0]:10.0f}"
               f"  residual {model / y - 1.0:+.3f}")
     print(f"\n/* PILOT_COST_*: {unit} per count, fitted by tools/fit_pilot_cost.py --measure {args.measure}"
           f" (rms {rms:.1%}); only ratios matter */")

@@ -224,7 +224,7 @@ class BakeOptions(_SizedStructure):
         ("max_events", ctypes.c_uint32),
         ("seed", ctypes.c_uint64),
         ("tile_size", ctypes.c_uint32),
-        ("reserved", ctypes.c_uint32),
+        ("channel_walks", ctypes.c_uint32),
         ("progress", ProgressCallback),
         ("progress_user", ctypes.c_void_p),
     ]
@@ -331,6 +331,8 @@ _handle_pp = ctypes.POINTER(ctypes.c_void_p)
 _BAKER_PROTOTYPES: Dict[str, Tuple[object, Sequence[object]]] = {
     "dwv_technique_name": (ctypes.c_char_p, (ctypes.c_int32,)),
     "dwv_technique_from_name": (_result_t, (ctypes.c_char_p, _p(ctypes.c_int32))),
+    "dwv_channel_walks_name": (ctypes.c_char_p, (ctypes.c_uint32,)),
+    "dwv_channel_walks_from_name": (_result_t, (ctypes.c_char_p, _p(ctypes.c_uint32))),
     "dwv_feature_name": (ctypes.c_char_p, (ctypes.c_uint32,)),
     "dwv_scene_create": (_result_t, (_handle_pp,)),
     "dwv_scene_retain": (_result_t, (_handle_p,)),

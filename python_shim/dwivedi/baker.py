@@ -321,13 +321,18 @@ def _normalize(v: Sequence[float], name: str) -> Vector:
 # ---------------------------------------------------------------------------------------------
 
 _TARGETS = {"camera": 0, "uv": 1}
+# dwv_channel_walks_t: how walks carry the colour channels (capi/dwivedi.h)
+_CHANNEL_WALKS = {"auto": 0, "shared": 1, "separate": 2}
 
 
 @dataclass
 class BakeSettings:
     """What to bake and how long (dwv_bake_options_t). Whichever budget is reached first ends the
     bake: `samples` per pixel, `time_limit` seconds (0: none), `target_error` relative RMSE of
-    the image, as in BakeStats (0: none). threads 0 uses every core; the image is the same for any thread count."""
+    the image, as in BakeStats (0: none). threads 0 uses every core; the image is the same for any thread count.
+    channel_walks: "shared" (one walk carries the three colour channels by spectral MIS, as Cycles),
+    "separate" (one walk per channel, in that channel's own medium) or "auto" (shared for an
+    explicit technique; with technique "auto" the pilot chooses per mesh)."""
 
     target: str = "camera"
     width: int = 256
@@ -342,6 +347,7 @@ class BakeSettings:
     max_events: int = 0
     seed: int = 0
     tile_size: int = 0
+    channel_walks: str = "auto"
 
     def _to_c(self) -> _library.BakeOptions:
         out = _library.BakeOptions()
@@ -358,6 +364,7 @@ class BakeSettings:
         out.max_events = _uint("max_events", self.max_events)
         out.seed = _uint("seed", self.seed, 64)
         out.tile_size = _uint("tile_size", self.tile_size)
+        out.channel_walks = _name_code("channel_walks", self.channel_walks, _CHANNEL_WALKS)
         return out
 
     @classmethod
@@ -365,7 +372,8 @@ class BakeSettings:
         return cls(target={v: k for k, v in _TARGETS.items()}.get(c.target, str(c.target)), width=c.width,
                    height=c.height, uv_mesh=c.uv_mesh, uv_margin=c.uv_margin, technique=_technique_name(c.technique),
                    samples=c.samples, time_limit=c.time_limit, target_error=c.target_error, threads=c.threads,
-                   max_events=c.max_events, seed=c.seed, tile_size=c.tile_size)
+                   max_events=c.max_events, seed=c.seed, tile_size=c.tile_size,
+                   channel_walks={v: k for k, v in _CHANNEL_WALKS.items()}.get(c.channel_walks, str(c.channel_walks)))
 
 
 @dataclass(frozen=True)

@@ -3,6 +3,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 #include <unistd.h>
 
 #include "bake/bake.h"
@@ -21,6 +22,28 @@
 #define TILES_PER_THREAD 16u /* enough that the last tiles of a pass even out between workers */
 #define DEFAULT_MAX_EVENTS 1000000u
 
+static const char *const channel_walks_names[] = {"auto", "shared", "separate"};
+#define CHANNEL_WALKS_COUNT ((uint32_t)(sizeof channel_walks_names / sizeof channel_walks_names[0]))
+
+const char *dwv_channel_walks_name(dwv_channel_walks_t channel_walks)
+{
+    return channel_walks < CHANNEL_WALKS_COUNT ? channel_walks_names[channel_walks] : NULL;
+}
+
+dwv_result_t dwv_channel_walks_from_name(const char *name, dwv_channel_walks_t *channel_walks)
+{
+    DWV_TRY(dwv_check_pointer("dwv_channel_walks_from_name", "name", name));
+    DWV_TRY(dwv_check_pointer("dwv_channel_walks_from_name", "channel_walks", channel_walks));
+    for (uint32_t i = 0; i < CHANNEL_WALKS_COUNT; ++i) {
+        if (strcmp(name, channel_walks_names[i]) == 0) {
+            *channel_walks = i;
+            return DWV_SUCCESS;
+        }
+    }
+    return dwv_fail(DWV_ERROR_UNKNOWN_NAME,
+                    "dwv_channel_walks_from_name: unknown channel walks '%.64s' (auto, shared or separate)", name);
+}
+
 struct dwv_bake_s {
     dwvb_bake *bake;
     dwv_scene_t *scene;
@@ -36,6 +59,9 @@ static dwv_result_t check_options(const char *fn, const dwvb_scene *s, const dwv
                         fn, o->width, o->height, MAX_SIDE, MAX_PIXELS);
     if (o->technique < DWV_TECHNIQUE_AUTO || o->technique > DWV_TECHNIQUE_CYCLES)
         return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: technique %d is not known", fn, (int)o->technique);
+    if (o->channel_walks > DWV_CHANNEL_WALKS_SEPARATE)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
+                        "%s: channel_walks %u is not known (0 auto, 1 shared, 2 separate)", fn, o->channel_walks);
     if (o->samples < 1u || o->samples > MAX_SAMPLES)
         return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: samples = %llu is outside [1, %llu]", fn,
                         (unsigned long long)o->samples, MAX_SAMPLES);

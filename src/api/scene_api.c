@@ -308,6 +308,7 @@ const char *dwv_feature_name(uint32_t feature)
     case DWV_FEATURE_WORLD_LIGHT: return "world_light";
     case DWV_FEATURE_DIRECT_LIGHTS: return "direct_lights";
     case DWV_FEATURE_DIFFUSE_SURFACES: return "diffuse_surfaces";
+    case DWV_FEATURE_CHANNEL_WALKS: return "channel_walks";
     default: return NULL;
     }
 }

@@ -32,6 +32,8 @@ struct dwvb_bake {
     uint32_t width, height, threads;
     dwvb_shader shader;
     dwvw_guide *guides;
+    dwvw_guide *channel_guides; /* per mesh x 3 (shade.h) */
+    int *channel_walks;         /* per mesh (shade.h) */
     int *needs_closest;
     int *auto_choice; /* per mesh: auto's technique is chosen by the pilot (choose_auto) */
     uint32_t features;
@@ -487,6 +489,8 @@ static void *control(void *arg)
 static void release_parts(dwvb_bake *bake)
 {
     free(bake->guides);
+    free(bake->channel_guides);
+    free(bake->channel_walks);
     free(bake->needs_closest);
     free(bake->auto_choice);
     free(bake->sums);
@@ -530,14 +534,48 @@ static void update_features(dwvb_bake *bake)
 {
     const dwvb_scene *scene = bake->scene;
     uint32_t features = scene->features & ~(uint32_t)(DWV_FEATURE_INCIDENT_PATCHES | DWV_FEATURE_CLOSEST_POINT);
+    int rgb = 0;
     for (uint32_t m = 0; m < scene->mesh_count; ++m) {
         const dwvb_material *material = &scene->shading[scene->meshes[m].material_id];
         if (!material->subsurface || !mesh_used(bake, m)) continue;
         if (bake->needs_closest[m]) features |= DWV_FEATURE_CLOSEST_POINT;
-        if (bake->guides[m].q_incident > 0.0 && bake->guides[m].patch_count > 0) features |= DWV_FEATURE_INCIDENT_PATCHES;
-        if (bake->guides[m].q_classical < 1.0) features |= DWV_FEATURE_GUIDED;
+        const dwvw_guide *guides = bake->channel_walks[m] ? &bake->channel_guides[3u * m] : &bake->guides[m];
+        for (int c = 0; c < (bake->channel_walks[m] ? 3 : 1); ++c) {
+            if (bake->channel_walks[m] && !(material->walk_scale[c] > 0.0)) continue;
+            if (guides[c].q_incident > 0.0 && guides[c].patch_count > 0) features |= DWV_FEATURE_INCIDENT_PATCHES;
+            if (guides[c].q_classical < 1.0) features |= DWV_FEATURE_GUIDED;
+        }
+        if (bake->channel_walks[m]) features |= DWV_FEATURE_CHANNEL_WALKS;
+        else if (!material->grey) rgb = 1;
     }
+    /* Three-channel walks only where some mesh walks its channels together. */
+    if (!rgb) features &= ~(uint32_t)DWV_FEATURE_RGB_WALKS;
     bake->features = features;
+}
+
+/* Whether mesh m's walks query the closest surface point, for the guides its samples use. */
+static int mesh_needs_closest(const dwvb_material *material, int channel_walks, const dwvw_guide *guide,
+                              const dwvw_guide *channel_guides)
+{
+    if (!channel_walks) return dwvw_guide_needs_closest(guide);
+    int needs = 0;
+    for (int c = 0; c < 3; ++c)
+        if (material->walk_scale[c] > 0.0) needs |= dwvw_guide_needs_closest(&channel_guides[c]);
+    return needs;
+}
+
+/* The technique of mesh m's walks in a medium whose largest albedo is `albedo`. */
+static dwvw_technique medium_technique(const dwvb_bake *bake, uint32_t m, double albedo)
+{
+    dwvw_technique technique = (dwvw_technique)bake->options.technique;
+    /* Incident guiding needs lit patches; where a mesh has none (no light reaches it) it
+     * aims at the closest surface point instead, as auto does. */
+    if (technique == DWVW_INCIDENT && bake->scene->patch_count[m] == 0) technique = DWVW_CLOSEST;
+    /* Auto leaves media to classical sampling below albedo 0.2 (dwvw_auto_weights); Cycles'
+     * floor raises every lower albedo to exactly 0.2, where walks average about 1.25 events
+     * and guiding has nothing to gain, so those stay classical too. */
+    if (technique == DWVW_AUTO && albedo <= DWVB_MIN_ALPHA) technique = DWVW_CLASSICAL;
+    return technique;
 }
 
 static void setup_guides(dwvb_bake *bake)
@@ -546,19 +584,25 @@ static void setup_guides(dwvb_bake *bake)
     for (uint32_t m = 0; m < scene->mesh_count; ++m) {
         const dwvb_material *material = &scene->shading[scene->meshes[m].material_id];
         if (!material->subsurface) continue;
-        dwvw_technique technique = (dwvw_technique)bake->options.technique;
-        /* Incident guiding needs lit patches; where a mesh has none (no light reaches it) it
-         * aims at the closest surface point instead, as auto does. */
-        if (technique == DWVW_INCIDENT && scene->patch_count[m] == 0) technique = DWVW_CLOSEST;
-        /* Auto leaves media to classical sampling below albedo 0.2 (dwvw_auto_weights); Cycles'
-         * floor raises every lower albedo to exactly 0.2, where walks average about 1.25 events
-         * and guiding has nothing to gain, so those stay classical too. */
-        if (technique == DWVW_AUTO && material->medium.albedo[material->medium.guide_channel] <= DWVB_MIN_ALPHA)
-            technique = DWVW_CLASSICAL;
+        dwvw_technique technique = medium_technique(bake, m, material->medium.albedo[material->medium.guide_channel]);
         dwvw_guide_init(&bake->guides[m], technique, &material->medium, scene->patches[m], scene->patch_count[m]);
-        bake->needs_closest[m] = dwvw_guide_needs_closest(&bake->guides[m]);
-        /* Above that albedo the pilot chooses (choose_auto); the mixture stays where it cannot. */
-        bake->auto_choice[m] = technique == DWVW_AUTO && mesh_used(bake, m);
+        /* Channel walks' guides: each channel's own medium, with the technique its albedo gets. */
+        int auto_walks = technique == DWVW_AUTO;
+        for (int c = 0; c < 3; ++c) {
+            if (material->grey || !(material->walk_scale[c] > 0.0)) continue;
+            const dwvw_medium *medium = &material->channel_medium[c];
+            dwvw_technique own = medium_technique(bake, m, medium->albedo[0]);
+            auto_walks |= own == DWVW_AUTO;
+            dwvw_guide_init(&bake->channel_guides[3u * m + (uint32_t)c], own, medium, scene->patches[m],
+                            scene->patch_count[m]);
+        }
+        bake->channel_walks[m] = !material->grey && bake->options.channel_walks == DWV_CHANNEL_WALKS_SEPARATE;
+        bake->needs_closest[m] = mesh_needs_closest(material, bake->channel_walks[m], &bake->guides[m],
+                                                    &bake->channel_guides[3u * m]);
+        /* Above that albedo the pilot chooses (choose_auto) the technique and, unless the option
+         * fixes it, whether the channels walk apart; the mixture stays where it cannot. */
+        bake->auto_choice[m] = bake->options.technique == DWV_TECHNIQUE_AUTO && mesh_used(bake, m) &&
+                               (auto_walks || (!material->grey && bake->options.channel_walks == DWV_CHANNEL_WALKS_AUTO));
     }
     update_features(bake);
 }
@@ -578,7 +622,15 @@ static void setup_guides(dwvb_bake *bake)
  *   at equal or lower variance (report's sphere: 17.4 against 24.3 events per walk), and on thin
  *   sheets it aims at the far face as well as the near one (slab: variance 0.61x poe's);
  * - the guided part of auto's mixture alone: toward the lit patches (incident), or the closest
- *   surface point where no light reaches the mesh.
+ *   surface point where no light reaches the mesh;
+ * - each of these three with one walk per colour channel (channel walks, shade.h), where the
+ *   medium's channels differ and the option leaves it to auto. A shared walk weighs every channel
+ *   by the spectral MIS of all three; over many events the channels' weights then carry each
+ *   other's pdfs and scatter widely. On the report's wax sphere (extinctions 2x and 5x apart) the
+ *   image's variance per sample was 10x lower with one backward walk per channel, for 1.6x the
+ *   time per sample (docs/speed.md); on the leaf (one extinction, albedos apart) it was not worth
+ *   its cost. The pilot's variance is the three channels' together, as the image's RMSE over RGB
+ *   counts it: the luminance hides the colour noise of shared walks.
  * Auto's mixture itself (the guided part plus a classical share of 1% or less) is no candidate:
  * its variance was that of the guided part alone within the pilot's noise and its cost above it,
  * so it won none of the pilots on the report's sphere, slab, leaf and default scene (both meshes)
@@ -586,29 +638,31 @@ static void setup_guides(dwvb_bake *bake)
  * cannot decide (too few samples). Every candidate is unbiased, so the choice moves noise, never
  * the mean.
  * The cost is counted, not timed, so that the choice (and the image) depends on the seed only:
- * instructions per sample (camera ray, shading, exit lighting), per walk event (the event's
+ * instructions per sample (camera ray, shading), per walk (its probe, exit and exit lighting),
+ * per walk event (the event's
  * sampling and weight), more per event of a walk with a guided component (every candidate but
  * classical: a Dwivedi direction's frame, sampling and pdf; 1.5x a classical event in the fit),
  * per Embree ray the walk casts (steps inside a ball clear of the mesh cast
  * none: shade.c run_walk), per closest-point query and per mixture term (see dwvb_tally). They
  * are a least-squares fit (relative residuals, coefficients >= 0) of callgrind's instruction
  * counts in the bake's workers, one thread, 32 x 32 pixels, 16 spp, over the report's sphere,
- * slab, leaf and default scene x classical, poe, backward, incident and cycles:
- * tools/fit_pilot_cost.py, which refits them (rms residual 6.4%; docs/speed.md). Rays come out
- * at 0: with the ray-free steps and the box's plane exits they are about 0.5-0.7 per event in
- * every technique, so the event's cost holds theirs. The query's cost depends on the mesh's size
- * and is fitted apart, with the others fixed, on the four scenes' closest bakes (per query 5,000
- * on the boxes, 11,400 on the sphere, 20,600 on the default scene's meshes: their median). One-
- * thread bake times agreed where the machine was quiet enough to measure (report's sphere, 32 x
- * 32 pixels, 16 spp, best of 6: backward and poe 1.3% and 5.4% faster than classical,
- * instructions 5.0% and 7.1%, before the last refit); under load a timed fit (--measure time) is
- * not usable (rms 32%). Only their ratios matter. */
-#define PILOT_COST_SAMPLE 4276.0
-#define PILOT_COST_EVENT 485.5
-#define PILOT_COST_GUIDED_EVENT 240.6
+ * slab, leaf and default scene x classical, poe, backward, incident, closest and cycles, and
+ * classical, backward and incident with channel walks: tools/fit_pilot_cost.py, which refits
+ * them (rms residual 18.8%; the worst: closest, whose query's cost grows with the mesh, -40% and
+ * -53% on the sphere and the default scene, and incident on the sphere, whose lit patches are
+ * weighed per event, -28% shared and -46% with channel walks; docs/speed.md). Rays come out at
+ * 0: with the ray-free steps and the box's plane exits they are about 0.5-0.7 per event in every
+ * technique, so the event's cost holds theirs. One-thread bake times agreed where the machine was
+ * quiet enough to measure (report's sphere, 32 x 32 pixels, 16 spp, best of 6: backward and poe
+ * 1.3% and 5.4% faster than classical, instructions 5.0% and 7.1%, two refits ago); under load a
+ * timed fit (--measure time) is not usable (rms 32%). Only their ratios matter. */
+#define PILOT_COST_SAMPLE 4514.0
+#define PILOT_COST_WALK 545.5
+#define PILOT_COST_EVENT 754.1
+#define PILOT_COST_GUIDED_EVENT 306.1
 #define PILOT_COST_RAY 0.0
-#define PILOT_COST_QUERY 8300.0
-#define PILOT_COST_TERM 44.91
+#define PILOT_COST_QUERY 6028.0
+#define PILOT_COST_TERM 25.22
 /* Pilot samples per candidate: a sixteenth of the bake's samples, at most PILOT_MAX; below
  * PILOT_MIN the estimate is too noisy to act on and auto keeps its mixture. A mesh needs
  * PILOT_MESH_MIN of them to be decided. */
@@ -616,8 +670,10 @@ static void setup_guides(dwvb_bake *bake)
 #define PILOT_MIN 256u
 #define PILOT_MESH_MIN 64.0
 
-/* The candidates, in the order of the pilot (a tie keeps the earlier, cheaper one). */
-#define PILOT_CANDIDATES 3
+/* The candidates, in the order of the pilot (a tie keeps the earlier, cheaper one): the three
+ * techniques with the channels walked together, then the same with one walk per channel. */
+#define PILOT_TECHNIQUES 3
+#define PILOT_CANDIDATES (2 * PILOT_TECHNIQUES)
 enum { PILOT_CLASSICAL = 0, PILOT_ENTRY = 1, PILOT_GUIDED = 2 };
 
 /* Auto's classical share at or below which the guided candidates drop it: the isotropic
@@ -629,17 +685,17 @@ enum { PILOT_CLASSICAL = 0, PILOT_ENTRY = 1, PILOT_GUIDED = 2 };
  * against classical's 0.23, so the pilot's estimate would pick it by chance. */
 #define PILOT_ISOTROPIC_SHARE 0.01
 
-/* Candidate `candidate` for mesh m, whose guide auto made (bake->guides[m]: the mixture). */
-static void pilot_guide(const dwvb_bake *bake, uint32_t m, int candidate, dwvw_guide *guide)
+/* Technique `technique` (PILOT_*) of the pilot for a mesh of `medium` whose guide auto made
+ * (`mixture`: auto's mixture, or classical where the albedo is too low to guide). */
+static void pilot_guide(const dwvb_bake *bake, uint32_t m, int technique, const dwvw_medium *medium,
+                        const dwvw_guide *mixture, dwvw_guide *guide)
 {
     const dwvb_scene *scene = bake->scene;
-    const dwvw_medium *medium = &scene->shading[scene->meshes[m].material_id].medium;
-    const dwvw_guide *mixture = &bake->guides[m];
-    if (candidate == PILOT_CLASSICAL) {
+    if (technique == PILOT_CLASSICAL || mixture->q_classical >= 1.0) {
         dwvw_guide_init(guide, DWVW_CLASSICAL, medium, NULL, 0);
         return;
     }
-    if (candidate == PILOT_ENTRY) dwvw_guide_init(guide, DWVW_BACKWARD, medium, NULL, 0);
+    if (technique == PILOT_ENTRY) dwvw_guide_init(guide, DWVW_BACKWARD, medium, NULL, 0);
     else if (mixture->q_incident > 0.0)
         dwvw_guide_init(guide, DWVW_INCIDENT, medium, scene->patches[m], scene->patch_count[m]);
     else dwvw_guide_init(guide, DWVW_CLOSEST, medium, NULL, 0);
@@ -652,8 +708,23 @@ static void pilot_guide(const dwvb_bake *bake, uint32_t m, int candidate, dwvw_g
     }
 }
 
+/* Candidate `candidate` for mesh m (auto's guides in bake): its guide, its channel guides and
+ * whether its channels walk apart (a grey medium's one-channel walks walk once either way). */
+static void pilot_candidate(const dwvb_bake *bake, uint32_t m, int candidate, dwvw_guide *guide,
+                            dwvw_guide channel_guides[3], int *channel_walks)
+{
+    const dwvb_material *material = &bake->scene->shading[bake->scene->meshes[m].material_id];
+    int technique = candidate % PILOT_TECHNIQUES;
+    pilot_guide(bake, m, technique, &material->medium, &bake->guides[m], guide);
+    *channel_walks = candidate >= PILOT_TECHNIQUES && !material->grey;
+    for (int c = 0; c < 3; ++c)
+        if (!material->grey && material->walk_scale[c] > 0.0)
+            pilot_guide(bake, m, technique, &material->channel_medium[c], &bake->channel_guides[3u * m + (uint32_t)c],
+                        &channel_guides[c]);
+}
+
 typedef struct pilot_sums {
-    double count, sum, sum_squares, cost;
+    double count, sum[3], sum_squares[3], cost;
 } pilot_sums;
 
 static uint64_t active_pixels(const dwvb_bake *bake)
@@ -671,7 +742,9 @@ static uint64_t active_pixels(const dwvb_bake *bake)
 
 typedef struct pilot_run {
     dwvb_bake *bake;
-    const dwvb_shader *shaders; /* one per candidate */
+    const dwvb_shader *shaders; /* indexed by candidate */
+    const int *candidates;      /* the candidates run (PILOT_*), candidate_count of them */
+    int candidate_count;
     pilot_sums *block_sums;     /* [block][candidate][mesh] */
     uint32_t samples, meshes;
     atomic_uint next_block;
@@ -690,7 +763,8 @@ static void *pilot_worker(void *arg)
         uint32_t end = (uint32_t)((uint64_t)run->samples * (block + 1u) / PILOT_BLOCKS);
         pilot_sums *sums = &run->block_sums[(size_t)block * PILOT_CANDIDATES * run->meshes];
         /* The same pixel samples for every candidate. */
-        for (int candidate = 0; candidate < PILOT_CANDIDATES; ++candidate) {
+        for (int k = 0; k < run->candidate_count; ++k) {
+            int candidate = run->candidates[k];
             for (uint32_t i = first; i < end; ++i) {
                 if (must_stop(bake)) {
                     atomic_store(&run->stopped, 1);
@@ -703,13 +777,15 @@ static void *pilot_worker(void *arg)
                 dwvb_tally tally = {0};
                 sample_with(bake, &run->shaders[candidate], PILOT_STREAM, index, i, rgb, &alpha, &mesh, &tally);
                 if (mesh == UINT32_MAX || !bake->auto_choice[mesh]) continue;
-                double l = luminance(rgb);
                 pilot_sums *p = &sums[(size_t)candidate * run->meshes + mesh];
                 p->count += 1.0;
-                p->sum += l;
-                p->sum_squares += l * l;
-                double event_cost = PILOT_COST_EVENT + (candidate == PILOT_CLASSICAL ? 0.0 : PILOT_COST_GUIDED_EVENT);
-                p->cost += PILOT_COST_SAMPLE + event_cost * (double)tally.events + PILOT_COST_RAY * (double)tally.rays +
+                for (int c = 0; c < 3; ++c) {
+                    p->sum[c] += rgb[c];
+                    p->sum_squares[c] += rgb[c] * rgb[c];
+                }
+                double event_cost = PILOT_COST_EVENT + (candidate % PILOT_TECHNIQUES == PILOT_CLASSICAL ? 0.0 : PILOT_COST_GUIDED_EVENT);
+                p->cost += PILOT_COST_SAMPLE + PILOT_COST_WALK * (double)tally.walks + event_cost * (double)tally.events +
+                           PILOT_COST_RAY * (double)tally.rays +
                            PILOT_COST_QUERY * (double)tally.point_queries + PILOT_COST_TERM * (double)tally.mixture_terms;
             }
         }
@@ -719,11 +795,13 @@ static void *pilot_worker(void *arg)
 
 /* Runs the pilot on the bake's threads; sums gets [candidate][mesh] totals. 0 done, 1 stopped
  * (cancel or time), -1 out of memory or no thread. */
-static int run_pilot(dwvb_bake *bake, const dwvb_shader *shaders, uint32_t samples, pilot_sums *sums)
+static int run_pilot(dwvb_bake *bake, const dwvb_shader *shaders, const int *candidates, int candidate_count,
+                     uint32_t samples, pilot_sums *sums)
 {
     uint32_t meshes = bake->scene->mesh_count;
     size_t per_block = PILOT_CANDIDATES * (size_t)meshes;
-    pilot_run run = {bake, shaders, calloc(PILOT_BLOCKS * per_block, sizeof(pilot_sums)), samples, meshes, 0u, 0};
+    pilot_run run = {bake, shaders, candidates, candidate_count, calloc(PILOT_BLOCKS * per_block, sizeof(pilot_sums)),
+                     samples, meshes, 0u, 0};
     if (!run.block_sums) return -1;
     atomic_init(&run.next_block, 0u);
     atomic_init(&run.stopped, 0);
@@ -737,8 +815,10 @@ static int run_pilot(dwvb_bake *bake, const dwvb_shader *shaders, uint32_t sampl
         for (size_t k = 0; k < per_block; ++k) {
             const pilot_sums *b = &run.block_sums[block * per_block + k];
             sums[k].count += b->count;
-            sums[k].sum += b->sum;
-            sums[k].sum_squares += b->sum_squares;
+            for (int c = 0; c < 3; ++c) {
+                sums[k].sum[c] += b->sum[c];
+                sums[k].sum_squares[c] += b->sum_squares[c];
+            }
             sums[k].cost += b->cost;
         }
     free(run.block_sums);
@@ -750,61 +830,90 @@ static int run_pilot(dwvb_bake *bake, const dwvb_shader *shaders, uint32_t sampl
 static int choose_auto(dwvb_bake *bake)
 {
     const dwvb_scene *scene = bake->scene;
-    uint32_t meshes = scene->mesh_count, candidates = 0;
-    for (uint32_t m = 0; m < meshes; ++m) candidates += (uint32_t)bake->auto_choice[m];
-    if (candidates == 0) return 0;
+    uint32_t meshes = scene->mesh_count, deciding = 0;
+    int separable = 0;
+    for (uint32_t m = 0; m < meshes; ++m) {
+        deciding += (uint32_t)bake->auto_choice[m];
+        separable |= bake->auto_choice[m] && !scene->shading[scene->meshes[m].material_id].grey;
+    }
+    if (deciding == 0) return 0;
     uint64_t budget = active_pixels(bake) * bake->options.samples / 16u;
     if (budget < PILOT_MIN) return 0;
     uint32_t n = budget < PILOT_MAX ? (uint32_t)budget : PILOT_MAX;
-    dwvw_guide *trial = malloc(PILOT_CANDIDATES * (size_t)meshes * sizeof *trial);
-    int *trial_closest = malloc(PILOT_CANDIDATES * (size_t)meshes * sizeof *trial_closest);
-    pilot_sums *sums = calloc(PILOT_CANDIDATES * (size_t)meshes, sizeof *sums); /* [candidate][mesh] */
-    if (!trial || !trial_closest || !sums) {
-        free(trial);
-        free(trial_closest);
-        free(sums);
-        return -1;
-    }
+    /* Which forms run: the option's, or both where some deciding mesh has channels that differ. */
+    int candidates[PILOT_CANDIDATES], candidate_count = 0;
+    int shared = bake->options.channel_walks != DWV_CHANNEL_WALKS_SEPARATE || !separable;
+    int separate = separable && bake->options.channel_walks != DWV_CHANNEL_WALKS_SHARED;
+    for (int c = 0; c < PILOT_CANDIDATES; ++c)
+        if (c < PILOT_TECHNIQUES ? shared : separate) candidates[candidate_count++] = c;
+    size_t slots = PILOT_CANDIDATES * (size_t)meshes;
+    dwvw_guide *trial = malloc(slots * sizeof *trial);
+    dwvw_guide *trial_channels = malloc(3u * slots * sizeof *trial_channels);
+    int *trial_closest = malloc(slots * sizeof *trial_closest);
+    int *trial_walks = malloc(slots * sizeof *trial_walks);
+    pilot_sums *sums = calloc(slots, sizeof *sums); /* [candidate][mesh] */
+    int stopped = -1;
+    if (!trial || !trial_channels || !trial_closest || !trial_walks || !sums) goto done;
     dwvb_shader shaders[PILOT_CANDIDATES];
-    for (int candidate = 0; candidate < PILOT_CANDIDATES; ++candidate) {
-        dwvw_guide *guides = &trial[(size_t)candidate * meshes];
-        int *closest = &trial_closest[(size_t)candidate * meshes];
+    for (int k = 0; k < candidate_count; ++k) {
+        int candidate = candidates[k];
+        size_t base = (size_t)candidate * meshes;
         for (uint32_t m = 0; m < meshes; ++m) {
-            if (bake->auto_choice[m]) pilot_guide(bake, m, candidate, &guides[m]);
-            else guides[m] = bake->guides[m];
-            closest[m] = dwvw_guide_needs_closest(&guides[m]);
+            const dwvb_material *material = &scene->shading[scene->meshes[m].material_id];
+            if (bake->auto_choice[m]) {
+                pilot_candidate(bake, m, candidate, &trial[base + m], &trial_channels[3u * (base + m)],
+                                &trial_walks[base + m]);
+            } else {
+                trial[base + m] = bake->guides[m];
+                for (int c = 0; c < 3; ++c) trial_channels[3u * (base + m) + (size_t)c] = bake->channel_guides[3u * m + (uint32_t)c];
+                trial_walks[base + m] = bake->channel_walks[m];
+            }
+            trial_closest[base + m] = material->subsurface &&
+                                      mesh_needs_closest(material, trial_walks[base + m], &trial[base + m],
+                                                         &trial_channels[3u * (base + m)]);
         }
         shaders[candidate] = bake->shader;
-        shaders[candidate].guides = guides;
-        shaders[candidate].needs_closest = closest;
+        shaders[candidate].guides = &trial[base];
+        shaders[candidate].channel_guides = &trial_channels[3u * base];
+        shaders[candidate].channel_walks = &trial_walks[base];
+        shaders[candidate].needs_closest = &trial_closest[base];
     }
-    int stopped = run_pilot(bake, shaders, n, sums);
+    stopped = run_pilot(bake, shaders, candidates, candidate_count, n, sums);
     if (stopped == 0) {
         for (uint32_t m = 0; m < meshes; ++m) {
             /* Every candidate traced the same camera rays, so each saw the mesh equally often. */
-            if (!bake->auto_choice[m] || sums[m].count < PILOT_MESH_MIN) continue;
-            /* variance x cost, per sample that saw the mesh */
-            int best = PILOT_CLASSICAL;
+            if (!bake->auto_choice[m] || sums[(size_t)candidates[0] * meshes + m].count < PILOT_MESH_MIN) continue;
+            /* variance x cost, per sample that saw the mesh; the variance is the three channels'
+             * together, as the image's RMSE over RGB counts it: the luminance would hide the
+             * colour noise of shared walks, whose channels' weights move against each other. */
+            int best = candidates[0];
             double best_work = INFINITY;
-            for (int c = 0; c < PILOT_CANDIDATES; ++c) {
-                const pilot_sums *p = &sums[(size_t)c * meshes + m];
-                double mean = p->sum / p->count;
-                double variance = fmax(p->sum_squares / p->count - mean * mean, 0.0) * p->count / (p->count - 1.0);
+            for (int k = 0; k < candidate_count; ++k) {
+                const pilot_sums *p = &sums[(size_t)candidates[k] * meshes + m];
+                double variance = 0.0;
+                for (int c = 0; c < 3; ++c) {
+                    double mean = p->sum[c] / p->count;
+                    variance += fmax(p->sum_squares[c] / p->count - mean * mean, 0.0) * p->count / (p->count - 1.0);
+                }
                 double work = variance * (p->cost / p->count);
                 if (work < best_work) {
                     best_work = work;
-                    best = c;
+                    best = candidates[k];
                 }
             }
-            dwvw_guide chosen;
-            pilot_guide(bake, m, best, &chosen);
-            bake->guides[m] = chosen;
-            bake->needs_closest[m] = dwvw_guide_needs_closest(&chosen);
+            size_t slot = (size_t)best * meshes + m;
+            bake->guides[m] = trial[slot];
+            for (int c = 0; c < 3; ++c) bake->channel_guides[3u * m + (uint32_t)c] = trial_channels[3u * slot + (size_t)c];
+            bake->channel_walks[m] = trial_walks[slot];
+            bake->needs_closest[m] = trial_closest[slot];
         }
         update_features(bake);
     }
+done:
     free(trial);
+    free(trial_channels);
     free(trial_closest);
+    free(trial_walks);
     free(sums);
     return stopped;
 }
@@ -843,6 +952,8 @@ dwv_result_t dwvb_bake_start(dwvb_scene *scene, const dwv_bake_options_t *option
     bake->tile_count = bake->tiles_x * ((bake->height + tile - 1u) / tile);
     uint32_t meshes = scene->mesh_count ? scene->mesh_count : 1u;
     bake->guides = calloc(meshes, sizeof *bake->guides);
+    bake->channel_guides = calloc(3u * (size_t)meshes, sizeof *bake->channel_guides);
+    bake->channel_walks = calloc(meshes, sizeof *bake->channel_walks);
     bake->needs_closest = calloc(meshes, sizeof *bake->needs_closest);
     bake->auto_choice = calloc(meshes, sizeof *bake->auto_choice);
     bake->sums = calloc(pixels, sizeof *bake->sums);
@@ -852,7 +963,7 @@ dwv_result_t dwvb_bake_start(dwvb_scene *scene, const dwv_bake_options_t *option
     bake->tile_seconds = calloc(bake->tile_count, sizeof *bake->tile_seconds);
     bake->tile_ranking = malloc(bake->tile_count * sizeof *bake->tile_ranking);
     bake->image = dwvb_image_new(bake->width, bake->height);
-    if (!bake->guides || !bake->needs_closest || !bake->auto_choice || !bake->sums || !bake->counts ||
+    if (!bake->guides || !bake->channel_guides || !bake->channel_walks || !bake->needs_closest || !bake->auto_choice || !bake->sums || !bake->counts ||
         !bake->tile_tallies || !bake->tile_order || !bake->tile_seconds || !bake->tile_ranking || !bake->image) {
         release_parts(bake);
         snprintf(message, size, "out of memory for a %u x %u bake", options->width, options->height);
@@ -878,6 +989,8 @@ dwv_result_t dwvb_bake_start(dwvb_scene *scene, const dwv_bake_options_t *option
     bake->shader.env.world_lit = dwvb_scene_world_lit(scene);
     bake->shader.env.geometry = scene->mesh_count ? &scene->geometry : NULL;
     bake->shader.guides = bake->guides;
+    bake->shader.channel_guides = bake->channel_guides;
+    bake->shader.channel_walks = bake->channel_walks;
     bake->shader.needs_closest = bake->needs_closest;
     bake->shader.max_events = options->max_events;
     clock_gettime(CLOCK_MONOTONIC, &bake->start);

@@ -127,4 +127,6 @@ void dwvb_material_init(dwvb_material *out, const dwv_material_t *in)
                 alpha[1] == alpha[2] && out->walk_scale[0] == out->walk_scale[1] &&
                 out->walk_scale[1] == out->walk_scale[2];
     dwvw_medium_init(&out->medium, out->grey ? 1 : 3, sigma_t, alpha, g);
+    for (int c = 0; c < 3; ++c)
+        if (!out->grey && out->walk_scale[c] > 0.0) dwvw_medium_init(&out->channel_medium[c], 1, &sigma_t[c], &alpha[c], g);
 }

@@ -44,6 +44,9 @@ typedef struct dwvb_material {
     double walk_scale[3];      /* w x Cycles' low-albedo compensation; 0 where a channel does not walk */
     int grey;                  /* all three channels walk alike: one-channel walks */
     dwvw_medium medium;
+    /* Each walking channel's own one-channel medium, for walks that carry one channel (channel
+     * walks, shade.h); unset where walk_scale[c] is 0 or the material is grey. */
+    dwvw_medium channel_medium[3];
 } dwvb_material;
 
 /* Cycles' albedo inversion: the single-scattering albedo for multiple-scattering albedo A in

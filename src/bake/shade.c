@@ -27,14 +27,14 @@ static uint64_t mixture_terms(const dwvw_walk *walk, uint64_t per_component, uin
  * after a ray that met nothing (the same walk and image, bit for bit). Walks meet only their own
  * mesh, so this holds for open meshes too. The first step (the probe, which the backward
  * technique needs in full) is always a ray (its origin is on the surface: no ball there). */
-static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvb_material *material, uint32_t entry_prim, dwvw_vec3 x, dwvw_vec3 direction, dwvw_vec3 entry_normal, uint64_t key,
+static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvw_medium *medium, const dwvw_guide *guide,
+                    uint32_t entry_prim, dwvw_vec3 x, dwvw_vec3 direction, dwvw_vec3 entry_normal, uint64_t key,
                     const dwvk_sampler *sampler, uint32_t walk_pair, dwvw_walk *walk, dwvg_hit *exit, dwvb_tally *tally)
 {
     const dwvg_world *world = &shader->scene->geometry;
     const dwvg_mesh *m = &shader->scene->meshes[mesh];
     const dwvg_clearance *grid = &world->clearance[mesh];
-    dwvw_walk_begin(walk, &material->medium, &shader->guides[mesh], key, shader->max_events, x, direction,
-                    entry_normal);
+    dwvw_walk_begin(walk, medium, guide, key, shader->max_events, x, direction, entry_normal);
     dwvw_walk_stratify(walk, sampler, walk_pair, DWVB_STRATIFIED_EVENTS);
     int needs_closest = shader->needs_closest[mesh];
     dwvb_ball_mode ball_mode = shader->scene->ball_mode;
@@ -103,10 +103,6 @@ static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvb_materia
     }
     tally->events += walk->events;
     ++tally->walks;
-    if (walk->status == DWVW_TRUNCATED) {
-        int channels = material->medium.channels;
-        for (int c = 0; c < 3; ++c) tally->truncated[c] += walk->weight[channels == 1 ? 0 : c] * material->walk_scale[c];
-    }
     return walk->status == DWVW_EXITED;
 }
 
@@ -138,6 +134,27 @@ static double exit_factor(const void *context, dwvw_vec3 light)
 {
     const dwvw_vec3 *n = context;
     return dwvb_principled_exit_factor(dwvw_dot(*n, light));
+}
+
+/* The light a walk gathers where it left mesh `mesh` (exit: its hit), from the sampler's light
+ * pairs from `pair` on: the Lambertian exit's (or Blender 3.x Principled's) direct light. */
+static void exit_light(const dwvb_shader *shader, uint32_t mesh_id, const dwvb_material *material, const dwvw_walk *walk,
+                       const dwvg_hit *exit, const dwvk_sampler *sampler, uint32_t pair, double direct[3])
+{
+    const dwvb_scene *scene = shader->scene;
+    const dwvg_mesh *mesh = &scene->meshes[mesh_id];
+    dwvw_vec3 exit_ng = walk->exit_normal;
+    dwvw_vec3 exit_n = dwvg_shading_normal(mesh, exit->prim, exit->u, exit->v, exit_ng);
+    /* Cycles shades the exit as a surface point of its triangle: the same terminator offset. */
+    double cutoff = scene->terminator_offsets[mesh_id];
+    dwvl_terminator exit_terminator = {mesh, exit->prim, exit->u, exit->v, cutoff};
+    const dwvl_terminator *exit_smooth = mesh->normals && cutoff > 0.0 ? &exit_terminator : NULL;
+    double exit_top = dwvg_world_top(&scene->geometry, mesh_id, exit->prim);
+    if (material->principled_v1)
+        dwvl_direct_lobe(&shader->env, walk->position, exit_n, exit_ng, exit_smooth, exit_top, sampler, pair, exit_factor,
+                         &exit_n, NULL, direct);
+    else
+        dwvl_direct(&shader->env, walk->position, exit_n, exit_ng, exit_smooth, exit_top, sampler, pair, direct);
 }
 
 void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, const dwvk_sampler *sampler,
@@ -200,25 +217,35 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, 
     double mu = sqrt(u[0]);
     dwvw_vec3 inward = dwvw_direction_about(dwvw_scale(n, -1.0), mu, 1.0 - mu, 1.0 + mu, u[1]);
     if (!(dwvw_dot(inward, ng) < 0.0)) return;
-    dwvw_walk walk;
-    dwvg_hit exit = {0};
     /* The walk's first events take the pairs after the exit's lights (walk.h, DWVW_PAIR_*). */
     uint32_t walk_pair = pair + DWVB_SHADE_PAIRS + 2u * light_pairs;
-    if (!run_walk(shader, hit->mesh, material, hit->prim, x, inward, n, key_walk, sampler, walk_pair, &walk, &exit,
-                  tally))
-        return;
-    dwvw_vec3 exit_ng = walk.exit_normal;
-    dwvw_vec3 exit_n = dwvg_shading_normal(mesh, exit.prim, exit.u, exit.v, exit_ng);
-    /* Cycles shades the exit as a surface point of its triangle: the same terminator offset. */
-    dwvl_terminator exit_terminator = {mesh, exit.prim, exit.u, exit.v, cutoff};
-    const dwvl_terminator *exit_smooth = mesh->normals && cutoff > 0.0 ? &exit_terminator : NULL;
-    double exit_top = dwvg_world_top(&scene->geometry, hit->mesh, exit.prim);
+    uint32_t exit_pair = pair + DWVB_SHADE_PAIRS + light_pairs;
+    dwvw_walk walk;
+    dwvg_hit exit = {0};
     double direct[3];
-    if (material->principled_v1)
-        dwvl_direct_lobe(&shader->env, walk.position, exit_n, exit_ng, exit_smooth, exit_top, sampler, pair + DWVB_SHADE_PAIRS + light_pairs,
-                         exit_factor, &exit_n, NULL, direct);
-    else
-        dwvl_direct(&shader->env, walk.position, exit_n, exit_ng, exit_smooth, exit_top, sampler, pair + DWVB_SHADE_PAIRS + light_pairs, direct);
+    if (shader->channel_walks && shader->channel_walks[hit->mesh]) {
+        /* Channel walks: each channel's estimate is its own walk's (its own extinction, albedo and
+         * Dwivedi distribution), so no channel's weight carries another's sampling pdf. They
+         * share the entry and the pixel's stratified numbers (each channel is stratified over the
+         * pixel's samples); their counter-based numbers differ. */
+        for (int c = 0; c < 3; ++c) {
+            if (!(material->walk_scale[c] > 0.0)) continue;
+            int exited = run_walk(shader, hit->mesh, &material->channel_medium[c],
+                                  &shader->channel_guides[3u * hit->mesh + (uint32_t)c], hit->prim, x, inward, n,
+                                  dwvk_mix64(key_walk + (uint64_t)c), sampler, walk_pair, &walk, &exit, tally);
+            if (walk.status == DWVW_TRUNCATED) tally->truncated[c] += walk.weight[0] * material->walk_scale[c];
+            if (!exited) continue;
+            exit_light(shader, hit->mesh, material, &walk, &exit, sampler, exit_pair, direct);
+            rgb[c] += walk.weight[0] * material->walk_scale[c] * direct[c];
+        }
+        return;
+    }
+    int exited = run_walk(shader, hit->mesh, &material->medium, &shader->guides[hit->mesh], hit->prim, x, inward, n,
+                          key_walk, sampler, walk_pair, &walk, &exit, tally);
     int grey = material->medium.channels == 1;
+    if (walk.status == DWVW_TRUNCATED)
+        for (int c = 0; c < 3; ++c) tally->truncated[c] += walk.weight[grey ? 0 : c] * material->walk_scale[c];
+    if (!exited) return;
+    exit_light(shader, hit->mesh, material, &walk, &exit, sampler, exit_pair, direct);
     for (int c = 0; c < 3; ++c) rgb[c] += walk.weight[grey ? 0 : c] * material->walk_scale[c] * direct[c];
 }

@@ -19,7 +19,12 @@ typedef struct dwvb_shader {
     const dwvb_scene *scene;
     dwvl_environment env;
     const dwvw_guide *guides;     /* per mesh (used where its material scatters) */
-    const int *needs_closest;     /* per mesh */
+    const int *needs_closest;     /* per mesh, for its guides and channel guides alike */
+    /* Per mesh: 1 where a sample runs one walk per walking colour channel, each in that channel's
+     * own medium (material.h channel_medium) with channel_guides[3 m + c], instead of one walk
+     * that carries the three channels by spectral MIS. NULL: none does. */
+    const int *channel_walks;
+    const dwvw_guide *channel_guides;
     uint32_t max_events;
 } dwvb_shader;
 

@@ -20,7 +20,7 @@ static void help(FILE *out)
 {
     fprintf(out,
             "usage: dwivedi bake [SCENE.json] --out PREFIX [--spp N] [--time SECONDS] [--error REL]\n"
-            "           [--technique T] [--threads N] [--seed S] [--width W] [--height H]\n"
+            "           [--technique T] [--channel-walks C] [--threads N] [--seed S] [--width W] [--height H]\n"
             "           [--ocio CONFIG] [--display NAME] [--view NAME] [--look NAME]\n"
             "           [--exposure E] [--gamma G] [--quiet]\n\n"
             "Bakes SCENE.json (docs/scene-format.md), or without it the built-in default scene: a thin\n"
@@ -35,6 +35,8 @@ static void help(FILE *out)
             "                 --error stop the bake at whichever comes first\n"
             "  --time S       wall-time budget in seconds          --error R  target relative error\n"
             "  --technique T  auto (default), classical, poe, closest, incident, backward, cycles\n"
+            "  --channel-walks C  auto (default: auto's pilot chooses), shared (one walk carries the\n"
+            "                 three colour channels, spectral MIS) or separate (one walk per channel)\n"
             "  --threads N    worker threads (default: all cores); the image does not depend on it\n"
             "  --seed S       random seed (default: the scene's, else 0)\n"
             "  --width W, --height H   image size (default: the scene's)\n"
@@ -74,7 +76,8 @@ static int parse_overrides(int argc, char **argv, bake_flags *f, dwv_bake_option
         }
         static const char *const flags[] = {"--out",     "--spp",   "--time",    "--error",   "--technique",
                                             "--threads", "--seed",  "--width",   "--height",  "--ocio",
-                                            "--display", "--view",  "--look",    "--exposure", "--gamma"};
+                                            "--display", "--view",  "--look",    "--exposure", "--gamma",
+                                            "--channel-walks"};
         int known = 0;
         for (size_t k = 0; k < sizeof flags / sizeof flags[0]; ++k) known |= strcmp(flag, flags[k]) == 0;
         if (!known) return cli_usage_error(verb, "unknown argument '%.64s'", flag);
@@ -101,6 +104,11 @@ static int parse_overrides(int argc, char **argv, bake_flags *f, dwv_bake_option
             if (dwv_technique_from_name(value, &technique) != DWV_SUCCESS)
                 return cli_usage_error(verb, "--technique: %s", dwv_last_error_message());
             if (apply) o->technique = technique;
+        } else if (strcmp(flag, "--channel-walks") == 0) {
+            dwv_channel_walks_t channel_walks;
+            if (dwv_channel_walks_from_name(value, &channel_walks) != DWV_SUCCESS)
+                return cli_usage_error(verb, "--channel-walks: %s", dwv_last_error_message());
+            if (apply) o->channel_walks = channel_walks;
         } else if (strcmp(flag, "--time") == 0 || strcmp(flag, "--error") == 0) {
             if (cli_parse_double(verb, flag, value, &number)) return CLI_USAGE;
             if (apply) *(flag[2] == 't' ? &o->time_limit : &o->target_error) = number;

@@ -64,7 +64,8 @@ static int64_t write_to_sink(exr_const_context_t ctxt, void *userdata, const voi
 /* The names of DWV_FEATURE_* bits, as capi/dwivedi.h lists them. */
 static const char *const feature_names[] = {"embree",        "subsurface",    "closest_point",
                                             "incident_patches", "rgb_walks", "guided",
-                                            "world_light",   "direct_lights", "diffuse_surfaces"};
+                                            "world_light",   "direct_lights", "diffuse_surfaces",
+                                            "channel_walks"};
 
 static void features_string(uint32_t bits, char *out, size_t size)
 {

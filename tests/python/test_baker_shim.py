@@ -384,10 +384,32 @@ class BakeTest(unittest.TestCase):
             with self.assertRaises(dwivedi.Error):
                 scene.bake(target="uv", uv_mesh=7, width=8, height=8, samples=1)
 
+    def test_channel_walks(self):
+        with cube_scene().commit() as scene:
+            features = {}
+            for channel_walks in ("shared", "separate", "auto"):
+                image = dwivedi.bake(scene, width=8, height=8, samples=4, threads=2, seed=5, technique="classical",
+                                     channel_walks=channel_walks)
+                features[channel_walks] = image.stats.features
+                self.assertTrue(all(math.isfinite(v) for v in image.pixels()))
+            self.assertIn("channel_walks", features["separate"])
+            self.assertNotIn("rgb_walks", features["separate"])
+            # An explicit technique walks the channels together unless told otherwise.
+            for name in ("shared", "auto"):
+                self.assertIn("rgb_walks", features[name])
+                self.assertNotIn("channel_walks", features[name])
+            self.assertEqual(dwivedi.BakeSettings(channel_walks="separate")._to_c().channel_walks, 2)
+            for bad in ("apart", "", 3):
+                with self.assertRaises(dwivedi.Error, msg=repr(bad)):
+                    dwivedi.bake(scene, width=8, height=8, samples=1, channel_walks=bad)
+            for bad in (None, 1.0, True):
+                with self.assertRaises(TypeError, msg=repr(bad)):
+                    dwivedi.bake(scene, width=8, height=8, samples=1, channel_walks=bad)
+
     def test_bad_settings(self):
         with cube_scene().commit() as scene:
             for overrides in ({"samples": 0}, {"width": 0}, {"time_limit": -1.0}, {"technique": "magic"},
-                              {"target": "screen"}):
+                              {"target": "screen"}, {"channel_walks": "magic"}):
                 with self.assertRaises(dwivedi.Error, msg=str(overrides)):
                     dwivedi.bake(scene, **{"width": 8, "height": 8, "samples": 1, **overrides})
             with self.assertRaises(TypeError):

@@ -30,11 +30,12 @@ def tool_module():
 class Fit(unittest.TestCase):
     def test_recovers_known_costs(self):
         fit = tool_module()
-        truth = [4000.0, 650.0, 350.0, 750.0, 6500.0, 45.0]
-        counts = [[1000, 5000, 0, 3000, 0, 45000], [1000, 3500, 3500, 2800, 0, 31000],
-                  [1000, 6000, 6000, 5900, 0, 110000], [1000, 900, 900, 500, 950, 8000],
-                  [1000, 800, 0, 760, 0, 7000], [1000, 5100, 5100, 7000, 0, 52000],
-                  [1000, 10000, 10000, 4000, 0, 190000]]
+        # samples, walks, events, guided events, rays, queries, terms
+        truth = [4000.0, 550.0, 650.0, 350.0, 750.0, 6500.0, 45.0]
+        counts = [[1000, 500, 5000, 0, 3000, 0, 45000], [1000, 500, 3500, 3500, 2800, 0, 31000],
+                  [1000, 1500, 6000, 6000, 5900, 0, 110000], [1000, 100, 900, 900, 500, 950, 8000],
+                  [1000, 300, 800, 0, 760, 0, 7000], [1000, 1000, 5100, 5100, 7000, 0, 52000],
+                  [1000, 3000, 10000, 10000, 4000, 0, 190000], [1000, 1000, 9000, 0, 4000, 0, 20000]]
         rows = [([float(c) for c in x], sum(t * c for t, c in zip(truth, x))) for x in counts]
         coef, rms = fit.fit(rows)
         self.assertLess(rms, 1e-9)
@@ -44,12 +45,13 @@ class Fit(unittest.TestCase):
     def test_costs_stay_non_negative(self):
         # Costs that fall with the ray count: the unconstrained fit's ray cost is negative.
         fit = tool_module()
-        counts = [[100, 500, 0, 100, 0, 900], [100, 500, 0, 900, 0, 900], [100, 900, 900, 300, 0, 2000],
-                  [100, 300, 300, 600, 10, 700], [100, 700, 0, 200, 0, 1500], [100, 600, 600, 800, 0, 1000]]
-        rows = [([float(c) for c in x], 1000.0 + 10.0 * x[1] - 2.0 * x[3] + 30.0 * x[4] + x[5])
+        counts = [[100, 50, 500, 0, 100, 0, 900], [100, 50, 500, 0, 900, 0, 900], [100, 150, 900, 900, 300, 0, 2000],
+                  [100, 50, 300, 300, 600, 10, 700], [100, 100, 700, 0, 200, 0, 1500],
+                  [100, 300, 600, 600, 800, 0, 1000], [100, 200, 400, 0, 500, 0, 300]]
+        rows = [([float(c) for c in x], 1000.0 + 5.0 * x[1] + 10.0 * x[2] - 2.0 * x[4] + 30.0 * x[5] + x[6])
                 for x in counts]
         coef, rms = fit.fit(rows)
-        self.assertEqual(len(coef), 6)
+        self.assertEqual(len(coef), 7)
         self.assertTrue(all(c >= 0.0 for c in coef), coef)
         self.assertGreater(rms, 0.0)
 

@@ -95,7 +95,13 @@ static void test_energy(void)
             double loss = 1e-6 * (double)st.events / (double)(st.walks ? st.walks : 1u);
             CHECK(st.walks > 0 && (st.features & DWV_FEATURE_SUBSURFACE), "walks %llu features %x",
                   (unsigned long long)st.walks, st.features);
-            CHECK(((st.features & DWV_FEATURE_RGB_WALKS) != 0) == (which == 1), "rgb walks feature %x", st.features);
+            /* Coloured media walk their channels together (rgb walks) or, where auto's pilot
+             * chooses so, apart (channel walks); grey ones walk once. */
+            int rgb_walks = (st.features & DWV_FEATURE_RGB_WALKS) != 0,
+                channel_walks = (st.features & DWV_FEATURE_CHANNEL_WALKS) != 0;
+            CHECK(which == 1 ? rgb_walks + channel_walks == 1 && (!channel_walks || techniques[t] == DWV_TECHNIQUE_AUTO)
+                             : !rgb_walks && !channel_walks,
+                  "rgb walks feature %x", st.features);
             double mean[3], sigma[3];
             for (int c = 0; c < 3; ++c) {
                 image_mean(image, c, &mean[c], &sigma[c]);
@@ -321,8 +327,12 @@ static void test_cancel_and_budgets(void)
  * covered pixels' luminance; the bound allows for the variance estimates' own noise at 64 spp
  * (20% either way) and, above, for the estimate's known excess under stratified samples: it
  * treats a pixel's samples as independent, while stratified ones are negatively correlated
- * (docs/speed.md: 1.08x to 1.38x). Here, seeds 11 and 12: classical walks 1.11x, the
- * entry-normal walks auto picks 1.28x (incident 1.28x). */
+ * (docs/speed.md: 1.08x to 1.38x with shared walks). Channel walks share a sample's stratified
+ * numbers over three walks, and the image gains from that stratification far more than the
+ * estimate sees: here, seeds 11 and 12, auto's channel walks 2.2x (classical shared walks 1.11x,
+ * entry-normal shared 1.28x). Even so a target_error bake stops sooner with them than with shared
+ * walks (the per-sample variance the estimate sees is lower for less than its cost); independent
+ * replicates would measure the error without the excess. */
 static void test_error_estimate_is_the_rmse(void)
 {
     dwv_scene_t *scene = mixed_scene();
@@ -353,7 +363,7 @@ static void test_error_estimate_is_the_rmse(void)
         double measured = sqrt(squares / covered / 2.0) / (total / covered);
         double estimated = 0.5 * (st[0].estimated_relative_error + st[1].estimated_relative_error);
         printf("relative RMSE at 64 spp: estimated %.4f, measured from two seeds %.4f\n", estimated, measured);
-        CHECK(estimated / measured > 0.8 && estimated / measured < 1.45, "estimated %.4f against measured %.4f",
+        CHECK(estimated / measured > 0.8 && estimated / measured < 2.5, "estimated %.4f against measured %.4f",
               estimated, measured);
     }
     dwv_image_release(images[0]);
@@ -536,7 +546,7 @@ static void test_feature_names(void)
     int named = 0;
     for (uint32_t bit = 0; bit < 32; ++bit) {
         const char *name = dwv_feature_name(1u << bit);
-        if (bit <= 8) {
+        if (bit <= 9) {
             CHECK(name != NULL, "bit %u has no name", bit);
             ++named;
         } else {
@@ -544,7 +554,7 @@ static void test_feature_names(void)
         }
     }
     CHECK(dwv_feature_name(0) == NULL && dwv_feature_name(3) == NULL, "not single bits");
-    CHECK(named == 9 && strcmp(dwv_feature_name(DWV_FEATURE_CLOSEST_POINT), "closest_point") == 0, "names");
+    CHECK(named == 10 && strcmp(dwv_feature_name(DWV_FEATURE_CLOSEST_POINT), "closest_point") == 0, "names");
 }
 
 int main(void)
