@@ -644,7 +644,8 @@ DWV_API void dwv_bake_release(dwv_bake_t *bake);
 DWV_API dwv_result_t dwv_bake(dwv_scene_t *scene, const dwv_bake_options_t *options, dwv_image_t **image);
 
 /* The pixels of an image: RGBA scene-linear Rec.709, row 0 at the top; the estimate's variance
- * (of the pixel mean, per channel RGB) and each pixel's sample count. Pointers stay valid while
+ * (of the pixel mean, per channel RGB, from the samples' own variance as if they were independent:
+ * stratified samples make it an upper bound) and each pixel's sample count. Pointers stay valid while
  * the image lives. UV bakes leave alpha 0 on texels outside every island and its margin. */
 typedef struct dwv_image_info_t {
     uint32_t struct_size;   /* sizeof(dwv_image_info_t): set by DWV_IMAGE_INFO_INIT */
@@ -658,8 +659,10 @@ typedef struct dwv_image_info_t {
 DWV_API dwv_result_t dwv_image_info(const dwv_image_t *image, dwv_image_info_t *info);
 
 /* What a bake did. The estimated relative error is the image's relative RMSE against its converged
- * self, from the pixels' own variances: sqrt(mean of the pixel-mean luminance variances) / mean
- * pixel luminance, over the covered pixels (target_error of the options is in the same terms). */
+ * self: sqrt(mean of the pixel-mean luminance variances) / mean pixel luminance, over the covered
+ * pixels (target_error of the options is in the same terms). Each pixel's samples form two
+ * independent stratified replicates, whose spread gives the variances; below 64 covered pixels the
+ * samples' own variances do, which overstate it under stratification. */
 typedef struct dwv_bake_stats_t {
     uint32_t struct_size;    /* sizeof(dwv_bake_stats_t): set by DWV_BAKE_STATS_INIT */
     dwv_technique_t technique;

@@ -21,9 +21,13 @@
 #define PILOT_STREAM 0x2000000000000000ull
 #define PROGRESS_PERIOD 0.1 /* seconds between progress callbacks */
 
+/* A pixel's samples form two independent replicates (sample_with): even samples and odd ones. */
+#define REPLICATES 2u
+
 typedef struct pixel_sums {
     double sum[3], sum_squares[3];
     double sum_alpha, sum_luminance_squares;
+    double replicate_luminance[REPLICATES]; /* the sum of each replicate's luminances */
 } pixel_sums;
 
 struct dwvb_bake {
@@ -116,9 +120,12 @@ static void sample_with(const dwvb_bake *bake, const dwvb_shader *shader, uint64
                         double rgb[3], double *alpha, uint32_t *mesh_seen, dwvb_tally *tally)
 {
     /* Pixel position, entry direction, light points and the walk's first events (shade.h,
-     * DWVB_STRATIFIED_EVENTS): stratified per pixel (kernel/sampler.h). */
-    dwvk_sampler sampler = {.key = dwvk_rng_key(bake->options.seed, stream | PIXEL_STREAM | index, 0u), .index = s,
-                            .stratified = 1};
+     * DWVB_STRATIFIED_EVENTS): stratified per pixel (kernel/sampler.h), in REPLICATES independent
+     * stratified sets, sample s in replicate s mod REPLICATES with its own scrambling: the spread
+     * between the replicates' means measures the pixel's error, stratification included
+     * (estimate_error). */
+    dwvk_sampler sampler = {.key = dwvk_rng_key(bake->options.seed, stream | PIXEL_STREAM | index, s % REPLICATES),
+                            .index = s / REPLICATES, .stratified = 1};
     uint64_t key_walk = dwvk_rng_key(bake->options.seed, stream | WALK_STREAM | index, s);
     *mesh_seen = UINT32_MAX;
     uint32_t x = index % bake->width, row = index / bake->width;
@@ -211,6 +218,7 @@ static void *worker(void *arg)
                     }
                     double l = luminance(rgb);
                     p->sum_luminance_squares += l * l;
+                    p->replicate_luminance[s % REPLICATES] += l;
                     p->sum_alpha += alpha;
                     ++bake->counts[index];
                 }
@@ -255,17 +263,30 @@ static double mean_variance(double sum, double sum_squares, uint32_t n)
     return v > 0.0 ? v : 0.0;
 }
 
-/* The image's relative RMSE against its converged self, estimated from the pixels' own variances:
- * sqrt(mean over the covered pixels of the variance of the pixel's mean luminance) / (mean of the
- * pixels' mean luminances) = sqrt(N sum var) / sum luminance for N covered pixels. This is the
- * "relative RMSE" of an image against a reference (RMSE / mean), so a target of 0.01 means noise
- * of 1% of the image's brightness per pixel. +inf while a covered pixel has fewer than two
- * samples, 0 for an image that is black with no variance. */
+/* Below this many covered pixels the image's error comes from the samples' own variance instead
+ * of the replicates' spread: with N pixels the spread has N degrees of freedom, its relative
+ * standard error sqrt(2 / N) in the variance (18% at 64), and one of a few pixels could by chance
+ * say the image is done long before it is. */
+#define REPLICATE_MIN_PIXELS 64.0
+
+/* The image's relative RMSE against its converged self: sqrt(mean over the covered pixels of the
+ * variance of the pixel's mean luminance) / (mean of the pixels' mean luminances) =
+ * sqrt(N sum var) / sum luminance for N covered pixels. This is the "relative RMSE" of an image
+ * against a reference (RMSE / mean), so a target of 0.01 means noise of 1% of the image's
+ * brightness per pixel. +inf while a covered pixel has fewer than two samples, 0 for an image that
+ * is black with no variance.
+ * A pixel's variance is measured by its two replicates (sample_with): means m0, m1 of n0, n1
+ * samples are independent and unbiased, so E[(m0 - m1)^2] = V0 + V1, and with V_r = c / n_r the
+ * variance of the pixel's mean, c / n, is E[(m0 - m1)^2] n0 n1 / n^2. The samples' own variance
+ * (x^2 sums) would treat a pixel's samples as independent, while stratified ones are negatively
+ * correlated, and overstate the error: 1.1x to 1.4x with shared walks, 2.2x with channel walks,
+ * which share a sample's stratified numbers over three walks (docs/speed.md). It is used below
+ * REPLICATE_MIN_PIXELS covered pixels, where the replicates' spread is too noisy. */
 static double estimate_error(const dwvb_bake *bake)
 {
     int any = any_surface_seen(bake);
     size_t pixels = (size_t)bake->width * bake->height;
-    double variance = 0.0, total = 0.0, count = 0.0;
+    double spread = 0.0, own = 0.0, total = 0.0, count = 0.0;
     for (size_t i = 0; i < pixels; ++i) {
         if (!covered(bake, (uint32_t)i, any)) continue;
         count += 1.0;
@@ -274,8 +295,12 @@ static double estimate_error(const dwvb_bake *bake)
         const pixel_sums *p = &bake->sums[i];
         double l = luminance(p->sum);
         total += l / n;
-        variance += mean_variance(l, p->sum_luminance_squares, n);
+        own += mean_variance(l, p->sum_luminance_squares, n);
+        double n0 = (double)((n + 1u) / 2u), n1 = (double)(n / 2u);
+        double d = p->replicate_luminance[0] / n0 - p->replicate_luminance[1] / n1;
+        spread += d * d * n0 * n1 / ((double)n * (double)n);
     }
+    double variance = count >= REPLICATE_MIN_PIXELS ? spread : own;
     if (variance == 0.0) return 0.0;
     return total > 0.0 ? sqrt(count * variance) / total : INFINITY;
 }
