@@ -854,8 +854,8 @@ static dwv_result_t read_seed(const cJSON *item, uint64_t *seed)
 static dwv_result_t read_bake(parser *ps, const cJSON *item)
 {
     static const char *const keys[] = {"target",  "width",       "height",  "samples",   "technique",
-                                       "time_limit", "target_error", "seed", "threads", "max_events",
-                                       "tile_size", "uv_mesh",     "uv_margin"};
+                                       "channel_walks", "time_limit", "target_error", "seed", "threads",
+                                       "max_events", "tile_size", "uv_mesh",     "uv_margin"};
     static const char *const targets[] = {"camera", "uv"};
     DWV_TRY(check_keys(item, "bake", keys, sizeof keys / sizeof keys[0]));
     dwv_bake_options_t *o = &ps->options;
@@ -878,6 +878,13 @@ static dwv_result_t read_bake(parser *ps, const cJSON *item)
         DWV_TRY(read_string(technique, "bake.technique", &name));
         dwv_result_t r = dwv_technique_from_name(name, &o->technique);
         if (r != DWV_SUCCESS) return prefix_capi(r, "bake.technique");
+    }
+    const cJSON *channel_walks = member(item, "channel_walks");
+    if (channel_walks) {
+        const char *name = NULL;
+        DWV_TRY(read_string(channel_walks, "bake.channel_walks", &name));
+        dwv_result_t r = dwv_channel_walks_from_name(name, &o->channel_walks);
+        if (r != DWV_SUCCESS) return prefix_capi(r, "bake.channel_walks");
     }
     DWV_TRY(opt_number(item, "bake", "time_limit", &o->time_limit));
     if (o->time_limit < 0.0)

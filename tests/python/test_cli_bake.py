@@ -98,6 +98,42 @@ class BakeCli(unittest.TestCase):
         self.assertIn("No Such View", done.stderr)
         self.assertEqual(os.listdir(self.folder), [])
 
+    def write_box_scene(self, **bake):
+        """A 1 m box whose radii differ per channel (so its channels can walk apart), lit by a sun
+        and seen by a camera, with `bake` as the scene's "bake" object; returns the file's path."""
+        positions = [x for corner in range(8) for x in ((corner & 1) - 0.5, (corner >> 1 & 1) - 0.5,
+                                                         (corner >> 2 & 1) - 0.5)]
+        indices = [0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4,
+                   2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5]
+        scene = {"version": 1,
+                 "materials": {"wax": {"subsurface_radius": [1.0, 0.5, 0.25], "subsurface_scale": 0.2}},
+                 "meshes": [{"material": "wax", "positions": positions, "indices": indices}],
+                 "lights": [{"kind": "sun", "strength": 3.0, "direction": [0.3, 0.5, -1.0]}],
+                 "camera": {"transform": {"look_at": {"eye": [1.5, -3.0, 2.0], "target": [0.0, 0.0, 0.0]}}},
+                 "bake": bake}
+        path = os.path.join(self.folder, "box.json")
+        with open(path, "w") as handle:
+            json.dump(scene, handle)
+        return path
+
+    def test_channel_walks_from_the_scene_and_the_flag(self):
+        """The scene's bake.channel_walks is used, --channel-walks overrides it, and a bad value in
+        either is refused with its name and where it was written."""
+        scene = self.write_box_scene(technique="classical", channel_walks="separate")
+        stats = self.bake(scene, "--threads", "2")
+        self.assertIn("channel_walks", stats["features"])
+        self.assertNotIn("rgb_walks", stats["features"])
+        stats = self.bake(scene, "--threads", "2", "--channel-walks", "shared")
+        self.assertNotIn("channel_walks", stats["features"])
+        self.assertIn("rgb_walks", stats["features"])
+        assert_bad_usage(self, ["bake", scene, "--out", self.prefix, "--channel-walks", "apart"], "dwivedi bake:",
+                         ["--channel-walks", "apart"])
+        bad = self.write_box_scene(channel_walks="apart")
+        done = run_cli("bake", bad, "--out", self.prefix, *SMALL)
+        self.assertEqual(done.returncode, 1, done.stderr)
+        self.assertIn("bake.channel_walks", done.stderr)
+        self.assertIn("apart", done.stderr)
+
     def test_look_none_is_blenders_no_look(self):
         """Blender's look menu calls "no look" None: `--look None` bakes what no --look does."""
         images = []

@@ -54,7 +54,8 @@ static int same_options(const dwv_bake_options_t *a, const dwv_bake_options_t *b
            a->height == b->height && a->uv_mesh == b->uv_mesh && a->uv_margin == b->uv_margin &&
            a->technique == b->technique && a->samples == b->samples && a->time_limit == b->time_limit &&
            a->target_error == b->target_error && a->threads == b->threads && a->max_events == b->max_events &&
-           a->seed == b->seed && a->tile_size == b->tile_size && a->progress == b->progress &&
+           a->seed == b->seed && a->tile_size == b->tile_size && a->channel_walks == b->channel_walks &&
+           a->progress == b->progress &&
            a->progress_user == b->progress_user;
 }
 
@@ -439,6 +440,18 @@ static void test_schema(void)
     expect_failure("unknown technique",
                    "{\"version\": 1, \"meshes\": [], " CAMERA ", \"bake\": {\"technique\": \"magic\"}}",
                    DWV_ERROR_UNKNOWN_NAME, "bake.technique", "magic");
+    expect_failure("unknown channel walks",
+                   "{\"version\": 1, \"meshes\": [], " CAMERA ", \"bake\": {\"channel_walks\": \"apart\"}}",
+                   DWV_ERROR_UNKNOWN_NAME, "bake.channel_walks: ", "'apart'");
+    expect_failure("channel walks in capitals",
+                   "{\"version\": 1, \"meshes\": [], " CAMERA ", \"bake\": {\"channel_walks\": \"SEPARATE\"}}",
+                   DWV_ERROR_UNKNOWN_NAME, "bake.channel_walks: ", "'SEPARATE'");
+    expect_failure("channel walks as a number",
+                   "{\"version\": 1, \"meshes\": [], " CAMERA ", \"bake\": {\"channel_walks\": 2}}",
+                   DWV_ERROR_FORMAT, "bake.channel_walks", "expected a string, found a number");
+    expect_failure("empty channel walks",
+                   "{\"version\": 1, \"meshes\": [], " CAMERA ", \"bake\": {\"channel_walks\": \"\"}}",
+                   DWV_ERROR_FORMAT, "bake.channel_walks", "empty");
     expect_failure("negative time", "{\"version\": 1, \"meshes\": [], " CAMERA ", \"bake\": {\"time_limit\": -1}}",
                    DWV_ERROR_OUT_OF_RANGE, "bake.time_limit", NULL);
     expect_failure("seed string", "{\"version\": 1, \"meshes\": [], " CAMERA ", \"bake\": {\"seed\": \"12a\"}}",
@@ -474,6 +487,32 @@ static void test_schema(void)
     CHECK(options.target == DWV_BAKE_UV && options.uv_mesh == 1u && options.uv_margin == 3u && options.threads == 2u &&
               options.max_events == 1000u && options.tile_size == 16u && options.seed == 9007199254740992ull,
           "uv bake options");
+
+    /* channel_walks: each name sets its value over the caller's; without the key the caller's stays. */
+    static const struct {
+        const char *name;
+        dwv_channel_walks_t value, caller;
+    } walks[] = {{"auto", DWV_CHANNEL_WALKS_AUTO, DWV_CHANNEL_WALKS_SEPARATE},
+                 {"shared", DWV_CHANNEL_WALKS_SHARED, DWV_CHANNEL_WALKS_AUTO},
+                 {"separate", DWV_CHANNEL_WALKS_SEPARATE, DWV_CHANNEL_WALKS_SHARED}};
+    for (size_t i = 0; i < sizeof walks / sizeof walks[0]; ++i) {
+        char json[256];
+        snprintf(json, sizeof json,
+                 "{\"version\": 1, \"meshes\": [], " CAMERA ", \"bake\": {\"channel_walks\": \"%s\"}}",
+                 walks[i].name);
+        dwv_bake_options_t walk_options = DWV_BAKE_OPTIONS_INIT;
+        walk_options.channel_walks = walks[i].caller;
+        CHECK(load_text(json, &walk_options) == DWV_SUCCESS, "channel_walks %s: %s", walks[i].name,
+              dwv_last_error_message());
+        CHECK(walk_options.channel_walks == walks[i].value, "channel_walks %s: read %u", walks[i].name,
+              walk_options.channel_walks);
+        walk_options.channel_walks = walks[i].caller;
+        CHECK(load_text("{\"version\": 1, \"meshes\": [], " CAMERA ", \"bake\": {\"samples\": 4}}", &walk_options) ==
+                  DWV_SUCCESS,
+              "bake without channel_walks: %s", dwv_last_error_message());
+        CHECK(walk_options.channel_walks == walks[i].caller, "channel_walks %u not kept when absent: %u",
+              walks[i].caller, walk_options.channel_walks);
+    }
 }
 
 static void test_numbers_and_strings(void)
