@@ -38,6 +38,15 @@ TECHNIQUES = [
     ('CYCLES', "Cycles Mixture", "Cycles' own mixture: half classical, half backward-guided"),
 ]
 
+# dwv_channel_walks_t (capi/dwivedi.h): how walks carry the three colour channels of a medium whose
+# channels differ; a grey medium walks once whichever is chosen.
+CHANNEL_WALKS = [
+    ('AUTO', "Auto", "Shared for an explicit technique; with technique Auto the bake's pilot chooses per mesh"),
+    ('SHARED', "Shared", "One walk carries all three colour channels, weighted by spectral MIS (as Cycles)"),
+    ('SEPARATE', "Separate", "One walk per colour channel, each in that channel's own medium: less colour noise "
+                             "where the channels' radii differ, for more walks per sample"),
+]
+
 
 _custom_library = False  # the preferences' library is in use (not the bundled one)
 
@@ -95,6 +104,8 @@ class DwivediBakeSettings(bpy.types.PropertyGroup):
         ('CAMERA', "Camera", "The active camera's view at the render resolution"),
         ('UV', "UV", "The outgoing subsurface radiance of one object laid out in its UV map")])
     technique: EnumProperty(name="Technique", items=TECHNIQUES, default='AUTO')
+    channel_walks: EnumProperty(name="Channel Walks", items=CHANNEL_WALKS, default='AUTO',
+                                description="How the walks carry the red, green and blue channels")
     samples: IntProperty(name="Samples", description="Samples per pixel (the bake stops there)",
                          default=64, min=0, soft_min=1, max=1 << 24)
     time_limit: FloatProperty(name="Time Limit", description="Seconds; 0: no limit", default=0.0, min=0.0,
@@ -160,8 +171,8 @@ class _Job:
         self.bake_settings = self.dwivedi.BakeSettings(
             target=settings.target.lower(), width=self.exported.width, height=self.exported.height,
             uv_mesh=self.exported.uv_mesh, uv_margin=settings.uv_margin, technique=settings.technique.lower(),
-            samples=settings.samples, time_limit=settings.time_limit, target_error=settings.target_error,
-            threads=settings.threads, seed=settings.seed)
+            channel_walks=settings.channel_walks.lower(), samples=settings.samples, time_limit=settings.time_limit,
+            target_error=settings.target_error, threads=settings.threads, seed=settings.seed)
         self.display = display_settings(scene, self.dwivedi)
         self.bake = None
 
@@ -394,6 +405,7 @@ class DWIVEDI_PT_bake(bpy.types.Panel):
             width, height = export.render_size(context.scene)
             layout.label(text=f"{width} x {height} (render resolution)")
         layout.prop(settings, "technique")
+        layout.prop(settings, "channel_walks")
         col = layout.column(align=True)
         col.prop(settings, "samples")
         col.prop(settings, "time_limit")

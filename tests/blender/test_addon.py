@@ -40,10 +40,15 @@ class AddonTest(harness.unittest.TestCase):
         self.assertTrue(hasattr(bpy.types, "DWIVEDI_PT_bake"))
         self.assertEqual(bpy.types.DWIVEDI_PT_bake.bl_context, "render")
         props = bpy.context.scene.dwivedi_bake
-        for name in ("target", "technique", "samples", "time_limit", "threads", "seed", "output_dir", "uv_object",
-                     "uv_size", "uv_margin"):
+        for name in ("target", "technique", "channel_walks", "samples", "time_limit", "threads", "seed", "output_dir",
+                     "uv_object", "uv_size", "uv_margin"):
             self.assertTrue(hasattr(props, name), name)
         self.assertEqual(props.target, 'CAMERA')
+        self.assertEqual(props.channel_walks, 'AUTO')
+        items = props.bl_rna.properties["channel_walks"].enum_items
+        self.assertEqual([item.identifier for item in items], ['AUTO', 'SHARED', 'SEPARATE'])
+        for item in items:
+            self.assertTrue(item.name and item.description, item.identifier)
         self.assertIn("Dwivedi", bpy.ops.dwivedi.bake.get_rna_type().name)
         module = sys.modules["dwivedi_bake"]
         self.assertEqual(module.bl_info["blender"][:2], (3, 4))
@@ -70,6 +75,64 @@ class AddonTest(harness.unittest.TestCase):
         mean_r = sum(pixels[0::4]) / (width * height)
         self.assertGreater(mean_r, 0.0, "light comes through the slab")
         self.assertIn("spp", scene.dwivedi_bake.last_result)
+
+    def test_panel_shows_channel_walks_after_technique(self):
+        small_slab()
+
+        class Layout:
+            """Records the properties a panel draws, in order."""
+
+            def __init__(self):
+                self.props = []
+
+            def prop(self, data, name, **options):
+                self.props.append(name)
+
+            def column(self, **options):
+                return self
+
+            def label(self, **options):
+                pass
+
+            def operator(self, *args, **options):
+                pass
+
+        class Panel:
+            layout = Layout()
+
+        sys.modules["dwivedi_bake"].DWIVEDI_PT_bake.draw(Panel, bpy.context)
+        drawn = Panel.layout.props
+        self.assertIn("channel_walks", drawn)
+        self.assertEqual(drawn.index("channel_walks"), drawn.index("technique") + 1, drawn)
+
+    def test_channel_walks_reach_the_bake(self):
+        """The slab's radii differ per channel: Separate walks each channel on its own (the bake
+        reports the channel_walks feature), Shared and Auto with an explicit technique walk them
+        together. The job is made as the operator makes it; then the operator bakes Separate."""
+        scene = small_slab()
+        module = sys.modules["dwivedi_bake"]
+        props = scene.dwivedi_bake
+        props.technique = 'CLASSICAL'
+        for choice, separate in (('SEPARATE', True), ('SHARED', False), ('AUTO', False)):
+            props.channel_walks = choice
+            job = module._Job(bpy.context, props)
+            try:
+                self.assertEqual(job.bake_settings.channel_walks, choice.lower())
+                image = job.dwivedi.bake(job.exported.scene, job.bake_settings)
+                try:
+                    features = image.stats.features
+                    self.assertTrue(all(math.isfinite(v) for v in image.pixels()), choice)
+                finally:
+                    image.close()
+            finally:
+                job.close()
+            self.assertEqual("channel_walks" in features, separate, (choice, features))
+            self.assertEqual("rgb_walks" in features, not separate, (choice, features))
+        result, error = harness.call_operator(channel_walks='SEPARATE')
+        self.assertEqual(result, {'FINISHED'}, error)
+        _, _, pixels = harness.image_pixels("Dwivedi Camera")
+        self.assertTrue(all(math.isfinite(v) for v in pixels))
+        self.assertGreater(max(pixels[0::4]), 0.0, "light comes through the slab")
 
     # Blender 3.4 takes an EXR with any layered channel name ("x.R") as multilayer and then gives
     # bpy.data.images.load no pixels (size 0 x 0); the library's channel names have no dots.
