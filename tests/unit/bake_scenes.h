@@ -133,4 +133,36 @@ static inline dwv_camera_t test_ortho_camera(double x, double y, double z, doubl
     return camera;
 }
 
+/* The report's wax sphere, committed: unit radius (rings x segments), subsurface radius (0.5,
+ * 0.25, 0.1) and colour (0.9, 0.6, 0.4) (extinctions 2x and 5x apart), lit by a sun of 2 from the
+ * camera's side, seen from +z (orthographic, 2.4 across). A zero radius in `flat_channel` (0..2)
+ * makes that channel Lambertian (it does not walk); -1 for none. `grey`: radius 0.25 and colour
+ * 0.8 in every channel instead. Exits the test on failure. */
+static inline dwv_scene_t *test_wax_sphere(int flat_channel, int grey, uint32_t rings, uint32_t segments)
+{
+    dwv_scene_t *scene;
+    if (dwv_scene_create(&scene) != DWV_SUCCESS) exit(2);
+    dwv_material_t m = DWV_MATERIAL_INIT;
+    static const double color[3] = {0.9, 0.6, 0.4}, radius[3] = {0.5, 0.25, 0.1};
+    for (int c = 0; c < 3; ++c) {
+        m.base_color[c] = m.subsurface_color[c] = grey ? 0.8 : color[c];
+        m.subsurface_radius[c] = grey ? 0.25 : c == flat_channel ? 0.0 : radius[c];
+    }
+    m.subsurface_scale = 1.0;
+    test_mesh sphere = test_sphere(0.0, 0.0, 0.0, 1.0, rings, segments);
+    test_add(scene, &sphere, &m);
+    test_mesh_free(&sphere);
+    dwv_light_desc_t sun = DWV_LIGHT_DESC_INIT;
+    sun.strength = 2.0;
+    sun.direction[0] = -0.5;
+    sun.direction[1] = -0.5;
+    sun.direction[2] = -0.7071;
+    dwv_camera_t camera = test_ortho_camera(0.0, 0.0, 5.0, 2.4);
+    if (dwv_scene_add_light(scene, &sun) || dwv_scene_set_camera(scene, &camera) || dwv_scene_commit(scene)) {
+        fprintf(stderr, "test scene: %s\n", dwv_last_error_message());
+        exit(2);
+    }
+    return scene;
+}
+
 #endif

@@ -73,33 +73,6 @@ static dwv_scene_t *world_lit_sphere(double color)
     return scene;
 }
 
-/* The report's wax sphere: radius (0.5, 0.25, 0.1), colour (0.9, 0.6, 0.4), lit by a sun from the
- * camera's side. */
-static dwv_scene_t *wax_sphere(void)
-{
-    dwv_scene_t *scene;
-    if (dwv_scene_create(&scene) != DWV_SUCCESS) exit(2);
-    dwv_material_t m = DWV_MATERIAL_INIT;
-    static const double color[3] = {0.9, 0.6, 0.4}, radius[3] = {0.5, 0.25, 0.1};
-    for (int c = 0; c < 3; ++c) {
-        m.base_color[c] = m.subsurface_color[c] = color[c];
-        m.subsurface_radius[c] = radius[c];
-    }
-    m.subsurface_scale = 1.0;
-    test_mesh sphere = test_sphere(0.0, 0.0, 0.0, 1.0, 24, 48);
-    test_add(scene, &sphere, &m);
-    test_mesh_free(&sphere);
-    dwv_light_desc_t sun = DWV_LIGHT_DESC_INIT;
-    sun.strength = 2.0;
-    sun.direction[0] = -0.5;
-    sun.direction[1] = -0.5;
-    sun.direction[2] = -0.7071;
-    if (dwv_scene_add_light(scene, &sun)) exit(2);
-    dwv_camera_t camera = test_ortho_camera(0.0, 0.0, 5.0, 2.4);
-    finish(scene, &camera);
-    return scene;
-}
-
 /* A 4 x 4 m slab `thickness` thick about z = 0, seen from +z, a sun of 3 W/m^2 shining down
  * (front_lit) or up. */
 static dwv_scene_t *sunlit_slab(double thickness, double color, double anisotropy, int front_lit)
@@ -160,6 +133,6 @@ int main(void)
     check_choice("thick front-lit slab, colour 0.5", sunlit_slab(2.0, 0.5, 0.0, 1), EXPECT_GUIDED, 0);
     check_choice("thin back-lit slab, colour 0.3", sunlit_slab(0.1, 0.3, 0.0, 0), EXPECT_INCIDENT, 0);
     check_choice("thin back-lit slab, g = 0.8", sunlit_slab(0.1, 0.8, 0.8, 0), EXPECT_CLASSICAL, 0);
-    check_choice("front-lit wax sphere", wax_sphere(), EXPECT_ENTRY, 1);
+    check_choice("front-lit wax sphere", test_wax_sphere(-1, 0, 24, 48), EXPECT_ENTRY, 1);
     return check_report("test_bake_auto");
 }

@@ -12,36 +12,10 @@
 #include "check.h"
 #include "dwivedi.h"
 
-/* The report's wax sphere (radius (0.5, 0.25, 0.1), colour (0.9, 0.6, 0.4): extinctions 2 and 5
- * times apart), unit radius, lit by a sun from the camera's side. A zero radius in `flat_channel`
- * (0..2) makes that channel Lambertian instead (it does not walk); -1 for none. `grey` makes the
- * three channels alike. */
+/* bake_scenes.h's wax sphere at a coarser tessellation. */
 static dwv_scene_t *wax_sphere(int flat_channel, int grey)
 {
-    dwv_scene_t *scene;
-    if (dwv_scene_create(&scene) != DWV_SUCCESS) exit(2);
-    dwv_material_t m = DWV_MATERIAL_INIT;
-    static const double color[3] = {0.9, 0.6, 0.4}, radius[3] = {0.5, 0.25, 0.1};
-    for (int c = 0; c < 3; ++c) {
-        m.base_color[c] = m.subsurface_color[c] = grey ? 0.8 : color[c];
-        m.subsurface_radius[c] = grey ? 0.25 : c == flat_channel ? 0.0 : radius[c];
-    }
-    m.subsurface_scale = 1.0;
-    test_mesh sphere = test_sphere(0.0, 0.0, 0.0, 1.0, 16, 32);
-    test_add(scene, &sphere, &m);
-    test_mesh_free(&sphere);
-    dwv_light_desc_t sun = DWV_LIGHT_DESC_INIT;
-    sun.strength = 2.0;
-    sun.direction[0] = -0.5;
-    sun.direction[1] = -0.5;
-    sun.direction[2] = -0.7071;
-    if (dwv_scene_add_light(scene, &sun)) exit(2);
-    dwv_camera_t camera = test_ortho_camera(0.0, 0.0, 5.0, 2.4);
-    if (dwv_scene_set_camera(scene, &camera) || dwv_scene_commit(scene)) {
-        fprintf(stderr, "scene: %s\n", dwv_last_error_message());
-        exit(2);
-    }
-    return scene;
+    return test_wax_sphere(flat_channel, grey, 16, 32);
 }
 
 typedef struct result {
