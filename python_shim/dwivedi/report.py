@@ -303,6 +303,17 @@ def cycles_section(quick: bool, blender: str, size: int, scenes: Sequence[str], 
         return json.loads(result_path.read_text())
 
 
+def noise_only(points: List[Dict[str, float]], reference_samples: int) -> List[Dict[str, float]]:
+    """The points with the RMSE each has against the converged image itself. Each was measured
+    against a reference of the same renderer at `reference_samples` spp, whose own noise is
+    independent of the point's: with per-sample variance s^2, RMSE^2 = s^2 / spp + s^2 / reference,
+    so the noise alone is RMSE x sqrt(reference / (spp + reference)). Without this, a point at a
+    quarter of the reference's samples carries 25% more variance than it has, and a renderer whose
+    curve must be extrapolated from it (the target lies below its last point) looks slower."""
+    return [{**p, "rmse": p["rmse"] * math.sqrt(reference_samples / (p["samples"] + reference_samples))}
+            for p in points]
+
+
 def time_to_rmse(points: List[Dict[str, float]], target: float) -> Optional[float]:
     """Seconds to reach `target` RMSE, interpolated log-log between measured points (RMSE falls
     as 1/sqrt(time)); extrapolated along that slope beyond the last point."""
@@ -359,10 +370,11 @@ def plots(out: Path, data: Dict[str, Any]) -> List[str]:
         made.append(f"rmse_{name}.png")
     for name, entry in data.get("cycles", {}).items():
         fig, ax = pyplot.subplots(figsize=(6, 4))
-        for who in ("cycles", "dwivedi"):
-            ax.loglog([p["seconds"] for p in entry[who]], [p["rmse"] for p in entry[who]], marker="o", label=who)
+        for who, reference in (("cycles", entry["reference_samples"]), ("dwivedi", entry["dwivedi_reference_samples"])):
+            points = noise_only(entry[who], reference)
+            ax.loglog([p["seconds"] for p in points], [p["rmse"] for p in points], marker="o", label=who)
         ax.set_xlabel("seconds (2 threads)")
-        ax.set_ylabel("RMSE against its own converged image")
+        ax.set_ylabel("RMSE against the converged image (noise only)")
         ax.set_title(f"{name}: dwivedi against Cycles")
         ax.legend()
         ax.grid(True, which="both", alpha=0.3)
@@ -411,15 +423,21 @@ def markdown(data: Dict[str, Any], made: List[str]) -> str:
                   "docs/cycles_energy_loss.md). Cycles' seconds exclude its scene sync (a 1-sample render's "
                   "time), dwivedi's are the bake's own (its auto pilot included); both take turns over "
                   f"{next(iter(data['cycles'].values())).get('repeats', 1)} timing round(s) and each count keeps "
-                  "its fastest time. Speed-up = Cycles' time / dwivedi's time to reach the RMSE of dwivedi's "
-                  "second-largest bake (log-log interpolation).",
+                  "its fastest time. RMSEs here are the noise alone: the reference's own noise, 1 / (4x) of a "
+                  "point's variance at its largest count, is taken out of each (noise_only). Speed-up = "
+                  "Cycles' time / dwivedi's time to reach the RMSE of dwivedi's second-largest bake (log-log "
+                  "interpolation, and beyond the last point along RMSE ~ 1/sqrt(time)).",
                   "",
                   "| scene | converged Cycles mean RGB | converged dwivedi mean RGB | RMSE between converged | "
                   "target RMSE | Cycles s | dwivedi s | speed-up |", "|---|---|---|---|---|---|---|---|"]
+        clean = {name: (noise_only(entry["cycles"], entry["reference_samples"]),
+                        noise_only(entry["dwivedi"], entry["dwivedi_reference_samples"]))
+                 for name, entry in data["cycles"].items()}
         for name, entry in data["cycles"].items():
-            target = entry["dwivedi"][-2]["rmse"]
-            tc = time_to_rmse(entry["cycles"], target)
-            td = time_to_rmse(entry["dwivedi"], target)
+            theirs_clean, ours_clean = clean[name]
+            target = ours_clean[-2]["rmse"]
+            tc = time_to_rmse(theirs_clean, target)
+            td = time_to_rmse(ours_clean, target)
             speed = f"{tc / td:.2f}x" if tc and td else "n/a"
             lines.append(f"| {name} | " + ", ".join(f"{v:.4f}" for v in entry["cycles_reference_mean_rgb"]) + " | "
                          + ", ".join(f"{v:.4f}" for v in entry["dwivedi_reference_mean_rgb"]) +
@@ -431,8 +449,8 @@ def markdown(data: Dict[str, Any], made: List[str]) -> str:
                   "| scene | spp | Cycles RMSE | dwivedi RMSE | variance ratio Cycles / dwivedi | Cycles s | "
                   "dwivedi s |", "|---|---|---|---|---|---|---|"]
         for name, entry in data["cycles"].items():
-            ours = {p["samples"]: p for p in entry["dwivedi"]}
-            for theirs in entry["cycles"]:
+            ours = {p["samples"]: p for p in clean[name][1]}
+            for theirs in clean[name][0]:
                 if theirs["samples"] in ours:
                     mine = ours[theirs["samples"]]
                     lines.append(f"| {name} | {theirs['samples']} | {theirs['rmse']:.4g} | {mine['rmse']:.4g} | "

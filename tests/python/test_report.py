@@ -37,6 +37,19 @@ class ReportTest(unittest.TestCase):
                 self.assertTrue((Path(tmp) / "v0_methods.png").is_file())
                 self.assertTrue((Path(tmp) / "rmse_slab.png").is_file())
 
+    def test_reference_noise_is_taken_out(self):
+        # Points measured against a reference of R spp: RMSE^2 = s^2 (1 / spp + 1 / R).
+        from dwivedi import report
+        s2, reference = 0.4, 4096
+        points = [{"samples": n, "seconds": 0.001 * n, "rmse": (s2 * (1.0 / n + 1.0 / reference)) ** 0.5}
+                  for n in (64, 256, 1024)]
+        for point in report.noise_only(points, reference):
+            self.assertAlmostEqual(point["rmse"] ** 2, s2 / point["samples"], delta=1e-12)
+        # Without it, the time to an RMSE below the last point was 1.25x too long here.
+        target = (s2 / 4096) ** 0.5
+        self.assertAlmostEqual(report.time_to_rmse(report.noise_only(points, reference), target), 4.096, delta=1e-9)
+        self.assertAlmostEqual(report.time_to_rmse(points, target), 1.25 * 4.096, delta=1e-9)
+
     def test_sections_alone_and_bad_choices(self):
         env = {**os.environ, "PYTHONPATH": str(SOURCE_DIR / "python_shim")}
         with tempfile.TemporaryDirectory() as tmp:
