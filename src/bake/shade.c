@@ -29,13 +29,15 @@ static uint64_t mixture_terms(const dwvw_walk *walk, uint64_t per_component, uin
  * technique needs in full) is always a ray (its origin is on the surface: no ball there). */
 static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvw_medium *medium, const dwvw_guide *guide,
                     uint32_t entry_prim, dwvw_vec3 x, dwvw_vec3 direction, dwvw_vec3 entry_normal, uint64_t key,
-                    const dwvk_sampler *sampler, uint32_t walk_pair, dwvw_walk *walk, dwvg_hit *exit, dwvb_tally *tally)
+                    const dwvk_sampler *sampler, uint32_t walk_pair, dwvw_pair_cache *pairs, dwvw_walk *walk,
+                    dwvg_hit *exit, dwvb_tally *tally)
 {
     const dwvg_world *world = &shader->scene->geometry;
     const dwvg_mesh *m = &shader->scene->meshes[mesh];
     const dwvg_clearance *grid = &world->clearance[mesh];
     dwvw_walk_begin(walk, medium, guide, key, shader->max_events, x, direction, entry_normal);
     dwvw_walk_stratify(walk, sampler, walk_pair, DWVB_STRATIFIED_EVENTS);
+    if (pairs) dwvw_walk_share_pairs(walk, pairs);
     int needs_closest = shader->needs_closest[mesh];
     dwvb_ball_mode ball_mode = shader->scene->ball_mode;
     int first = 1;
@@ -227,12 +229,13 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, 
         /* Channel walks: each channel's estimate is its own walk's (its own extinction, albedo and
          * Dwivedi distribution), so no channel's weight carries another's sampling pdf. They
          * share the entry and the pixel's stratified numbers (each channel is stratified over the
-         * pixel's samples); their counter-based numbers differ. */
+         * pixel's samples), made once for the three (`pairs`); their counter-based numbers differ. */
+        dwvw_pair_cache pairs = {.first_pair = walk_pair, .have = 0u, .stratified = 0u};
         for (int c = 0; c < 3; ++c) {
             if (!(material->walk_scale[c] > 0.0)) continue;
             int exited = run_walk(shader, hit->mesh, &material->channel_medium[c],
                                   &shader->channel_guides[3u * hit->mesh + (uint32_t)c], hit->prim, x, inward, n,
-                                  dwvk_mix64(key_walk + (uint64_t)c), sampler, walk_pair, &walk, &exit, tally);
+                                  dwvk_mix64(key_walk + (uint64_t)c), sampler, walk_pair, &pairs, &walk, &exit, tally);
             if (walk.status == DWVW_TRUNCATED) tally->truncated[c] += walk.weight[0] * material->walk_scale[c];
             if (!exited) continue;
             exit_light(shader, hit->mesh, material, &walk, &exit, sampler, exit_pair, direct);
@@ -241,7 +244,7 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, 
         return;
     }
     int exited = run_walk(shader, hit->mesh, &material->medium, &shader->guides[hit->mesh], hit->prim, x, inward, n,
-                          key_walk, sampler, walk_pair, &walk, &exit, tally);
+                          key_walk, sampler, walk_pair, NULL, &walk, &exit, tally);
     int grey = material->medium.channels == 1;
     if (walk.status == DWVW_TRUNCATED)
         for (int c = 0; c < 3; ++c) tally->truncated[c] += walk.weight[grey ? 0 : c] * material->walk_scale[c];

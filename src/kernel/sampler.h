@@ -174,11 +174,12 @@ static inline float dwvk_uniform_f_from_d(double u)
 /* The same pair as single-precision uniforms on the 2^-24 grid (the walk's per-event sampling
  * runs in single precision): the top 24 bits, truncated, so that a uniform on a finer dyadic grid
  * stays uniform and never rounds up to 1 (a float conversion by rounding would). */
-static inline dwvk_uniform_pair_f dwvk_sampler_pair_at_f(const dwvk_sampler *sampler, uint32_t index_reversed,
-                                                           uint32_t pair)
+/* dwvk_sampler_pair_at_f from what dwvk_sampler_pair_bits gave for the pair: `have` its return
+ * value, `both` its bits (used only where have is 1). */
+static inline dwvk_uniform_pair_f dwvk_sampler_pair_given_f(const dwvk_sampler *sampler, uint32_t pair, int have,
+                                                              uint64_t both)
 {
-    uint64_t both;
-    if (dwvk_sampler_pair_bits(sampler, index_reversed, pair, &both)) {
+    if (have) {
         /* dwvk_uniform_f_from_d of x 2^-32 is x's top 24 bits: (x >> 8) 2^-24, without the double */
         dwvk_uniform_pair_f f = {(float)(int32_t)(both >> 40) * 0x1.0p-24f,
                                  (float)(int32_t)((uint32_t)both >> 8) * 0x1.0p-24f};
@@ -190,13 +191,20 @@ static inline dwvk_uniform_pair_f dwvk_sampler_pair_at_f(const dwvk_sampler *sam
     return f;
 }
 
+static inline dwvk_uniform_pair_f dwvk_sampler_pair_at_f(const dwvk_sampler *sampler, uint32_t index_reversed,
+                                                           uint32_t pair)
+{
+    uint64_t both = 0u;
+    int have = dwvk_sampler_pair_bits(sampler, index_reversed, pair, &both);
+    return dwvk_sampler_pair_given_f(sampler, pair, have, both);
+}
+
 /* The pair as the walk's flight takes it: the first number as dwvk_sampler_pair_at_f's (a float
  * on the 2^-24 grid), the second as dwvk_sampler_pair_at's (a double). */
-static inline float dwvk_sampler_pair_at_fd(const dwvk_sampler *sampler, uint32_t index_reversed, uint32_t pair,
-                                            double *second)
+static inline float dwvk_sampler_pair_given_fd(const dwvk_sampler *sampler, uint32_t pair, int have, uint64_t both,
+                                               double *second)
 {
-    uint64_t both;
-    if (dwvk_sampler_pair_bits(sampler, index_reversed, pair, &both)) {
+    if (have) {
         *second = (double)(uint32_t)both * 0x1.0p-32;
         return (float)(int32_t)(both >> 40) * 0x1.0p-24f;
     }
@@ -204,6 +212,14 @@ static inline float dwvk_sampler_pair_at_fd(const dwvk_sampler *sampler, uint32_
     dwvk_sampler_pair_independent(sampler, pair, u);
     *second = u[1];
     return dwvk_uniform_f_from_d(u[0]);
+}
+
+static inline float dwvk_sampler_pair_at_fd(const dwvk_sampler *sampler, uint32_t index_reversed, uint32_t pair,
+                                            double *second)
+{
+    uint64_t both = 0u;
+    int have = dwvk_sampler_pair_bits(sampler, index_reversed, pair, &both);
+    return dwvk_sampler_pair_given_fd(sampler, pair, have, both, second);
 }
 
 static inline dwvk_uniform_pair_f dwvk_sampler_pair_f(const dwvk_sampler *sampler, uint32_t pair)

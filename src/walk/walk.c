@@ -91,6 +91,7 @@ void dwvw_walk_begin(dwvw_walk *walk, const dwvw_medium *medium, const dwvw_guid
     walk->index_reversed = 0u;
     walk->first_pair = 0u;
     walk->stratified_events = 0u;
+    walk->pair_cache = NULL;
     walk->max_events = max_events;
     walk->events = 0;
     walk->status = DWVW_RUNNING;
@@ -240,6 +241,29 @@ static const dwvw_frame *frame_about_axis(dwvw_walk *walk, dwvw_vec3 axis)
     return slot;
 }
 
+void dwvw_walk_share_pairs(dwvw_walk *walk, dwvw_pair_cache *cache)
+{
+    walk->pair_cache = cache;
+}
+
+/* dwvk_sampler_pair_bits for the walk's pair `pair`, through its cache where it has one. */
+static inline int walk_pair_bits(const dwvw_walk *walk, uint32_t pair, uint64_t *both)
+{
+    dwvw_pair_cache *cache = walk->pair_cache;
+    uint32_t k = pair - walk->first_pair;
+    if (cache == NULL || k >= DWVW_PAIR_CACHE)
+        return dwvk_sampler_pair_bits(walk->sampler, walk->index_reversed, pair, both);
+    uint32_t bit = 1u << k;
+    if (!(cache->have & bit)) {
+        uint64_t made = 0u;
+        if (dwvk_sampler_pair_bits(walk->sampler, walk->index_reversed, pair, &made)) cache->stratified |= bit;
+        cache->bits[k] = made;
+        cache->have |= bit;
+    }
+    *both = cache->bits[k];
+    return (cache->stratified & bit) != 0u;
+}
+
 double dwvw_walk_sample(dwvw_walk *walk)
 {
     const dwvw_medium *m = walk->medium;
@@ -248,9 +272,12 @@ double dwvw_walk_sample(dwvw_walk *walk)
     const int stratified = walk->events < walk->stratified_events;
     const uint32_t pair = walk->first_pair + DWVW_PAIRS_PER_EVENT * walk->events;
     double flight_choice = 0.0;
-    float flight_distance = stratified ? dwvk_sampler_pair_at_fd(walk->sampler, walk->index_reversed,
-                                                                 pair + DWVW_PAIR_FLIGHT, &flight_choice)
-                                       : 0.0f;
+    float flight_distance = 0.0f;
+    if (stratified) {
+        uint64_t both = 0u;
+        int have = walk_pair_bits(walk, pair + DWVW_PAIR_FLIGHT, &both);
+        flight_distance = dwvk_sampler_pair_given_fd(walk->sampler, pair + DWVW_PAIR_FLIGHT, have, both, &flight_choice);
+    }
     double *choice = stratified ? &flight_choice : NULL;
 
     /* Channel: proportional to throughput x albedo (Cycles), to throughput where all albedos are 0. */
@@ -279,8 +306,14 @@ double dwvw_walk_sample(dwvw_walk *walk)
     float g = (float)m->g;
     if (walk->events > 0) {
         /* The first step keeps the entry direction: only its distance is sampled. */
-        dwvk_uniform_pair_f u = stratified ? dwvk_sampler_pair_at_f(walk->sampler, walk->index_reversed, pair + DWVW_PAIR_DIRECTION)
-                                           : dwvk_rng_uniform_pair_f(walk->key, dim + DWVW_DIM_DIRECTION);
+        dwvk_uniform_pair_f u;
+        if (stratified) {
+            uint64_t both = 0u;
+            int have = walk_pair_bits(walk, pair + DWVW_PAIR_DIRECTION, &both);
+            u = dwvk_sampler_pair_given_f(walk->sampler, pair + DWVW_PAIR_DIRECTION, have, both);
+        } else {
+            u = dwvk_rng_uniform_pair_f(walk->key, dim + DWVW_DIM_DIRECTION);
+        }
         if (chosen == 0) {
             walk->direction = dwvw_classical_direction(previous, g, u);
         } else {

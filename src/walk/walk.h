@@ -106,6 +106,18 @@ typedef enum dwvw_status {
     DWVW_TRUNCATED = 3   /* ended by the event cap: its weight is reported, not dropped */
 } dwvw_status;
 
+/* The stratified pairs of walks that draw the same ones (the channel walks of one sample, which
+ * share the sampler and first pair): each pair's bits are made once, by the first walk that needs
+ * them, and read by the others. DWVW_PAIR_CACHE pairs from first_pair; `have` bit k: pair
+ * first_pair + k is known, with dwvk_sampler_pair_bits's answer in `stratified` bit k (0: the pair
+ * is not stratified, and its numbers are the counter-based ones) and its bits in bits[k]. */
+#define DWVW_PAIR_CACHE 32u
+typedef struct dwvw_pair_cache {
+    uint32_t first_pair;
+    uint32_t have, stratified;
+    uint64_t bits[DWVW_PAIR_CACHE];
+} dwvw_pair_cache;
+
 typedef struct dwvw_walk {
     const dwvw_medium *medium;
     const dwvw_guide *guide;
@@ -114,6 +126,7 @@ typedef struct dwvw_walk {
     uint32_t index_reversed;      /* dwvk_sampler_index_reversed(sampler), once per walk */
     uint32_t first_pair;          /* the sampler's pair of event 0 (DWVW_PAIR_* above) */
     uint32_t stratified_events;   /* events 0 .. this - 1 are drawn from the sampler */
+    dwvw_pair_cache *pair_cache;  /* NULL, or the pairs this walk shares with others */
     uint32_t max_events;
     uint32_t events;       /* scattering events so far */
     dwvw_status status;
@@ -161,6 +174,10 @@ void dwvw_walk_begin(dwvw_walk *walk, const dwvw_medium *medium, const dwvw_guid
  * same; only the walks of one pixel are stratified against each other. Events whose pairs would
  * pass 2^32 - 1 stay counter-based. */
 void dwvw_walk_stratify(dwvw_walk *walk, const dwvk_sampler *sampler, uint32_t first_pair, uint32_t events);
+/* After dwvw_walk_stratify: the walk takes its stratified pairs from `cache` (cache->first_pair
+ * must be the walk's first pair), making and keeping there those it is the first to need. Walks
+ * that share a cache draw the same numbers they would draw without it, bit for bit. */
+void dwvw_walk_share_pairs(dwvw_walk *walk, dwvw_pair_cache *cache);
 /* Before dwvw_walk_sample, where the guide needs it: the closest surface point's outward normal. */
 void dwvw_walk_set_closest(dwvw_walk *walk, dwvw_vec3 normal);
 /* Samples the next step's direction (walk->direction) and tentative distance (return value). */

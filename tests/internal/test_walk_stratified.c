@@ -51,13 +51,15 @@ typedef struct one_walk {
     double score[DWVW_MAX_CHANNELS];
 } one_walk;
 
-static one_walk run_walk(const dwvw_medium *medium, const dwvw_guide *guide, const dwvw_shape *sphere, uint64_t key,
-                         const dwvk_sampler *sampler, uint32_t stratified_events)
+static one_walk run_walk_shared(const dwvw_medium *medium, const dwvw_guide *guide, const dwvw_shape *sphere,
+                                uint64_t key, const dwvk_sampler *sampler, uint32_t stratified_events,
+                                dwvw_pair_cache *pairs)
 {
     const dwvw_vec3 origin = {0.0, 0.0, 0.0}, inward = {0.0, 0.0, 1.0}, outward = {0.0, 0.0, -1.0};
     dwvw_walk walk;
     dwvw_walk_begin(&walk, medium, guide, key, 100000u, origin, inward, outward);
     dwvw_walk_stratify(&walk, sampler, FIRST_PAIR, stratified_events);
+    if (pairs) dwvw_walk_share_pairs(&walk, pairs);
     int needs_closest = dwvw_guide_needs_closest(guide);
     while (walk.status == DWVW_RUNNING) {
         if (needs_closest) {
@@ -75,6 +77,12 @@ static one_walk run_walk(const dwvw_medium *medium, const dwvw_guide *guide, con
     double cosine = walk.status == DWVW_EXITED ? fmax(0.0, -walk.exit_normal.z) : 0.0;
     for (int c = 0; c < medium->channels; ++c) end.score[c] = walk.weight[c] * cosine;
     return end;
+}
+
+static one_walk run_walk(const dwvw_medium *medium, const dwvw_guide *guide, const dwvw_shape *sphere, uint64_t key,
+                         const dwvk_sampler *sampler, uint32_t stratified_events)
+{
+    return run_walk_shared(medium, guide, sphere, key, sampler, stratified_events, NULL);
 }
 
 /* PIXELS pixels of WALKS_PER_PIXEL walks; stratified_events 0 with `stratified` 0: counter-based. */
@@ -175,6 +183,38 @@ static void test_first_events_only(void)
     CHECK(differ_k1 > 200, "only %d of 256 walks changed when their first event was stratified", differ_k1);
 }
 
+/* Walks that share their stratified pairs through a cache (a bake's channel walks) draw what they
+ * would draw alone, bit for bit, also for samples past 2^32, whose pairs are counter-based; the
+ * cache is used (its pairs made once). */
+static void test_shared_pairs(void)
+{
+    const double sigma_t[3] = {1.0, 2.0, 4.0}, albedo[3] = {0.99, 0.95, 0.8};
+    const dwvw_shape sphere = {DWVW_SPHERE, 0.0, 10.0};
+    dwvw_medium media[3];
+    dwvw_guide guides[3];
+    for (int c = 0; c < 3; ++c) {
+        dwvw_medium_init(&media[c], 1, &sigma_t[c], &albedo[c], 0.0);
+        dwvw_guide_init(&guides[c], c == 0 ? DWVW_CLASSICAL : DWVW_POE, &media[c], NULL, 0);
+    }
+    int same = 1, shared = 0;
+    for (uint64_t s = 0; s < 512; ++s) {
+        uint64_t index = s < 256 ? s : (1ull << 32) + s; /* past 2^32: not stratified */
+        dwvk_sampler sampler = {.key = dwvk_rng_key(7u, 0u, 0u), .index = index, .stratified = 1};
+        dwvw_pair_cache pairs = {.first_pair = FIRST_PAIR, .have = 0u, .stratified = 0u};
+        for (int c = 0; c < 3; ++c) {
+            uint64_t key = dwvk_rng_key(8u, (uint64_t)c, s);
+            one_walk alone = run_walk_shared(&media[c], &guides[c], &sphere, key, &sampler, 8u, NULL);
+            uint32_t had = pairs.have;
+            one_walk with = run_walk_shared(&media[c], &guides[c], &sphere, key, &sampler, 8u, &pairs);
+            same &= alone.status == with.status && alone.events == with.events && alone.score[0] == with.score[0];
+            shared += c > 0 && had != 0u;
+        }
+        same &= s < 256 ? pairs.stratified != 0u : pairs.stratified == 0u;
+    }
+    CHECK(same, "walks sharing their pairs differ from walks alone");
+    CHECK(shared == 1024, "the later walks found %d of 1024 caches filled", shared);
+}
+
 int main(void)
 {
     const double grey_sigma = 1.0, grey_albedo = 0.99;
@@ -183,5 +223,6 @@ int main(void)
     test_case("rgb classical", 3, rgb_sigma, rgb_albedo, DWVW_CLASSICAL, 1);
     test_case("rgb auto", 3, rgb_sigma, rgb_albedo, DWVW_AUTO, 1);
     test_first_events_only();
+    test_shared_pairs();
     return check_report("test_walk_stratified");
 }
