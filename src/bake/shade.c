@@ -230,16 +230,31 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, 
          * Dwivedi distribution), so no channel's weight carries another's sampling pdf. They
          * share the entry and the pixel's stratified numbers (each channel is stratified over the
          * pixel's samples), made once for the three (`pairs`); their counter-based numbers differ. */
-        dwvw_pair_cache pairs = {.first_pair = walk_pair, .have = 0u, .stratified = 0u};
+        dwvw_pair_cache pairs[DWVB_MAX_CHANNEL_WALKS]; /* bits are written before they are read */
+        for (uint32_t j = 0; j < DWVB_MAX_CHANNEL_WALKS; ++j) {
+            pairs[j].first_pair = walk_pair + j * DWVW_PAIRS_PER_EVENT * DWVB_STRATIFIED_EVENTS;
+            pairs[j].have = pairs[j].stratified = 0u;
+        }
         for (int c = 0; c < 3; ++c) {
             if (!(material->walk_scale[c] > 0.0)) continue;
-            int exited = run_walk(shader, hit->mesh, &material->channel_medium[c],
-                                  &shader->channel_guides[3u * hit->mesh + (uint32_t)c], hit->prim, x, inward, n,
-                                  dwvk_mix64(key_walk + (uint64_t)c), sampler, walk_pair, &pairs, &walk, &exit, tally);
-            if (walk.status == DWVW_TRUNCATED) tally->truncated[c] += walk.weight[0] * material->walk_scale[c];
-            if (!exited) continue;
-            exit_light(shader, hit->mesh, material, &walk, &exit, sampler, exit_pair, direct);
-            rgb[c] += walk.weight[0] * material->walk_scale[c] * direct[c];
+            /* A channel of `count` walks averages them; walk j draws its own stratified pairs
+             * (shared with the other channels' walk j) and counter-based numbers. */
+            uint32_t count = shader->channel_counts ? shader->channel_counts[3u * hit->mesh + (uint32_t)c] : 1u;
+            uint64_t walks = tally->walks, events = tally->events, terms = tally->mixture_terms;
+            for (uint32_t j = 0; j < count; ++j) {
+                int exited = run_walk(shader, hit->mesh, &material->channel_medium[c],
+                                      &shader->channel_guides[3u * hit->mesh + (uint32_t)c], hit->prim, x, inward, n,
+                                      dwvk_mix64(key_walk + (uint64_t)c + 3u * (uint64_t)j), sampler,
+                                      pairs[j].first_pair, &pairs[j], &walk, &exit, tally);
+                double share = material->walk_scale[c] / (double)count;
+                if (walk.status == DWVW_TRUNCATED) tally->truncated[c] += walk.weight[0] * share;
+                if (!exited) continue;
+                exit_light(shader, hit->mesh, material, &walk, &exit, sampler, exit_pair, direct);
+                rgb[c] += walk.weight[0] * share * direct[c];
+            }
+            tally->channel_walks[c] += tally->walks - walks;
+            tally->channel_events[c] += tally->events - events;
+            tally->channel_terms[c] += tally->mixture_terms - terms;
         }
         return;
     }

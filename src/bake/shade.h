@@ -25,6 +25,10 @@ typedef struct dwvb_shader {
      * that carries the three channels by spectral MIS. NULL: none does. */
     const int *channel_walks;
     const dwvw_guide *channel_guides;
+    /* Per mesh x 3, where channels walk apart: walks per sample of each channel, 1 to
+     * DWVB_MAX_CHANNEL_WALKS, each weighing 1 / count (NULL: one each). Auto's pilot sets them
+     * where a channel's variance is worth more walks than its cost (bake.c). */
+    const uint8_t *channel_counts;
     uint32_t max_events;
 } dwvb_shader;
 
@@ -40,6 +44,8 @@ typedef struct dwvb_tally {
      * the surface. */
     uint64_t rays, point_queries, ray_free_steps, ray_free_misses;
     double truncated[3];
+    /* Of the walks above, those of channel walks by channel: walks, events and mixture terms. */
+    uint64_t channel_walks[3], channel_events[3], channel_terms[3];
 } dwvb_tally;
 
 /* Pairs of random dimensions shading uses before direct lighting starts: the entry direction. */
@@ -51,6 +57,9 @@ typedef struct dwvb_tally {
  * the first event alone gives x0.67 to x0.85, 16 events or all of them no more than 8 within the
  * noise, while each stratified event costs two sampler pairs (docs/speed.md, "Stratified walks"). */
 #define DWVB_STRATIFIED_EVENTS 8u
+/* Walks per sample of one channel at most (channel_counts); walk j of a channel takes the sampler
+ * pairs DWVW_PAIRS_PER_EVENT x DWVB_STRATIFIED_EVENTS x j after the first's. */
+#define DWVB_MAX_CHANNEL_WALKS 3u
 
 /* The radiance leaving hit point `hit` along -view (view: unit direction of the ray that found
  * it, from the viewer). `sampler` drives entry and light sampling from pair `pair` on, then the

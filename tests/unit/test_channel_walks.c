@@ -18,9 +18,37 @@ static dwv_scene_t *wax_sphere(int flat_channel, int grey)
     return test_wax_sphere(flat_channel, grey, 16, 32);
 }
 
+/* The report's back-lit slab: 4 x 4 x 0.1 m, radius (1, 0.5, 0.25) (1.3, 2.5 and 5 mean free
+ * paths thick), colour 0.8, a sun from below, seen from above (every pixel sees the slab). */
+static dwv_scene_t *backlit_slab(void)
+{
+    dwv_scene_t *scene;
+    if (dwv_scene_create(&scene) != DWV_SUCCESS) exit(2);
+    dwv_material_t m = DWV_MATERIAL_INIT;
+    static const double radius[3] = {1.0, 0.5, 0.25};
+    for (int c = 0; c < 3; ++c) {
+        m.base_color[c] = m.subsurface_color[c] = 0.8;
+        m.subsurface_radius[c] = radius[c];
+    }
+    m.subsurface_scale = 1.0;
+    test_mesh box = test_box(-2.0, -2.0, -0.05, 2.0, 2.0, 0.05);
+    test_add(scene, &box, &m);
+    test_mesh_free(&box);
+    dwv_light_desc_t sun = DWV_LIGHT_DESC_INIT;
+    sun.strength = 3.0;
+    sun.direction[2] = 1.0;
+    dwv_camera_t camera = test_ortho_camera(0.0, 0.0, 3.0, 1.0);
+    if (dwv_scene_add_light(scene, &sun) || dwv_scene_set_camera(scene, &camera) || dwv_scene_commit(scene)) {
+        fprintf(stderr, "scene: %s\n", dwv_last_error_message());
+        exit(2);
+    }
+    return scene;
+}
+
 typedef struct result {
     double mean[3], standard_error[3];
     uint32_t features;
+    uint64_t walks, samples;
     float *rgba;
     size_t pixels;
 } result;
@@ -45,6 +73,8 @@ static int bake(dwv_scene_t *scene, dwv_technique_t technique, dwv_channel_walks
     dwv_image_stats(image, &st);
     dwv_image_info(image, &info);
     out->features = st.features;
+    out->walks = st.walks;
+    out->samples = st.samples;
     out->pixels = (size_t)info.width * info.height;
     out->rgba = malloc(4u * out->pixels * sizeof *out->rgba);
     if (!out->rgba) exit(2);
@@ -165,11 +195,37 @@ static void test_option_and_names(void)
     dwv_scene_release(scene);
 }
 
+/* Auto's pilot gives a channel more walks per sample where they are cheap and its variance is
+ * large: on the back-lit slab, red (1.3 mean free paths thick, walks of 2.4 events) against blue
+ * (5, 11 events). The image keeps its mean (each of a channel's walks weighs 1 / count). */
+static void test_walk_counts(void)
+{
+    dwv_scene_t *scene = backlit_slab();
+    result shared, counted;
+    if (bake(scene, DWV_TECHNIQUE_INCIDENT, DWV_CHANNEL_WALKS_SHARED, 2048, 5, &shared) &&
+        bake(scene, DWV_TECHNIQUE_AUTO, DWV_CHANNEL_WALKS_SEPARATE, 2048, 6, &counted)) {
+        double walks_per_sample = (double)counted.walks / (double)counted.samples;
+        CHECK(counted.features & DWV_FEATURE_CHANNEL_WALKS && walks_per_sample > 3.5,
+              "slab: %.2f walks per sample with channel walks (features %#x): no channel got more than one",
+              walks_per_sample, counted.features);
+        for (int c = 0; c < 3; ++c) {
+            double difference = counted.mean[c] - shared.mean[c];
+            double error = hypot(counted.standard_error[c], shared.standard_error[c]);
+            CHECK(fabs(difference) < 4.5 * error, "slab, channel %d: %.6f with counted walks, %.6f shared (%.1f standard errors)",
+                  c, counted.mean[c], shared.mean[c], difference / error);
+        }
+        free(shared.rgba);
+        free(counted.rgba);
+    }
+    dwv_scene_release(scene);
+}
+
 int main(void)
 {
     test_option_and_names();
     test_grey_walks_once();
     test_means_agree();
     test_separate_is_less_noisy();
+    test_walk_counts();
     return check_report("test_channel_walks");
 }
