@@ -546,7 +546,7 @@ enum {
     DWV_FEATURE_SUBSURFACE = 1u << 1,        /* random walks (some material scatters) */
     DWV_FEATURE_CLOSEST_POINT = 1u << 2,     /* closest-point queries during walks */
     DWV_FEATURE_INCIDENT_PATCHES = 1u << 3,  /* lit patches for incident-illumination guiding */
-    DWV_FEATURE_RGB_WALKS = 1u << 4,         /* three-channel walks (else grey, one channel) */
+    DWV_FEATURE_RGB_WALKS = 1u << 4,         /* walks carrying three colour channels together */
     DWV_FEATURE_GUIDED = 1u << 5,            /* Dwivedi guiding (else classical: albedo too low) */
     DWV_FEATURE_WORLD_LIGHT = 1u << 6,       /* the world is sampled (not black) */
     DWV_FEATURE_DIRECT_LIGHTS = 1u << 7,     /* next-event estimation to lights */

@@ -657,7 +657,8 @@ static void setup_guides(dwvb_bake *bake)
  *   image's variance per sample was 10x lower with one backward walk per channel, for 1.6x the
  *   time per sample (docs/speed.md); on the leaf (one extinction, albedos apart) it was not worth
  *   its cost. The pilot's variance is the three channels' together, as the image's RMSE over RGB
- *   counts it: the luminance hides the colour noise of shared walks.
+ *   counts it: the luminance hides the colour noise of shared walks. A channel-walk candidate
+ *   also gets the walks per sample of each channel that suit it (candidate_work).
  * Auto's mixture itself (the guided part plus a classical share of 1% or less) is no candidate:
  * its variance was that of the guided part alone within the pilot's noise and its cost above it,
  * so it won none of the pilots on the report's sphere, slab, leaf and default scene (both meshes)
@@ -862,8 +863,9 @@ static int run_pilot(dwvb_bake *bake, const dwvb_shader *shaders, const int *can
  * together, as the image's RMSE over RGB counts it: the luminance would hide the colour noise of
  * shared walks, whose channels' weights move against each other. With channel walks, also how many
  * walks each walking channel takes per sample (counts, 1 to DWVB_MAX_CHANNEL_WALKS; else 1): the
- * optimal allocation of stratified sampling (Cochran 1977, Sec. 5.5: n_c ~ sqrt(v_c / t_c)),
- * searched exactly over the counts. n walks of a channel divide its variance v_c by n and multiply
+ * optimal allocation of stratified sampling with a cost per stratum (Cochran 1977, Sampling
+ * Techniques, ch. 5: n_c ~ sqrt(v_c / t_c)), searched exactly over the counts, some channel keeping
+ * one walk (below). n walks of a channel divide its variance v_c by n and multiply
  * its walks' cost t_c by n; the rest of a sample's cost is shared. A channel whose walks are cheap
  * and noisy gets more of them: the back-lit slab's red, 1.3 mean free paths thick, against its
  * blue, 5 (docs/speed.md). Fewer than one walk per sample would cost the channel's squared mean
