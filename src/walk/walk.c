@@ -243,7 +243,8 @@ static const dwvw_frame *frame_about_axis(dwvw_walk *walk, dwvw_vec3 axis)
 
 void dwvw_walk_share_pairs(dwvw_walk *walk, dwvw_pair_cache *cache)
 {
-    walk->pair_cache = cache;
+    /* A cache of other pairs would hand out wrong numbers: the walk then makes its own. */
+    walk->pair_cache = cache != NULL && cache->first_pair == walk->first_pair ? cache : NULL;
 }
 
 /* dwvk_sampler_pair_bits for the walk's pair `pair`, through its cache where it has one. */

@@ -174,9 +174,9 @@ void dwvw_walk_begin(dwvw_walk *walk, const dwvw_medium *medium, const dwvw_guid
  * same; only the walks of one pixel are stratified against each other. Events whose pairs would
  * pass 2^32 - 1 stay counter-based. */
 void dwvw_walk_stratify(dwvw_walk *walk, const dwvk_sampler *sampler, uint32_t first_pair, uint32_t events);
-/* After dwvw_walk_stratify: the walk takes its stratified pairs from `cache` (cache->first_pair
- * must be the walk's first pair), making and keeping there those it is the first to need. Walks
- * that share a cache draw the same numbers they would draw without it, bit for bit. */
+/* After dwvw_walk_stratify: the walk takes its stratified pairs from `cache`, making and keeping
+ * there those it is the first to need (a cache whose first_pair is not the walk's is not used).
+ * Walks that share a cache draw the same numbers they would draw without it, bit for bit. */
 void dwvw_walk_share_pairs(dwvw_walk *walk, dwvw_pair_cache *cache);
 /* Before dwvw_walk_sample, where the guide needs it: the closest surface point's outward normal. */
 void dwvw_walk_set_closest(dwvw_walk *walk, dwvw_vec3 normal);

@@ -211,6 +211,12 @@ static void test_shared_pairs(void)
         }
         same &= s < 256 ? pairs.stratified != 0u : pairs.stratified == 0u;
     }
+    /* A cache of other pairs is not used: the walk is its own. */
+    dwvk_sampler sampler = {.key = dwvk_rng_key(7u, 0u, 0u), .index = 3u, .stratified = 1};
+    dwvw_pair_cache other = {.first_pair = FIRST_PAIR + 1u, .have = 0u, .stratified = 0u};
+    one_walk alone = run_walk_shared(&media[0], &guides[0], &sphere, 99u, &sampler, 8u, NULL);
+    one_walk with = run_walk_shared(&media[0], &guides[0], &sphere, 99u, &sampler, 8u, &other);
+    same &= alone.events == with.events && alone.score[0] == with.score[0] && other.have == 0u;
     CHECK(same, "walks sharing their pairs differ from walks alone");
     CHECK(shared == 1024, "the later walks found %d of 1024 caches filled", shared);
 }
