@@ -400,8 +400,8 @@ class ErrorPoint:
 @dataclass(frozen=True)
 class BakeStats:
     """What a bake did (dwv_bake_stats_t). estimated_relative_error is the image's estimated
-    relative RMSE (per-pixel noise over mean brightness, from the pixels' own variances); mean_rgb
-    the mean of the covered pixels."""
+    relative RMSE (per-pixel noise over mean brightness, from the spread between each pixel's two
+    independent stratified replicates); mean_rgb the mean of the covered pixels."""
 
     technique: str
     samples_per_pixel: int
