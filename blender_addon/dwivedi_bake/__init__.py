@@ -194,8 +194,12 @@ class _Job:
         # Degenerate geometry the library met (zero-area, non-finite or too distant triangles, open
         # meshes, backs of faces): said in the summary, so that a left-out mesh is not a mystery.
         degenerate = f", {stats.warnings} geometry warnings" if stats.warnings else ""
+        # The technique asked for and whether the walks carried the colour channels apart (the
+        # Channel Walks setting, or auto's choice per mesh), which the setting alone does not say.
+        walks = stats.technique + (" with channel walks" if "channel_walks" in stats.features else "")
         return (f"Dwivedi bake: {self.exported.width} x {self.exported.height}, {stats.samples_per_pixel} spp, "
-                f"{stats.seconds:.2f} s, est. error {stats.estimated_relative_error:.2%}{degenerate} -> {self.exr}")
+                f"{stats.seconds:.2f} s, est. error {stats.estimated_relative_error:.2%}, {walks}{degenerate} -> "
+                f"{self.exr}")
 
     def close(self):
         if self.bake is not None:

@@ -128,6 +128,15 @@ class AddonTest(harness.unittest.TestCase):
                 job.close()
             self.assertEqual("channel_walks" in features, separate, (choice, features))
             self.assertEqual("rgb_walks" in features, not separate, (choice, features))
+            # The operator's one-line summary says whether the channels walked apart.
+            job = module._Job(bpy.context, props)
+            try:
+                job.start()
+                summary = job.finish(bpy.context, props)
+            finally:
+                job.close()
+            self.assertIn(", classical", summary)
+            self.assertEqual("with channel walks" in summary, separate, summary)
         result, error = harness.call_operator(channel_walks='SEPARATE')
         self.assertEqual(result, {'FINISHED'}, error)
         _, _, pixels = harness.image_pixels("Dwivedi Camera")
