@@ -134,7 +134,7 @@ static void test_means_agree(void)
 static void test_separate_is_less_noisy(void)
 {
     dwv_scene_t *scene = wax_sphere(-1, 0);
-    result shared, separate;
+    result shared = {.rgba = NULL}, separate = {.rgba = NULL};
     if (bake(scene, DWV_TECHNIQUE_BACKWARD, DWV_CHANNEL_WALKS_SHARED, 256, 3, &shared) &&
         bake(scene, DWV_TECHNIQUE_BACKWARD, DWV_CHANNEL_WALKS_SEPARATE, 256, 3, &separate)) {
         double shared_variance = 0.0, separate_variance = 0.0;
@@ -144,9 +144,9 @@ static void test_separate_is_less_noisy(void)
         }
         CHECK(separate_variance < 0.5 * shared_variance, "variance of the image mean: separate %.3g, shared %.3g",
               separate_variance, shared_variance);
-        free(shared.rgba);
-        free(separate.rgba);
     }
+    free(shared.rgba);
+    free(separate.rgba);
     dwv_scene_release(scene);
 }
 
@@ -154,16 +154,16 @@ static void test_separate_is_less_noisy(void)
 static void test_grey_walks_once(void)
 {
     dwv_scene_t *scene = wax_sphere(-1, 1);
-    result shared, separate;
+    result shared = {.rgba = NULL}, separate = {.rgba = NULL};
     if (bake(scene, DWV_TECHNIQUE_BACKWARD, DWV_CHANNEL_WALKS_SHARED, 16, 4, &shared) &&
         bake(scene, DWV_TECHNIQUE_BACKWARD, DWV_CHANNEL_WALKS_SEPARATE, 16, 4, &separate)) {
         CHECK(memcmp(shared.rgba, separate.rgba, 4u * shared.pixels * sizeof *shared.rgba) == 0,
               "grey: separate and shared pixels differ");
         CHECK(!(separate.features & (DWV_FEATURE_CHANNEL_WALKS | DWV_FEATURE_RGB_WALKS)), "grey: features %#x",
               separate.features);
-        free(shared.rgba);
-        free(separate.rgba);
     }
+    free(shared.rgba);
+    free(separate.rgba);
     dwv_scene_release(scene);
 }
 
@@ -201,7 +201,7 @@ static void test_option_and_names(void)
 static void test_walk_counts(void)
 {
     dwv_scene_t *scene = backlit_slab();
-    result shared, counted;
+    result shared = {.rgba = NULL}, counted = {.rgba = NULL};
     if (bake(scene, DWV_TECHNIQUE_INCIDENT, DWV_CHANNEL_WALKS_SHARED, 2048, 5, &shared) &&
         bake(scene, DWV_TECHNIQUE_AUTO, DWV_CHANNEL_WALKS_SEPARATE, 2048, 6, &counted)) {
         double walks_per_sample = (double)counted.walks / (double)counted.samples;
@@ -214,9 +214,9 @@ static void test_walk_counts(void)
             CHECK(fabs(difference) < 4.5 * error, "slab, channel %d: %.6f with counted walks, %.6f shared (%.1f standard errors)",
                   c, counted.mean[c], shared.mean[c], difference / error);
         }
-        free(shared.rgba);
-        free(counted.rgba);
     }
+    free(shared.rgba);
+    free(counted.rgba);
     dwv_scene_release(scene);
 }
 
