@@ -255,7 +255,9 @@ enum {
     DWV_TECHNIQUE_CLOSEST = 3,   /* Dwivedi about the closest surface point's normal (Meng 2016) */
     DWV_TECHNIQUE_INCIDENT = 4,  /* Dwivedi toward lit surface patches (Meng 2016) */
     DWV_TECHNIQUE_BACKWARD = 5,  /* entry normal or, by depth, an opposite interface (Cycles) */
-    DWV_TECHNIQUE_CYCLES = 6     /* Cycles' mixture: classical 1/2 + backward 1/2 */
+    DWV_TECHNIQUE_CYCLES = 6,    /* Cycles' mixture: classical 1/2 + backward 1/2 */
+    DWV_TECHNIQUE_SHEET = 7      /* toward the lit side through a thin sheet: an importance linear
+                                    in the height (zero-variance theory), classical share 1% */
 };
 DWV_API const char *dwv_technique_name(dwv_technique_t technique);
 DWV_API dwv_result_t dwv_technique_from_name(const char *name, dwv_technique_t *technique);
@@ -551,7 +553,8 @@ enum {
     DWV_FEATURE_WORLD_LIGHT = 1u << 6,       /* the world is sampled (not black) */
     DWV_FEATURE_DIRECT_LIGHTS = 1u << 7,     /* next-event estimation to lights */
     DWV_FEATURE_DIFFUSE_SURFACES = 1u << 8,  /* plain diffuse surfaces shaded */
-    DWV_FEATURE_CHANNEL_WALKS = 1u << 9      /* one walk per colour channel (DWV_CHANNEL_WALKS_SEPARATE) */
+    DWV_FEATURE_CHANNEL_WALKS = 1u << 9,     /* one walk per colour channel (DWV_CHANNEL_WALKS_SEPARATE) */
+    DWV_FEATURE_SHEET = 1u << 10             /* walks toward a thin sheet's lit side (DWV_TECHNIQUE_SHEET) */
 };
 /* The lower-case name of one feature bit ("embree", "closest_point"...), or NULL. */
 DWV_API const char *dwv_feature_name(uint32_t feature);

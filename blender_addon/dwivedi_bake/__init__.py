@@ -36,6 +36,7 @@ TECHNIQUES = [
     ('INCIDENT', "Incident Illumination", "Dwivedi sampling toward lit surface patches (Meng 2016)"),
     ('BACKWARD', "Backward", "Entry normal or an opposite interface, by depth (as Cycles)"),
     ('CYCLES', "Cycles Mixture", "Cycles' own mixture: half classical, half backward-guided"),
+    ('SHEET', "Thin Sheet", "Toward the lit side through a thin sheet (leaves, ears, paper): importance linear in depth"),
 ]
 
 # dwv_channel_walks_t (capi/dwivedi.h): how walks carry the three colour channels of a medium whose

@@ -57,7 +57,7 @@ static dwv_result_t check_options(const char *fn, const dwvb_scene *s, const dwv
         (uint64_t)o->width * o->height > MAX_PIXELS)
         return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: %u x %u pixels: each side must be 1 to %u and at most %u pixels",
                         fn, o->width, o->height, MAX_SIDE, MAX_PIXELS);
-    if (o->technique < DWV_TECHNIQUE_AUTO || o->technique > DWV_TECHNIQUE_CYCLES)
+    if (o->technique < DWV_TECHNIQUE_AUTO || o->technique > DWV_TECHNIQUE_SHEET)
         return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: technique %d is not known", fn, (int)o->technique);
     if (o->channel_walks > DWV_CHANNEL_WALKS_SEPARATE)
         return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,

@@ -309,6 +309,7 @@ const char *dwv_feature_name(uint32_t feature)
     case DWV_FEATURE_DIRECT_LIGHTS: return "direct_lights";
     case DWV_FEATURE_DIFFUSE_SURFACES: return "diffuse_surfaces";
     case DWV_FEATURE_CHANNEL_WALKS: return "channel_walks";
+    case DWV_FEATURE_SHEET: return "sheet";
     default: return NULL;
     }
 }

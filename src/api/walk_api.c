@@ -15,7 +15,7 @@
 #define DEFAULT_MAX_EVENTS 1000000u
 #define MAX_WALKS 1000000000000ull
 
-static const char *const technique_names[] = {"auto", "classical", "poe", "closest", "incident", "backward", "cycles"};
+static const char *const technique_names[] = {"auto", "classical", "poe", "closest", "incident", "backward", "cycles", "sheet"};
 #define TECHNIQUE_COUNT ((int32_t)(sizeof technique_names / sizeof technique_names[0]))
 
 const char *dwv_technique_name(dwv_technique_t technique)
@@ -35,7 +35,7 @@ dwv_result_t dwv_technique_from_name(const char *name, dwv_technique_t *techniqu
     }
     return dwv_fail(DWV_ERROR_UNKNOWN_NAME,
                     "dwv_technique_from_name: unknown technique '%.64s' (auto, classical, poe, closest, "
-                    "incident, backward or cycles)", name);
+                    "incident, backward, cycles or sheet)", name);
 }
 
 static long sysconf_cores(void)

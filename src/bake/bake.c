@@ -560,7 +560,8 @@ static int mesh_used(const dwvb_bake *bake, uint32_t m)
 static void update_features(dwvb_bake *bake)
 {
     const dwvb_scene *scene = bake->scene;
-    uint32_t features = scene->features & ~(uint32_t)(DWV_FEATURE_INCIDENT_PATCHES | DWV_FEATURE_CLOSEST_POINT);
+    uint32_t features = scene->features & ~(uint32_t)(DWV_FEATURE_INCIDENT_PATCHES | DWV_FEATURE_CLOSEST_POINT |
+                                                      DWV_FEATURE_SHEET);
     int rgb = 0;
     for (uint32_t m = 0; m < scene->mesh_count; ++m) {
         const dwvb_material *material = &scene->shading[scene->meshes[m].material_id];
@@ -571,6 +572,7 @@ static void update_features(dwvb_bake *bake)
             if (bake->channel_walks[m] && !(material->walk_scale[c] > 0.0)) continue;
             if (guides[c].q_incident > 0.0 && guides[c].patch_count > 0) features |= DWV_FEATURE_INCIDENT_PATCHES;
             if (guides[c].q_classical < 1.0) features |= DWV_FEATURE_GUIDED;
+            if (guides[c].q_sheet > 0.0) features |= DWV_FEATURE_SHEET;
         }
         if (bake->channel_walks[m]) features |= DWV_FEATURE_CHANNEL_WALKS;
         else if (!material->grey) rgb = 1;

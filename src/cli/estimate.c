@@ -23,7 +23,7 @@ static void help(FILE *out)
             "  --anisotropy G Henyey-Greenstein g in (-1, 1) (default 0)\n"
             "  --incidence    normal (default), diffuse (cosine-weighted), or a cosine in (0, 1]\n"
             "  --light        front (default), back, both: which exits score\n"
-            "  --technique    auto, classical, poe, closest, incident, backward, cycles\n"
+            "  --technique    auto, classical, poe, closest, incident, backward, cycles, sheet\n"
             "  --walks N      number of walks, 2 to 10^12\n"
             "  --seed S       random seed (default 0); the result does not depend on --threads\n"
             "  --threads N    worker threads (default: all cores)\n"

@@ -1,7 +1,10 @@
 #include "walk.h"
 
 #include <float.h>
+#include <math.h>
 #include <string.h>
+
+#include "kernel/sheet.h"
 
 void dwvw_medium_init(dwvw_medium *medium, int channels, const double *sigma_t, const double *albedo, double g)
 {
@@ -52,6 +55,8 @@ void dwvw_guide_init(dwvw_guide *guide, dwvw_technique technique, const dwvw_med
                      const dwvw_light_patch *patches, int patch_count)
 {
     guide->q_classical = guide->q_poe = guide->q_closest = guide->q_incident = guide->q_backward = 0.0;
+    guide->q_sheet = 0.0;
+    guide->sheet_normal = dwvw_v(0.0, 0.0, 1.0);
     guide->patch_count = patch_count < DWVW_MAX_PATCHES ? patch_count : DWVW_MAX_PATCHES;
     for (int i = 0; i < guide->patch_count; ++i) {
         guide->patches[i] = patches[i];
@@ -63,6 +68,19 @@ void dwvw_guide_init(dwvw_guide *guide, dwvw_technique technique, const dwvw_med
     case DWVW_CLOSEST: guide->q_closest = 1.0; break;
     case DWVW_INCIDENT: guide->q_incident = 1.0; break;
     case DWVW_BACKWARD: guide->q_backward = 1.0; break;
+    case DWVW_SHEET: {
+        if (guide->patch_count == 0) { /* no lit side to aim at */
+            guide->q_classical = 1.0;
+            break;
+        }
+        int strongest = 0;
+        for (int i = 1; i < guide->patch_count; ++i)
+            if (guide->patches[i].power > guide->patches[strongest].power) strongest = i;
+        guide->sheet_normal = guide->patches[strongest].normal;
+        guide->q_classical = fmax(DWVW_SHEET_CLASSICAL_SHARE, fabs(medium->g));
+        guide->q_sheet = 1.0 - guide->q_classical;
+        break;
+    }
     case DWVW_CYCLES: {
         /* Cycles: guided_fraction = 1 - max(0.5, |g|^(1/8)). */
         double guided = 1.0 - fmax(0.5, pow(fabs(medium->g), 0.125));
@@ -81,10 +99,18 @@ int dwvw_guide_needs_closest(const dwvw_guide *guide)
     return guide->q_closest > 0.0;
 }
 
+/* Classical sampling alone: the guide of sheet walks that enter on the lit side. */
+static const dwvw_guide classical_guide = {.q_classical = 1.0, .sheet_normal = {0.0, 0.0, 1.0}};
+
 void dwvw_walk_begin(dwvw_walk *walk, const dwvw_medium *medium, const dwvw_guide *guide, uint64_t key,
                      uint32_t max_events, dwvw_vec3 point, dwvw_vec3 direction, dwvw_vec3 normal)
 {
     walk->medium = medium;
+    /* The sheet's importance rises from the far face toward the lit one: a walk that enters on the
+     * lit side (its entry faces the lit normal's way) has no far face to start from, and its
+     * light leaves where it came in, which the linear importance does not describe (a front-lit
+     * sphere's variance was 10^4 times classical's). Such a walk is classical. */
+    if (guide->q_sheet > 0.0 && dwvw_dot(normal, guide->sheet_normal) > 0.0) guide = &classical_guide;
     walk->guide = guide;
     walk->key = key;
     walk->sampler = NULL;
@@ -265,6 +291,71 @@ static inline int walk_pair_bits(const dwvw_walk *walk, uint32_t pair, uint64_t 
     return (cache->stratified & bit) != 0u;
 }
 
+/* The sheet technique's importance a = sigma_t h + z_e per channel at the walk's position, h its
+ * height above the entry point toward the lit side, held at h >= 0 (src/kernel/sheet.h: a sheet's
+ * far face is where its walks come in). */
+static void sheet_importance(const dwvw_walk *walk, double a[DWVW_MAX_CHANNELS])
+{
+    const dwvw_medium *m = walk->medium;
+    double h = dwvw_dot(dwvw_sub(walk->position, walk->entry_point), walk->guide->sheet_normal);
+    h = h > 0.0 ? h : 0.0;
+    for (int c = 0; c < m->channels; ++c) a[c] = m->sigma_t[c] * h + DWVK_SHEET_EXTRAPOLATION;
+}
+
+/* A step of the sheet technique (after the channel's pick): classical with probability
+ * q_classical, else the sheet's cosine about the lit normal (its slope from the importance of the
+ * channel that guides, so that the direction's pdf is the same for every channel) and the picked
+ * channel's flight (src/kernel/sheet.h). The random numbers are those of dwvw_walk_sample. */
+static double sheet_sample(dwvw_walk *walk, int channel, const double *choice, float u_flight, uint32_t dim,
+                           uint32_t pair)
+{
+    const dwvw_medium *m = walk->medium;
+    const dwvw_guide *guide = walk->guide;
+    const dwvw_vec3 normal = guide->sheet_normal;
+    /* two components for the tally of mixture terms (shade.c); the weight update is sheet_weight_update */
+    walk->component_count = 2;
+    walk->single_component = -1;
+    walk->component_q[0] = guide->q_classical;
+    walk->component_q[1] = guide->q_sheet;
+    sheet_importance(walk, walk->sheet_a);
+    double u_component = choice != NULL ? *choice : dwvk_rng_uniform_d(walk->key, dim + DWVW_DIM_COMPONENT);
+    int classical = u_component < guide->q_classical;
+    double beta = dwvk_sheet_beta(walk->sheet_a[m->guide_channel]);
+    dwvw_vec3 previous = walk->direction;
+    float g = (float)m->g;
+    if (walk->events > 0) {
+        dwvk_uniform_pair_f u;
+        if (choice != NULL) {
+            uint64_t both = 0u;
+            int have = walk_pair_bits(walk, pair + DWVW_PAIR_DIRECTION, &both);
+            u = dwvk_sampler_pair_given_f(walk->sampler, pair + DWVW_PAIR_DIRECTION, have, both);
+        } else {
+            u = dwvk_rng_uniform_pair_f(walk->key, dim + DWVW_DIM_DIRECTION);
+        }
+        if (classical) {
+            walk->direction = dwvw_classical_direction(previous, g, u);
+        } else {
+            double mu = dwvk_sheet_cosine_sample(beta, (double)u.a);
+            double sin2 = (1.0 - mu) * (1.0 + mu);
+            walk->direction = dwvw_frame_direction(frame_about_axis(walk, normal), mu, sqrt(sin2 > 0.0 ? sin2 : 0.0),
+                                                   dwvk_azimuth_f(u.b));
+        }
+        walk->phase = g == 0.0f ? DWVK_INV_FOUR_PI : dwvk_hg_pdf_f(g, (float)dwvw_cosine(previous, walk->direction));
+    } else {
+        walk->phase = 1.0; /* the entry's direction: not sampled, pdf 1 for every component */
+    }
+    /* the cosine of the direction as it is, for the flight and both pdfs alike */
+    walk->sheet_mu = dwvw_cosine(walk->direction, normal);
+    walk->sheet_direction_pdf = walk->events > 0 ? dwvk_sheet_cosine_pdf(beta, walk->sheet_mu) * DWVK_SHEET_INV_TWO_PI : 1.0;
+    for (int c = 0; c < m->channels; ++c) /* channels of equal extinction have equal importance */
+        walk->sheet_norm[c] = c > 0 && m->sigma_t[c] == m->sigma_t[c - 1]
+                                  ? walk->sheet_norm[c - 1]
+                                  : dwvk_sheet_flight_norm(walk->sheet_a[c], walk->sheet_mu);
+    if (classical) walk->step_distance = dwvw_flight(m->sigma_t[channel], u_flight);
+    else walk->step_distance = dwvk_sheet_flight_sample(walk->sheet_a[channel], walk->sheet_mu, (double)u_flight) / m->sigma_t[channel];
+    return walk->step_distance;
+}
+
 double dwvw_walk_sample(dwvw_walk *walk)
 {
     const dwvw_medium *m = walk->medium;
@@ -294,6 +385,10 @@ double dwvw_walk_sample(dwvw_walk *walk)
                        stratified ? *choice : dwvk_rng_uniform_d(walk->key, dim + DWVW_DIM_CHANNEL), choice);
     } else {
         walk->channel_p[0] = 1.0;
+    }
+    if (walk->guide->q_sheet > 0.0) {
+        float u_flight = stratified ? flight_distance : dwvk_rng_uniform_f(walk->key, dim + DWVW_DIM_DISTANCE);
+        return sheet_sample(walk, channel, choice, u_flight, dim, pair);
     }
 
     if (walk->component_count == 0 || walk->components_vary) build_components(walk);
@@ -454,31 +549,45 @@ static void rgb_weight_update(dwvw_walk *walk, const double *qp, int first, int 
     }
 }
 
-double dwvw_walk_probe_reach(const dwvw_walk *walk)
+/* The sheet technique's weight update, for any channel count: as rgb_weight_update, with the
+ * sheet's flight pdf p(tau) = exp(-tau) x dwvk_sheet_flight_pdf_scaled (its tail on leaving) in
+ * place of Dwivedi's, so that every term keeps its factor exp(-sigma_c t) and the sum is formed
+ * relative to exp(-r t), r the smallest active extinction (nothing overflows; a channel's ratio
+ * underflows only where its weight is negligible). */
+static void sheet_weight_update(dwvw_walk *walk, double t, int exited)
 {
-    if (!(walk->guide->q_backward > 0.0)) return walk->step_distance;
-    /* An opposite interface counts within 10 mean free paths of the thinnest channel (Cycles'
-     * reach), or within the step. */
     const dwvw_medium *m = walk->medium;
-    double sigma_min = m->sigma_t[0];
-    for (int c = 1; c < m->channels; ++c) sigma_min = fmin(sigma_min, m->sigma_t[c]);
-    return fmax(walk->step_distance, 10.0 / sigma_min);
+    const dwvw_guide *guide = walk->guide;
+    double rate = INFINITY;
+    for (int c = 0; c < m->channels; ++c)
+        if (walk->channel_p[c] > 0.0 && m->sigma_t[c] < rate) rate = m->sigma_t[c];
+    if (!(rate < INFINITY)) rate = m->sigma_t[0];
+    double decay[DWVW_MAX_CHANNELS], denominator = 0.0, sheet = 0.0;
+    for (int c = 0; c < m->channels; ++c) {
+        double sigma = m->sigma_t[c];
+        decay[c] = sigma == rate ? 1.0 : dwvk_exp_fast((rate - sigma) * t);
+        if (!(walk->channel_p[c] > 0.0)) continue;
+        /* the sheet's pdf depends on the extinction alone: channels of equal extinction share it */
+        if (c == 0 || sigma != m->sigma_t[c - 1] || !(walk->channel_p[c - 1] > 0.0)) {
+            double a = walk->sheet_a[c], mu = walk->sheet_mu, tau = sigma * t;
+            double psi = a + mu * tau;
+            double scaled = exited ? dwvk_sheet_tail_integral(a, mu, tau) : psi > 0.0 ? sigma * psi : 0.0;
+            sheet = guide->q_sheet * walk->sheet_direction_pdf * scaled / walk->sheet_norm[c];
+        }
+        double classical = guide->q_classical * walk->phase * (exited ? 1.0 : sigma);
+        denominator += walk->channel_p[c] * (classical + sheet) * decay[c];
+    }
+    for (int c = 0; c < m->channels; ++c) {
+        double numerator = walk->phase * (exited ? 1.0 : m->sigma_t[c] * m->albedo[c]) * decay[c];
+        double ratio = numerator / denominator; /* >= 0 or NaN, as in rgb_weight_update */
+        walk->weight[c] *= ratio <= DBL_MAX ? ratio : 0.0;
+    }
 }
 
-dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 hit_normal)
+/* The weight update of a step of Dwivedi and classical components (every technique but sheet). */
+static void mixture_weight_update(dwvw_walk *walk, double t, int exited)
 {
     const dwvw_medium *m = walk->medium;
-    if (walk->events == 0 && walk->guide->q_backward > 0.0 && hit_distance < INFINITY) {
-        /* The first step's probe: an opposite interface within its reach. */
-        if (hit_distance <= dwvw_walk_probe_reach(walk)) {
-            walk->have_opposite = 1;
-            walk->components_vary = 1; /* the backward fraction now follows the depth */
-            walk->opposite_depth = -hit_distance * dwvw_dot(walk->direction, walk->entry_normal);
-        }
-    }
-    int exited = hit_distance <= walk->step_distance;
-    double t = exited ? hit_distance : walk->step_distance;
-
     /* weight_c' *= f_c' / p with p = sum_k Q_k p_k sum_c P_c pdist_{k,c}(t); f_c' and each pdist
      * share the factor exp(-sigma t), so the ratio is formed from exp(sigma_c' t - sigma_c s_k t)
      * and neither underflows alone. pdist is sigma s exp(-sigma s t) for a scattering event and
@@ -508,6 +617,35 @@ dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 h
     } else {
         rgb_weight_update(walk, qp, first, end, t, exited);
     }
+}
+
+double dwvw_walk_probe_reach(const dwvw_walk *walk)
+{
+    if (!(walk->guide->q_backward > 0.0)) return walk->step_distance;
+    /* An opposite interface counts within 10 mean free paths of the thinnest channel (Cycles'
+     * reach), or within the step. */
+    const dwvw_medium *m = walk->medium;
+    double sigma_min = m->sigma_t[0];
+    for (int c = 1; c < m->channels; ++c) sigma_min = fmin(sigma_min, m->sigma_t[c]);
+    return fmax(walk->step_distance, 10.0 / sigma_min);
+}
+
+dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 hit_normal)
+{
+    const dwvw_medium *m = walk->medium;
+    if (walk->events == 0 && walk->guide->q_backward > 0.0 && hit_distance < INFINITY) {
+        /* The first step's probe: an opposite interface within its reach. */
+        if (hit_distance <= dwvw_walk_probe_reach(walk)) {
+            walk->have_opposite = 1;
+            walk->components_vary = 1; /* the backward fraction now follows the depth */
+            walk->opposite_depth = -hit_distance * dwvw_dot(walk->direction, walk->entry_normal);
+        }
+    }
+    int exited = hit_distance <= walk->step_distance;
+    double t = exited ? hit_distance : walk->step_distance;
+
+    if (walk->guide->q_sheet > 0.0) sheet_weight_update(walk, t, exited);
+    else mixture_weight_update(walk, t, exited);
     walk->position = dwvw_madd(walk->position, walk->direction, t);
     if (exited) {
         walk->exit_normal = hit_normal;
@@ -519,6 +657,14 @@ dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 h
     double largest = 0.0;
     for (int c = 0; c < m->channels; ++c) largest = walk->weight[c] > largest ? walk->weight[c] : largest;
     if (!(largest > 0.0)) return walk->status = DWVW_ABSORBED;
+    if (walk->guide->q_sheet > 0.0) {
+        /* A sheet walk's weight falls as its importance rises (weight x importance stays near the
+         * answer): the roulette weighs that product, relative to the entry's importance z_e, so
+         * that walks nearing the lit side are not ended for their small weights. */
+        double a[DWVW_MAX_CHANNELS];
+        sheet_importance(walk, a);
+        largest *= a[m->guide_channel] / DWVK_SHEET_EXTRAPOLATION;
+    }
     if (largest < DWVW_ROULETTE_THRESHOLD) {
         /* Russian roulette below the threshold: survive with probability largest/threshold.
          * Guided walks carry weights near alpha exp(sigma kappa z)/(1 + kappa), just below 1 near

@@ -14,6 +14,9 @@
  *              along the entry direction found an opposite interface at depth D (as Cycles does,
  *              after d'Eon and Krivanek 2020; Cycles mixes world units and mean free paths there)
  *   cycles     Cycles' own mixture: classical 1/2 + backward 1/2 (isotropic media)
+ *   sheet      toward the strongest lit patch through a thin sheet, its direction and flight
+ *              drawn from an importance linear in the height (src/kernel/sheet.h), with a
+ *              classical share max(1%, |g|); classical alone where no light is known
  *   auto       a small classical share + incident (closest where no light is known)
  * The colour channel that drives the distance is chosen with probability proportional to
  * throughput x albedo, as Cycles does; the direction pdfs do not depend on it (v comes from the
@@ -67,9 +70,15 @@ typedef enum dwvw_technique {
     DWVW_CLOSEST = 3,
     DWVW_INCIDENT = 4,
     DWVW_BACKWARD = 5,
-    DWVW_CYCLES = 6
+    DWVW_CYCLES = 6,
+    DWVW_SHEET = 7
 } dwvw_technique;
-#define DWVW_TECHNIQUE_COUNT 7
+#define DWVW_TECHNIQUE_COUNT 8
+/* The sheet technique's classical share in isotropic media (|g| where that is larger): its
+ * direction pdf ignores the phase function's peak, and its flight reaches no farther below the
+ * walk than the importance stays positive, so the classical share covers every path
+ * (Hesterberg's defensive mixture: the weight per event is at most 1 / share). */
+#define DWVW_SHEET_CLASSICAL_SHARE 0.01
 
 typedef struct dwvw_medium {
     int channels;                        /* 1 (grey) or 3 */
@@ -94,7 +103,9 @@ typedef struct dwvw_light_patch {
 
 /* What a technique mixes, fixed for a walk. */
 typedef struct dwvw_guide {
-    double q_classical, q_poe, q_closest, q_incident, q_backward; /* sum to 1 */
+    double q_classical, q_poe, q_closest, q_incident, q_backward; /* sum to 1 with q_sheet */
+    double q_sheet;
+    dwvw_vec3 sheet_normal; /* the sheet technique's lit normal: the strongest patch's */
     int patch_count;
     dwvw_light_patch patches[DWVW_MAX_PATCHES];
 } dwvw_guide;
@@ -149,6 +160,10 @@ typedef struct dwvw_walk {
     double component_stretch[DWVW_MAX_COMPONENTS];
     double channel_p[DWVW_MAX_CHANNELS];
     double phase;                                   /* phase function value of the step */
+    /* the sheet technique's step: importance a per channel at its start, its cosine to the lit
+     * normal, the flight's normalisation N per channel, and its direction pdf per steradian (1 on
+     * the first step) */
+    double sheet_a[DWVW_MAX_CHANNELS], sheet_norm[DWVW_MAX_CHANNELS], sheet_mu, sheet_direction_pdf;
     /* Frames about the guided axes met so far (an axis repeats from event to event for every
      * technique but closest): dwvw_frame_about is a function of the axis's bits alone. */
     uint32_t frames_made;                           /* frames made so far; the slot of the next */

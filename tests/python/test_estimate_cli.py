@@ -41,7 +41,7 @@ class EstimateHelpTest(unittest.TestCase):
                 self.assertEqual(done.stderr, "")
                 self.assertIn("usage: dwivedi estimate", done.stdout)
                 for word in ("--scene", "--albedo", "--technique", "--walks", "--threads", "--json", "auto",
-                             "classical", "poe", "closest", "incident", "backward", "cycles"):
+                             "classical", "poe", "closest", "incident", "backward", "cycles", "sheet"):
                     self.assertIn(word, done.stdout)
 
     def test_listed_by_dwivedi_help(self) -> None:
@@ -89,7 +89,7 @@ class EstimateJsonTest(unittest.TestCase):
             self.assertGreater(result["efficiency"], 0.0)
 
     def test_technique_is_echoed(self) -> None:
-        for technique in ("classical", "poe", "closest", "incident", "backward", "cycles"):
+        for technique in ("classical", "poe", "closest", "incident", "backward", "cycles", "sheet"):
             with self.subTest(technique=technique):
                 result = self.estimate_json(*replaced(replaced(SMALL_RUN, "--technique", technique), "--walks", "200"))
                 self.assertEqual(result["technique"], technique)

@@ -165,4 +165,39 @@ static inline dwv_scene_t *test_wax_sphere(int flat_channel, int grey, uint32_t 
     return scene;
 }
 
+/* A 4 x 4 m box of material m and the given thickness centred on z = 0, under a sun of 3 that
+ * shines along sun_z (+1: from below, the box back-lit; -1: from the camera's side), seen from +z
+ * (orthographic, 1 m across: every pixel sees the top face), committed. Exits the test on failure. */
+static inline dwv_scene_t *test_sunlit_box(const dwv_material_t *m, double thickness, double sun_z)
+{
+    dwv_scene_t *scene;
+    if (dwv_scene_create(&scene) != DWV_SUCCESS) exit(2);
+    test_mesh box = test_box(-2.0, -2.0, -0.5 * thickness, 2.0, 2.0, 0.5 * thickness);
+    test_add(scene, &box, m);
+    test_mesh_free(&box);
+    dwv_light_desc_t sun = DWV_LIGHT_DESC_INIT;
+    sun.strength = 3.0;
+    sun.direction[2] = sun_z;
+    dwv_camera_t camera = test_ortho_camera(0.0, 0.0, 3.0, 1.0);
+    if (dwv_scene_add_light(scene, &sun) || dwv_scene_set_camera(scene, &camera) || dwv_scene_commit(scene)) {
+        fprintf(stderr, "test scene: %s\n", dwv_last_error_message());
+        exit(2);
+    }
+    return scene;
+}
+
+/* The report's leaf: a box 2 cm thick, subsurface radius 0.1 m in every channel (one extinction,
+ * 2.5 mean free paths across) and colour (0.6, 0.95, 0.4), lit from behind (test_sunlit_box). */
+static inline dwv_scene_t *test_leaf(void)
+{
+    dwv_material_t m = DWV_MATERIAL_INIT;
+    static const double color[3] = {0.6, 0.95, 0.4};
+    for (int c = 0; c < 3; ++c) {
+        m.base_color[c] = m.subsurface_color[c] = color[c];
+        m.subsurface_radius[c] = 0.1;
+    }
+    m.subsurface_scale = 1.0;
+    return test_sunlit_box(&m, 0.02, 1.0);
+}
+
 #endif

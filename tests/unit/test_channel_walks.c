@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bake_compare.h"
 #include "bake_scenes.h"
 #include "check.h"
 #include "dwivedi.h"
@@ -22,8 +23,6 @@ static dwv_scene_t *wax_sphere(int flat_channel, int grey)
  * paths thick), colour 0.8, a sun from below, seen from above (every pixel sees the slab). */
 static dwv_scene_t *backlit_slab(void)
 {
-    dwv_scene_t *scene;
-    if (dwv_scene_create(&scene) != DWV_SUCCESS) exit(2);
     dwv_material_t m = DWV_MATERIAL_INIT;
     static const double radius[3] = {1.0, 0.5, 0.25};
     for (int c = 0; c < 3; ++c) {
@@ -31,66 +30,16 @@ static dwv_scene_t *backlit_slab(void)
         m.subsurface_radius[c] = radius[c];
     }
     m.subsurface_scale = 1.0;
-    test_mesh box = test_box(-2.0, -2.0, -0.05, 2.0, 2.0, 0.05);
-    test_add(scene, &box, &m);
-    test_mesh_free(&box);
-    dwv_light_desc_t sun = DWV_LIGHT_DESC_INIT;
-    sun.strength = 3.0;
-    sun.direction[2] = 1.0;
-    dwv_camera_t camera = test_ortho_camera(0.0, 0.0, 3.0, 1.0);
-    if (dwv_scene_add_light(scene, &sun) || dwv_scene_set_camera(scene, &camera) || dwv_scene_commit(scene)) {
-        fprintf(stderr, "scene: %s\n", dwv_last_error_message());
-        exit(2);
-    }
-    return scene;
+    return test_sunlit_box(&m, 0.1, 1.0);
 }
 
-typedef struct result {
-    double mean[3], standard_error[3];
-    uint32_t features;
-    uint64_t walks, samples;
-    float *rgba;
-    size_t pixels;
-} result;
+typedef test_result result;
 
+/* A 12 x 12 bake (bake_compare.h). */
 static int bake(dwv_scene_t *scene, dwv_technique_t technique, dwv_channel_walks_t channel_walks, uint64_t samples,
                 uint64_t seed, result *out)
 {
-    dwv_bake_options_t o = DWV_BAKE_OPTIONS_INIT;
-    o.width = o.height = 12;
-    o.samples = samples;
-    o.threads = 2;
-    o.seed = seed;
-    o.technique = technique;
-    o.channel_walks = channel_walks;
-    dwv_image_t *image = NULL;
-    if (dwv_bake(scene, &o, &image) != DWV_SUCCESS) {
-        CHECK(0, "bake: %s", dwv_last_error_message());
-        return 0;
-    }
-    dwv_bake_stats_t st = DWV_BAKE_STATS_INIT;
-    dwv_image_info_t info = DWV_IMAGE_INFO_INIT;
-    dwv_image_stats(image, &st);
-    dwv_image_info(image, &info);
-    out->features = st.features;
-    out->walks = st.walks;
-    out->samples = st.samples;
-    out->pixels = (size_t)info.width * info.height;
-    out->rgba = malloc(4u * out->pixels * sizeof *out->rgba);
-    if (!out->rgba) exit(2);
-    memcpy(out->rgba, info.rgba, 4u * out->pixels * sizeof *out->rgba);
-    /* The mean over all pixels and its standard error, from the pixel means' own variances. */
-    for (int c = 0; c < 3; ++c) {
-        double sum = 0.0, variance = 0.0;
-        for (size_t i = 0; i < out->pixels; ++i) {
-            sum += info.rgba[4u * i + (size_t)c];
-            variance += info.variance[3u * i + (size_t)c];
-        }
-        out->mean[c] = sum / (double)out->pixels;
-        out->standard_error[c] = sqrt(variance) / (double)out->pixels;
-    }
-    dwv_image_release(image);
-    return 1;
+    return test_bake_result(scene, technique, channel_walks, 12u, samples, seed, out);
 }
 
 /* Separate walks (two techniques) against shared ones: the same means within 4.5 standard errors. */

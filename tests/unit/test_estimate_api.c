@@ -196,11 +196,12 @@ static void test_rgb_run(void)
 
 static void test_technique_names(void)
 {
-    static const char *const expected[7] = {"auto", "classical", "poe", "closest", "incident", "backward", "cycles"};
-    static const dwv_technique_t values[7] = {DWV_TECHNIQUE_AUTO,     DWV_TECHNIQUE_CLASSICAL, DWV_TECHNIQUE_POE,
+    static const char *const expected[8] = {"auto", "classical", "poe", "closest", "incident", "backward", "cycles",
+                                            "sheet"};
+    static const dwv_technique_t values[8] = {DWV_TECHNIQUE_AUTO,     DWV_TECHNIQUE_CLASSICAL, DWV_TECHNIQUE_POE,
                                               DWV_TECHNIQUE_CLOSEST,  DWV_TECHNIQUE_INCIDENT,  DWV_TECHNIQUE_BACKWARD,
-                                              DWV_TECHNIQUE_CYCLES};
-    for (int i = 0; i < 7; ++i) {
+                                              DWV_TECHNIQUE_CYCLES,   DWV_TECHNIQUE_SHEET};
+    for (int i = 0; i < 8; ++i) {
         const char *name = dwv_technique_name(values[i]);
         CHECK(name != NULL && strcmp(name, expected[i]) == 0, "dwv_technique_name(%d) = '%s', expected '%s'",
               (int)values[i], name ? name : "(null)", expected[i]);
@@ -209,7 +210,7 @@ static void test_technique_names(void)
         CHECK(result == DWV_SUCCESS && back == values[i], "dwv_technique_from_name('%s') = %d (result %d)",
               expected[i], (int)back, (int)result);
     }
-    CHECK(dwv_technique_name(-1) == NULL && dwv_technique_name(7) == NULL && dwv_technique_name(99) == NULL,
+    CHECK(dwv_technique_name(-1) == NULL && dwv_technique_name(8) == NULL && dwv_technique_name(99) == NULL,
           "%s", "names of techniques that do not exist");
 
     static const char *const unknown[] = {"", "Auto", "AUTO", "auto ", " auto", "classic", "poe2", "cycle", "none"};

@@ -60,7 +60,7 @@ static void test_names(void)
         CHECK(s != NULL && s[0] != '\0', "dwv_result_string(%d) is empty", (int)enums[i]);
         CHECK(enums[i] < 4 || enums[i] > 3 ? 1 : 0, "unreachable");
         if (enums[i] < 0 || enums[i] > 3) CHECK(dwv_v0_method_name(enums[i]) == NULL, "v0 method %d has a name", (int)enums[i]);
-        if (enums[i] < 0 || enums[i] > 6) CHECK(dwv_technique_name(enums[i]) == NULL, "technique %d has a name", (int)enums[i]);
+        if (enums[i] < 0 || enums[i] > 7) CHECK(dwv_technique_name(enums[i]) == NULL, "technique %d has a name", (int)enums[i]);
     }
     CHECK(dwv_version() == DWV_VERSION && dwv_version_string() != NULL, "version");
     dwv_v0_method_t method = 0;
@@ -405,7 +405,7 @@ static void test_estimate(void)
     ESTIMATE_REFUSED(eo.light = -1, RANGE);
     ESTIMATE_REFUSED(eo.light = DWV_LIGHT_BACK, INVALID); /* a half-space has no back face */
     ESTIMATE_REFUSED(eo.technique = -1, RANGE);
-    ESTIMATE_REFUSED(eo.technique = DWV_TECHNIQUE_CYCLES + 1, RANGE);
+    ESTIMATE_REFUSED(eo.technique = DWV_TECHNIQUE_SHEET + 1, RANGE);
     ESTIMATE_REFUSED(eo.technique = INT32_MAX, RANGE);
     ESTIMATE_REFUSED(eo.walks = 0u, RANGE);
     ESTIMATE_REFUSED(eo.walks = 1u, RANGE);
@@ -476,7 +476,7 @@ static void test_walk(void)
     REFUSED(dwv_walk_create, dwv_walk_create(&m, DWV_TECHNIQUE_AUTO, NULL, 0, 0, 0, &w), INVALID);
     m = (dwv_medium_t)DWV_MEDIUM_INIT;
     REFUSED(dwv_walk_create, dwv_walk_create(&m, -7, NULL, 0, 0, 0, &w), RANGE);
-    REFUSED(dwv_walk_create, dwv_walk_create(&m, 7, NULL, 0, 0, 0, &w), RANGE);
+    REFUSED(dwv_walk_create, dwv_walk_create(&m, 8, NULL, 0, 0, 0, &w), RANGE);
     REFUSED(dwv_walk_create, dwv_walk_create(&m, DWV_TECHNIQUE_AUTO, NULL, 1, 0, 0, &w), NULLP);
     REFUSED(dwv_walk_create, dwv_walk_create(&m, DWV_TECHNIQUE_AUTO, patches, 17, 0, 0, &w), RANGE);
     REFUSED(dwv_walk_create, dwv_walk_create(&m, DWV_TECHNIQUE_AUTO, patches, UINT32_MAX, 0, 0, &w), RANGE);

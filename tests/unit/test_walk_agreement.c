@@ -1,5 +1,5 @@
-/* Every random-walk technique estimates the same quantity: on each scene and albedo, the seven
- * techniques (auto, classical, poe, closest, incident, backward, cycles) must agree pairwise within
+/* Every random-walk technique estimates the same quantity: on each scene and albedo, the eight
+ * techniques (auto, classical, poe, closest, incident, backward, cycles, sheet) must agree pairwise within
  * 5 sigma, sigma = sqrt(se_a^2 + se_b^2) (independent runs: every run has a seed of its own).
  * Scenes: the front-lit half-space (total diffuse reflectance), a slab of 4 mean free paths lit from
  * the back (total transmittance) and from the front (reflectance), and a sphere of radius 2 mean
@@ -32,7 +32,7 @@ static const scene_t SCENES[] = {
     {"sphere 2, back", DWV_SHAPE_SPHERE, 2.0, DWV_LIGHT_BACK},
 };
 static const double ALBEDOS[] = {0.3, 0.9, 0.99, 0.999};
-enum { TECHNIQUES = DWV_TECHNIQUE_CYCLES + 1 };
+enum { TECHNIQUES = DWV_TECHNIQUE_SHEET + 1 };
 
 int main(void)
 {

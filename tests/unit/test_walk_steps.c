@@ -402,13 +402,13 @@ static void test_steps_match_estimate(void)
     const char *const shape_names[3] = {"halfspace", "slab", "sphere"};
     const dwv_medium_t *const media[2] = {&grey, &rgb};
     const char *const medium_names[2] = {"grey", "rgb"};
-    static const dwv_technique_t techniques[7] = {DWV_TECHNIQUE_CLASSICAL, DWV_TECHNIQUE_POE, DWV_TECHNIQUE_CLOSEST,
+    static const dwv_technique_t techniques[8] = {DWV_TECHNIQUE_CLASSICAL, DWV_TECHNIQUE_POE, DWV_TECHNIQUE_CLOSEST,
                                                   DWV_TECHNIQUE_BACKWARD, DWV_TECHNIQUE_CYCLES, DWV_TECHNIQUE_AUTO,
-                                                  DWV_TECHNIQUE_INCIDENT};
+                                                  DWV_TECHNIQUE_INCIDENT, DWV_TECHNIQUE_SHEET};
     char label[64];
     for (int s = 0; s < 3; ++s) {
         for (int m = 0; m < 2; ++m) {
-            for (int t = 0; t < 7; ++t) {
+            for (int t = 0; t < 8; ++t) {
                 snprintf(label, sizeof label, "%s %s %s", shape_names[s], medium_names[m],
                          dwv_technique_name(techniques[t]));
                 config_t config = {label, shapes[s], *media[m], techniques[t], DWV_LIGHT_FRONT, 0u};
@@ -428,6 +428,8 @@ static void test_steps_match_estimate(void)
         {"slab grey incident light both", 1, DWV_TECHNIQUE_INCIDENT, DWV_LIGHT_BOTH, 0u},
         {"slab grey auto light both", 1, DWV_TECHNIQUE_AUTO, DWV_LIGHT_BOTH, 0u},
         {"sphere grey incident light back", 2, DWV_TECHNIQUE_INCIDENT, DWV_LIGHT_BACK, 0u},
+        {"slab grey sheet light back", 1, DWV_TECHNIQUE_SHEET, DWV_LIGHT_BACK, 0u},
+        {"sphere grey sheet light back", 2, DWV_TECHNIQUE_SHEET, DWV_LIGHT_BACK, 0u},
         {"halfspace grey classical cap 3", 0, DWV_TECHNIQUE_CLASSICAL, DWV_LIGHT_FRONT, 3u},
         {"sphere grey auto cap 4", 2, DWV_TECHNIQUE_AUTO, DWV_LIGHT_FRONT, 4u},
     };
@@ -637,7 +639,7 @@ static void test_create_arguments(void)
     media[13].medium.anisotropy = NAN;
     media[14].medium.struct_size = 0u;
     for (size_t i = 0; i < sizeof media / sizeof media[0]; ++i) {
-        for (dwv_technique_t t = DWV_TECHNIQUE_AUTO; t <= DWV_TECHNIQUE_CYCLES; ++t) {
+        for (dwv_technique_t t = DWV_TECHNIQUE_AUTO; t <= DWV_TECHNIQUE_SHEET; ++t) {
             walk = NULL;
             prime_message();
             dwv_result_t r = dwv_walk_create(&media[i].medium, t, &patch, 1u, 0u, 0u, &walk);
@@ -684,7 +686,7 @@ static void test_create_arguments(void)
 
     /* The largest patch list is accepted, by every technique. */
     patches[15] = patch;
-    for (dwv_technique_t t = DWV_TECHNIQUE_AUTO; t <= DWV_TECHNIQUE_CYCLES; ++t) {
+    for (dwv_technique_t t = DWV_TECHNIQUE_AUTO; t <= DWV_TECHNIQUE_SHEET; ++t) {
         CHECK(dwv_walk_create(&good, t, patches, 16u, 0u, 0u, &walk) == DWV_SUCCESS && walk != NULL,
               "16 patches, technique %s: %s", dwv_technique_name(t), dwv_last_error_message());
         dwv_walk_release(walk);
