@@ -214,7 +214,7 @@ static void op_estimate(reader *r)
     o.incidence = flags & 4u ? (dwv_incidence_t)u32(r) : (dwv_incidence_t)(byte(r) & 1u);
     o.incidence_cosine = flags & 8u ? real(r) : unit(r);
     o.light = flags & 0x10u ? (dwv_light_t)u32(r) : (dwv_light_t)(1 + byte(r) % 3u);
-    o.technique = flags & 0x20u ? (dwv_technique_t)u32(r) : (dwv_technique_t)(byte(r) % 7u);
+    o.technique = flags & 0x20u ? (dwv_technique_t)u32(r) : (dwv_technique_t)(byte(r) % (DWV_TECHNIQUE_SHEET + 1u));
     /* Tiny runs, but the count itself may be absurd when it is refused: only valid counts run. */
     uint8_t count = byte(r);
     o.walks = count < 200u ? 2u + count % 24u : u64(r);
@@ -265,7 +265,7 @@ static void op_walk(reader *r)
         patches[j].power = how & 4u ? real(r) : 0.1 + unit(r);
     }
     uint8_t t = byte(r);
-    dwv_technique_t technique = t < 240u ? (dwv_technique_t)(t % 7u) : (dwv_technique_t)u32(r);
+    dwv_technique_t technique = t < 240u ? (dwv_technique_t)(t % (DWV_TECHNIQUE_SHEET + 1u)) : (dwv_technique_t)u32(r);
     dwv_walk_t *walk = NULL;
     prime();
     if (!check(dwv_walk_create(&m, technique, patch_count ? patches : NULL, patch_count, u64(r), 1u + byte(r) % 50u,
