@@ -80,6 +80,14 @@
 
 /* ---- references, in long double ------------------------------------------------------------- */
 
+/* Whether long double reaches below double's range at run time (x87 extended precision does;
+ * under valgrind, which computes it as double, it does not). */
+static int long_double_has_range(void)
+{
+    volatile long double tiny = 1e-300L;
+    return tiny * tiny != 0.0L;
+}
+
 static long double ref_norm(long double a, long double mu)
 {
     return mu >= 0.0L ? a + mu : a + mu - mu * expl(a / mu);
@@ -364,8 +372,10 @@ static void test_weight_update(void)
             double got = w->weight[c] / start[c];
             CHECK(isfinite(got) && got >= 0.0, "case %llu channel %d: ratio %g", (unsigned long long)i, c, got);
             if (expected[c] == 0.0L) {
-                CHECK(got == 0.0, "case %llu channel %d: ratio %g where the formula gives 0", (unsigned long long)i, c,
-                      got);
+                /* Where long double has only double's range (valgrind computes it so), the direct
+                 * form underflows to 0 where the walk's factored form keeps a ratio below 1e-250. */
+                CHECK(got == 0.0 || (!long_double_has_range() && got < 1e-250),
+                      "case %llu channel %d: ratio %g where the formula gives 0", (unsigned long long)i, c, got);
                 ++exact_zero;
                 continue;
             }
