@@ -257,7 +257,7 @@ enum {
     DWV_TECHNIQUE_BACKWARD = 5,  /* entry normal or, by depth, an opposite interface (Cycles) */
     DWV_TECHNIQUE_CYCLES = 6,    /* Cycles' mixture: classical 1/2 + backward 1/2 */
     DWV_TECHNIQUE_SHEET = 7      /* toward the lit side through a thin sheet: an importance linear
-                                    in the height (zero-variance theory), classical share 1% */
+                                    in the height (zero-variance theory), classical share max(1%, |g|) */
 };
 DWV_API const char *dwv_technique_name(dwv_technique_t technique);
 DWV_API dwv_result_t dwv_technique_from_name(const char *name, dwv_technique_t *technique);

@@ -655,7 +655,7 @@ static void setup_guides(dwvb_bake *bake)
  * - the sheet walk (walk.h, src/kernel/sheet.h), where light reaches some deciding mesh: toward
  *   the strongest lit patch with an importance linear in depth, the zero-variance walk of a thin
  *   sheet of albedo near 1, where Dwivedi's exponential is flat (the report's leaf: 7.5x less
- *   image variance than classical walks at equal samples, efficiency 3.8x auto's earlier pick);
+ *   image variance than classical walks at equal samples, efficiency 3.3x-4.4x auto's earlier pick);
  * - each of these four with one walk per colour channel (channel walks, shade.h), where the
  *   medium's channels differ and the option leaves it to auto. A shared walk weighs every channel
  *   by the spectral MIS of all three; over many events the channels' weights then carry each
