@@ -17,7 +17,7 @@
 #include <string.h>
 
 #include "api/image_handle.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 #define MAX_REPEATS 1000u
 

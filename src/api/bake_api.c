@@ -7,8 +7,8 @@
 #include <unistd.h>
 
 #include "bake/bake.h"
-#include "dwivedi.h"
-#include "error.h"
+#include <dwivedi.h>
+#include "util/error.h"
 #include "image_handle.h"
 #include "scene_handle.h"
 

@@ -3,8 +3,8 @@
 #include <string.h>
 
 #include "bake/image.h"
-#include "dwivedi.h"
-#include "error.h"
+#include <dwivedi.h>
+#include "util/error.h"
 #include "image_handle.h"
 
 #define MAX_SIDE 16384u

@@ -3,7 +3,7 @@
 #define DWV_API_IMAGE_HANDLE_H
 
 #include "bake/image.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 struct dwv_image_s {
     dwvb_image image;

@@ -1,18 +1,19 @@
 #define _POSIX_C_SOURCE 200809L /* strnlen */
 
 /* capi entry points that write images out: OpenEXR and colour-managed display images (PNG or
- * bytes in memory). They validate every argument, then hand over to src/io. */
+ * bytes in memory). They validate every argument, then hand over to src/output. */
+#include <dwivedi.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "bake/image.h"
-#include "dwivedi.h"
-#include "error.h"
 #include "image_handle.h"
-#include "io/atomic_file.h"
-#include "io/display.h"
-#include "io/exr.h"
-#include "io/png_writer.h"
+#include "util/error.h"
+#include "output/atomic_file.h"
+#include "output/display.h"
+#include "output/exr.h"
+#include "output/png_writer.h"
 
 /* The message of an io call, prefixed with the entry point's name. */
 static dwv_result_t io_result(const char *fn, dwv_result_t result, const char *message)
@@ -25,7 +26,7 @@ static dwv_result_t check_path(const char *fn, const char *path)
 {
     DWV_TRY(dwv_check_pointer(fn, "path", path));
     char message[512];
-    return io_result(fn, dwvio_check_output_path(path, message, sizeof message), message);
+    return io_result(fn, dwvo_check_output_path(path, message, sizeof message), message);
 }
 
 static dwv_result_t check_name(const char *fn, const char *what, const char *name)
@@ -56,13 +57,35 @@ static dwv_result_t check_display(const char *fn, const dwv_display_options_t *d
     return DWV_SUCCESS;
 }
 
+/* The DWV_FEATURE_* bits' names, comma-separated ("bitN" for a bit this version does not name). */
+static void features_text(uint32_t bits, char *out, size_t size)
+{
+    size_t used = 0u;
+    out[0] = '\0';
+    for (uint32_t i = 0; i < 32u; ++i) {
+        if (!(bits & (1u << i))) continue;
+        const char *name = dwv_feature_name(1u << i);
+        int n = name ? snprintf(out + used, size - used, "%s%s", used ? "," : "", name)
+                     : snprintf(out + used, size - used, "%sbit%u", used ? "," : "", i);
+        if (n < 0 || (size_t)n >= size - used) return;
+        used += (size_t)n;
+    }
+}
+
 dwv_result_t dwv_image_write_exr(const dwv_image_t *image, const char *path)
 {
     static const char fn[] = "dwv_image_write_exr";
     DWV_TRY(dwv_check_pointer(fn, "image", image));
     DWV_TRY(check_path(fn, path));
+    const dwvb_image *img = dwv_image_object(image);
+    char features[512];
+    features_text(img->stats.features, features, sizeof features);
+    const char *technique = dwv_technique_name(img->stats.technique);
+    if (img->stats.samples_per_pixel == 0u) technique = "none"; /* caller-made pixels, not a bake */
+    dwvo_exr_image exr = {img->width, img->height, img->rgba, img->variance, img->samples, &img->stats,
+                          img->error_vs_time, technique ? technique : "unknown", features};
     char message[512];
-    return io_result(fn, dwvio_write_exr(dwv_image_object(image), path, message, sizeof message), message);
+    return io_result(fn, dwvo_write_exr(&exr, path, message, sizeof message), message);
 }
 
 /* The display bytes of `img` into `out` (4 x width x height). */
@@ -70,7 +93,7 @@ static dwv_result_t render_display(const char *fn, const dwvb_image *img, const 
                                    uint8_t *out)
 {
     char message[512];
-    dwv_result_t result = dwvio_to_display(img->rgba, img->width, img->height, display, out, message, sizeof message);
+    dwv_result_t result = dwvo_to_display(img->rgba, img->width, img->height, display, out, message, sizeof message);
     return io_result(fn, result, message);
 }
 
@@ -88,7 +111,7 @@ dwv_result_t dwv_image_write_display_png(const dwv_image_t *image, const char *p
     dwv_result_t result = render_display(fn, img, display, pixels);
     if (result == DWV_SUCCESS) {
         char message[512];
-        result = io_result(fn, dwvio_write_png_rgba8(pixels, img->width, img->height, path, message, sizeof message),
+        result = io_result(fn, dwvo_write_png_rgba8(pixels, img->width, img->height, path, message, sizeof message),
                            message);
     }
     free(pixels);

@@ -2,11 +2,12 @@
 #include <math.h>
 #include <string.h>
 
-#include "dwivedi.h"
-#include "error.h"
+#include <dwivedi.h>
+#include "util/error.h"
+#include "util/version.h"
 #include "kernel/classical.h"
 #include "kernel/diffusion_length.h"
-#include "kernel/dwivedi.h"
+#include "kernel/dwivedi_sampling.h"
 #include "kernel/rng.h"
 
 uint32_t dwv_version(void)
@@ -14,13 +15,10 @@ uint32_t dwv_version(void)
     return DWV_VERSION;
 }
 
-#define DWV_STRINGIFY2(x) #x
-#define DWV_STRINGIFY(x) DWV_STRINGIFY2(x)
 
 const char *dwv_version_string(void)
 {
-    return DWV_STRINGIFY(DWV_VERSION_MAJOR) "." DWV_STRINGIFY(DWV_VERSION_MINOR) "." DWV_STRINGIFY(
-        DWV_VERSION_PATCH);
+    return DWVU_VERSION_STRING;
 }
 
 /* ---- diffusion length ---------------------------------------------------------------------- */

@@ -3,7 +3,7 @@
 
 dwv_result_t API_NAME(dwv_dwivedi_sample)(const dwv_dwivedi_t *dist, API_REAL u, API_REAL *cos_theta)
 {
-    static const char fn[] = DWV_STRINGIFY(API_NAME(dwv_dwivedi_sample));
+    static const char fn[] = DWVU_STRINGIFY(API_NAME(dwv_dwivedi_sample));
     DWV_TRY(check_dwivedi(fn, dist));
     DWV_TRY(dwv_check_range(fn, "u", u, 0.0, 1.0));
     DWV_TRY(dwv_check_pointer(fn, "cos_theta", cos_theta));
@@ -14,7 +14,7 @@ dwv_result_t API_NAME(dwv_dwivedi_sample)(const dwv_dwivedi_t *dist, API_REAL u,
 
 dwv_result_t API_NAME(dwv_dwivedi_pdf)(const dwv_dwivedi_t *dist, API_REAL cos_theta, API_REAL *pdf)
 {
-    static const char fn[] = DWV_STRINGIFY(API_NAME(dwv_dwivedi_pdf));
+    static const char fn[] = DWVU_STRINGIFY(API_NAME(dwv_dwivedi_pdf));
     DWV_TRY(check_dwivedi(fn, dist));
     DWV_TRY(dwv_check_range(fn, "cos_theta", cos_theta, -1.0, 1.0));
     DWV_TRY(dwv_check_pointer(fn, "pdf", pdf));
@@ -25,7 +25,7 @@ dwv_result_t API_NAME(dwv_dwivedi_pdf)(const dwv_dwivedi_t *dist, API_REAL cos_t
 
 dwv_result_t API_NAME(dwv_dwivedi_sample_pdf)(const dwv_dwivedi_t *dist, API_REAL u, API_SAMPLE_T *sample)
 {
-    static const char fn[] = DWV_STRINGIFY(API_NAME(dwv_dwivedi_sample_pdf));
+    static const char fn[] = DWVU_STRINGIFY(API_NAME(dwv_dwivedi_sample_pdf));
     DWV_TRY(check_dwivedi(fn, dist));
     DWV_TRY(dwv_check_range(fn, "u", u, 0.0, 1.0));
     DWV_TRY(dwv_check_struct(fn, "sample", sample, (uint32_t)sizeof(API_SAMPLE_T)));
@@ -41,7 +41,7 @@ dwv_result_t API_NAME(dwv_dwivedi_sample_pdf)(const dwv_dwivedi_t *dist, API_REA
 
 dwv_result_t API_NAME(dwv_dwivedi_stretch)(const dwv_dwivedi_t *dist, API_REAL cos_theta, API_REAL *stretch)
 {
-    static const char fn[] = DWV_STRINGIFY(API_NAME(dwv_dwivedi_stretch));
+    static const char fn[] = DWVU_STRINGIFY(API_NAME(dwv_dwivedi_stretch));
     DWV_TRY(check_dwivedi(fn, dist));
     DWV_TRY(dwv_check_range(fn, "cos_theta", cos_theta, -1.0, 1.0));
     DWV_TRY(dwv_check_pointer(fn, "stretch", stretch));
@@ -52,7 +52,7 @@ dwv_result_t API_NAME(dwv_dwivedi_stretch)(const dwv_dwivedi_t *dist, API_REAL c
 
 dwv_result_t API_NAME(dwv_hg_sample)(API_REAL g, API_REAL u, API_REAL *cos_theta)
 {
-    static const char fn[] = DWV_STRINGIFY(API_NAME(dwv_hg_sample));
+    static const char fn[] = DWVU_STRINGIFY(API_NAME(dwv_hg_sample));
     DWV_TRY(dwv_check_finite(fn, "g", g));
     if (!(fabs(g) < 1.0)) return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: g = %.9g must be in (-1, 1)", fn, (double)g);
     DWV_TRY(dwv_check_range(fn, "u", u, 0.0, 1.0));
@@ -63,7 +63,7 @@ dwv_result_t API_NAME(dwv_hg_sample)(API_REAL g, API_REAL u, API_REAL *cos_theta
 
 dwv_result_t API_NAME(dwv_hg_pdf)(API_REAL g, API_REAL cos_theta, API_REAL *pdf)
 {
-    static const char fn[] = DWV_STRINGIFY(API_NAME(dwv_hg_pdf));
+    static const char fn[] = DWVU_STRINGIFY(API_NAME(dwv_hg_pdf));
     DWV_TRY(dwv_check_finite(fn, "g", g));
     if (!(fabs(g) < 1.0)) return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: g = %.9g must be in (-1, 1)", fn, (double)g);
     DWV_TRY(dwv_check_range(fn, "cos_theta", cos_theta, -1.0, 1.0));
@@ -74,7 +74,7 @@ dwv_result_t API_NAME(dwv_hg_pdf)(API_REAL g, API_REAL cos_theta, API_REAL *pdf)
 
 dwv_result_t API_NAME(dwv_exponential_sample)(API_REAL sigma, API_REAL u, API_REAL *distance)
 {
-    static const char fn[] = DWV_STRINGIFY(API_NAME(dwv_exponential_sample));
+    static const char fn[] = DWVU_STRINGIFY(API_NAME(dwv_exponential_sample));
     DWV_TRY(dwv_check_finite(fn, "sigma", sigma));
     if (!(sigma > 0)) return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: sigma = %.9g must be > 0", fn, (double)sigma);
     DWV_TRY(dwv_check_range(fn, "u", u, 0.0, 1.0));
@@ -89,7 +89,7 @@ dwv_result_t API_NAME(dwv_exponential_sample)(API_REAL sigma, API_REAL u, API_RE
 
 dwv_result_t API_NAME(dwv_exponential_pdf)(API_REAL sigma, API_REAL distance, API_REAL *pdf)
 {
-    static const char fn[] = DWV_STRINGIFY(API_NAME(dwv_exponential_pdf));
+    static const char fn[] = DWVU_STRINGIFY(API_NAME(dwv_exponential_pdf));
     DWV_TRY(dwv_check_finite(fn, "sigma", sigma));
     if (!(sigma > 0)) return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: sigma = %.9g must be > 0", fn, (double)sigma);
     DWV_TRY(dwv_check_finite(fn, "distance", distance));

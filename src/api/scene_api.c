@@ -6,8 +6,8 @@
 #include <string.h>
 
 #include "bake/scene.h"
-#include "dwivedi.h"
-#include "error.h"
+#include <dwivedi.h>
+#include "util/error.h"
 #include "geom/mesh.h"
 #include "scene_handle.h"
 

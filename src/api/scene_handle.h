@@ -3,7 +3,7 @@
 #define DWV_API_SCENE_HANDLE_H
 
 #include "bake/scene.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 struct dwv_scene_s {
     dwvb_scene scene;

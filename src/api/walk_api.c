@@ -7,8 +7,8 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "dwivedi.h"
-#include "error.h"
+#include <dwivedi.h>
+#include "util/error.h"
 #include "kernel/rng.h"
 #include "walk/estimate.h"
 
@@ -225,8 +225,8 @@ dwv_result_t dwv_walk_create(const dwv_medium_t *medium, dwv_technique_t techniq
         DWV_TRY(check_vector(fn, name[1], p->point, 0));
         DWV_TRY(check_vector(fn, name[2], p->normal, 1));
         DWV_TRY(check_positive(fn, name[3], p->power));
-        converted[j].point = dwvw_v(p->point[0], p->point[1], p->point[2]);
-        converted[j].normal = dwvw_v(p->normal[0], p->normal[1], p->normal[2]);
+        converted[j].point = dwvu_v(p->point[0], p->point[1], p->point[2]);
+        converted[j].normal = dwvu_v(p->normal[0], p->normal[1], p->normal[2]);
         converted[j].power = p->power;
         converted[j].is_plane = p->is_plane != 0;
     }
@@ -269,13 +269,13 @@ dwv_result_t dwv_walk_begin(dwv_walk_t *walk, uint64_t index, const double point
     DWV_TRY(check_vector(fn, "point", point, 0));
     DWV_TRY(check_vector(fn, "direction", direction, 1));
     DWV_TRY(check_vector(fn, "normal", normal, 1));
-    dwvw_vec3 d = dwvw_v(direction[0], direction[1], direction[2]);
-    dwvw_vec3 n = dwvw_v(normal[0], normal[1], normal[2]);
-    if (!(dwvw_dot(d, n) < 0.0))
+    dwvu_vec3 d = dwvu_v(direction[0], direction[1], direction[2]);
+    dwvu_vec3 n = dwvu_v(normal[0], normal[1], normal[2]);
+    if (!(dwvu_dot(d, n) < 0.0))
         return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: direction does not enter the medium (it must oppose the "
                         "outward normal)", fn);
     dwvw_walk_begin(&walk->walk, &walk->medium, &walk->guide, dwvk_rng_key(walk->seed, index, 0), walk->max_events,
-                    dwvw_v(point[0], point[1], point[2]), d, n);
+                    dwvu_v(point[0], point[1], point[2]), d, n);
     walk->begun = 1;
     walk->sampled = 0;
     return DWV_SUCCESS;
@@ -286,7 +286,7 @@ dwv_result_t dwv_walk_set_closest(dwv_walk_t *walk, const double normal[3])
     static const char fn[] = "dwv_walk_set_closest";
     DWV_TRY(dwv_check_pointer(fn, "walk", walk));
     DWV_TRY(check_vector(fn, "normal", normal, 1));
-    dwvw_walk_set_closest(&walk->walk, dwvw_v(normal[0], normal[1], normal[2]));
+    dwvw_walk_set_closest(&walk->walk, dwvu_v(normal[0], normal[1], normal[2]));
     return DWV_SUCCESS;
 }
 
@@ -317,10 +317,10 @@ dwv_result_t dwv_walk_report(dwv_walk_t *walk, double hit_distance, const double
     if (!walk->sampled) return dwv_fail(DWV_ERROR_INVALID_STATE, "%s: no step was sampled (call dwv_walk_sample)", fn);
     if (isnan(hit_distance) || hit_distance < 0.0)
         return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: hit_distance = %.17g must be >= 0 or INFINITY", fn, hit_distance);
-    dwvw_vec3 n = walk->walk.entry_normal;
+    dwvu_vec3 n = walk->walk.entry_normal;
     if (hit_distance < INFINITY) {
         DWV_TRY(check_vector(fn, "hit_normal", hit_normal, 1));
-        n = dwvw_v(hit_normal[0], hit_normal[1], hit_normal[2]);
+        n = dwvu_v(hit_normal[0], hit_normal[1], hit_normal[2]);
     }
     dwvw_status status = dwvw_walk_complete(&walk->walk, hit_distance, n);
     walk->sampled = 0;

@@ -12,6 +12,8 @@
 #include "bake/shade.h"
 #include "bake/uv_raster.h"
 #include "kernel/rng.h"
+#include "util/clock.h"
+#include "util/parallel.h"
 
 /* The walk's random numbers come from a stream of their own: bit 63 of the stream marks it. The
  * per-pixel scrambles of the stratified pairs (kernel/sampler.h) come from bit 62's stream. */
@@ -43,7 +45,7 @@ struct dwvb_bake {
     int *auto_choice; /* per mesh: auto's technique is chosen by the pilot (choose_auto) */
     uint32_t features;
     /* camera */
-    dwvw_vec3 eye, right, up, forward; /* right/up scaled to the image's half extents */
+    dwvu_vec3 eye, right, up, forward; /* right/up scaled to the image's half extents */
     /* UV */
     dwvb_uv_raster raster;
     /* accumulation */
@@ -63,7 +65,7 @@ struct dwvb_bake {
     atomic_int time_up;
     atomic_int cancelled;
     atomic_uint_fast64_t events;
-    struct timespec start;
+    double start; /* dwvu_clock_seconds() when the bake began */
     uint64_t spp_done;
     double error;
     /* control */
@@ -72,6 +74,7 @@ struct dwvb_bake {
     pthread_mutex_t lock;
     pthread_cond_t changed; /* workers finished, or the bake ended */
     uint32_t workers_running;
+    dwvu_parallel workers; /* a pass's tile workers */
     int done;
     dwv_result_t result;
     char message[256];
@@ -81,9 +84,7 @@ struct dwvb_bake {
 
 static double elapsed(const dwvb_bake *bake)
 {
-    struct timespec now;
-    clock_gettime(CLOCK_MONOTONIC, &now);
-    return (double)(now.tv_sec - bake->start.tv_sec) + 1e-9 * (double)(now.tv_nsec - bake->start.tv_nsec);
+    return dwvu_clock_seconds() - bake->start;
 }
 
 static double luminance(const double rgb[3])
@@ -97,18 +98,18 @@ static double luminance(const double rgb[3])
 /* One camera sample through pixel (x, row). Blender's camera: local -z forward, +y up, the
  * sensor (or ortho_scale) across the larger image side; a box filter over the pixel. */
 static void camera_sample(const dwvb_bake *bake, uint32_t x, uint32_t row, const dwvk_sampler *sampler,
-                          dwvw_vec3 *origin, dwvw_vec3 *direction)
+                          dwvu_vec3 *origin, dwvu_vec3 *direction)
 {
     double u[2];
     dwvk_sampler_pair(sampler, PIXEL_PAIR, u);
     double sx = 2.0 * ((double)x + u[0]) / bake->width - 1.0;
     double sy = 1.0 - 2.0 * ((double)row + u[1]) / bake->height;
-    dwvw_vec3 offset = dwvw_add(dwvw_scale(bake->right, sx), dwvw_scale(bake->up, sy));
+    dwvu_vec3 offset = dwvu_add(dwvu_scale(bake->right, sx), dwvu_scale(bake->up, sy));
     if (bake->scene->camera.kind == DWV_CAMERA_PERSPECTIVE) {
         *origin = bake->eye;
-        *direction = dwvw_normalize(dwvw_add(bake->forward, offset));
+        *direction = dwvu_normalize(dwvu_add(bake->forward, offset));
     } else {
-        *origin = dwvw_add(bake->eye, offset);
+        *origin = dwvu_add(bake->eye, offset);
         *direction = bake->forward;
     }
 }
@@ -131,9 +132,9 @@ static void sample_with(const dwvb_bake *bake, const dwvb_shader *shader, uint64
     *mesh_seen = UINT32_MAX;
     uint32_t x = index % bake->width, row = index / bake->width;
     dwvg_hit hit;
-    dwvw_vec3 view;
+    dwvu_vec3 view;
     if (bake->options.target == DWV_BAKE_CAMERA) {
-        dwvw_vec3 origin;
+        dwvu_vec3 origin;
         camera_sample(bake, x, row, &sampler, &origin, &view);
         if (!(bake->scene->mesh_count > 0 && dwvg_intersect(&bake->scene->geometry, origin, view, 0.0, INFINITY, &hit))) {
             for (int c = 0; c < 3; ++c) rgb[c] = bake->scene->world[c];
@@ -149,7 +150,7 @@ static void sample_with(const dwvb_bake *bake, const dwvb_shader *shader, uint64
         hit.v = texel->b2;
         hit.t = 0.0;
         const dwvg_mesh *mesh = &bake->scene->meshes[hit.mesh];
-        view = dwvw_scale(dwvg_geometric_normal(mesh, hit.prim), -1.0);
+        view = dwvu_scale(dwvg_geometric_normal(mesh, hit.prim), -1.0);
     }
     *mesh_seen = hit.mesh;
     dwvb_shade(shader, &hit, view, &sampler, PIXEL_PAIR + 1u, key_walk, rgb, tally);
@@ -195,8 +196,7 @@ static void *worker(void *arg)
         uint32_t slot = atomic_fetch_add(&bake->next_tile, 1u);
         if (slot >= bake->tile_count) break;
         uint32_t tile = bake->tile_order[slot];
-        struct timespec tile_start, tile_end;
-        clock_gettime(CLOCK_MONOTONIC, &tile_start);
+        double tile_start = dwvu_clock_seconds();
         uint32_t x0 = (tile % bake->tiles_x) * tile_size, y0 = (tile / bake->tiles_x) * tile_size;
         uint32_t x1 = x0 + tile_size < bake->width ? x0 + tile_size : bake->width;
         uint32_t y1 = y0 + tile_size < bake->height ? y0 + tile_size : bake->height;
@@ -226,9 +226,7 @@ static void *worker(void *arg)
             }
         }
         atomic_fetch_add(&bake->events, tally->events - events_before);
-        clock_gettime(CLOCK_MONOTONIC, &tile_end);
-        bake->tile_seconds[tile] = (double)(tile_end.tv_sec - tile_start.tv_sec) +
-                                   1e-9 * (double)(tile_end.tv_nsec - tile_start.tv_nsec);
+        bake->tile_seconds[tile] = dwvu_clock_seconds() - tile_start;
         if (!stop) atomic_fetch_add(&bake->tiles_done, 1u);
     }
     pthread_mutex_lock(&bake->lock);
@@ -337,15 +335,7 @@ static void report(dwvb_bake *bake, int done)
 
 static void timed_wait(dwvb_bake *bake, double seconds)
 {
-    struct timespec until;
-    clock_gettime(CLOCK_MONOTONIC, &until);
-    double whole = floor(seconds);
-    until.tv_sec += (time_t)whole;
-    until.tv_nsec += (long)((seconds - whole) * 1e9);
-    if (until.tv_nsec >= 1000000000L) {
-        until.tv_sec += 1;
-        until.tv_nsec -= 1000000000L;
-    }
+    struct timespec until = dwvu_clock_after(seconds);
     pthread_cond_timedwait(&bake->changed, &bake->lock, &until);
 }
 
@@ -378,13 +368,10 @@ static int run_pass(dwvb_bake *bake)
     order_tiles(bake);
     atomic_store(&bake->next_tile, 0u);
     atomic_store(&bake->tiles_done, 0u);
-    pthread_t ids[1024];
-    uint32_t started = 0;
     pthread_mutex_lock(&bake->lock);
     bake->workers_running = bake->threads;
     pthread_mutex_unlock(&bake->lock);
-    for (; started < bake->threads; ++started)
-        if (pthread_create(&ids[started], NULL, worker, bake) != 0) break;
+    uint32_t started = dwvu_parallel_start(&bake->workers, bake->threads, worker, bake);
     pthread_mutex_lock(&bake->lock);
     bake->workers_running -= bake->threads - started;
     while (bake->workers_running > 0) {
@@ -394,7 +381,7 @@ static int run_pass(dwvb_bake *bake)
         pthread_mutex_lock(&bake->lock);
     }
     pthread_mutex_unlock(&bake->lock);
-    for (uint32_t i = 0; i < started; ++i) pthread_join(ids[i], NULL);
+    dwvu_parallel_join(&bake->workers);
     return started == 0 ? -1 : 0;
 }
 
@@ -539,15 +526,15 @@ static void setup_camera(dwvb_bake *bake)
 {
     const dwv_camera_t *cam = &bake->scene->camera;
     const double *m = cam->transform;
-    bake->eye = dwvw_v(m[3], m[7], m[11]);
-    dwvw_vec3 x = dwvw_v(m[0], m[4], m[8]), y = dwvw_v(m[1], m[5], m[9]), z = dwvw_v(m[2], m[6], m[10]);
+    bake->eye = dwvu_v(m[3], m[7], m[11]);
+    dwvu_vec3 x = dwvu_v(m[0], m[4], m[8]), y = dwvu_v(m[1], m[5], m[9]), z = dwvu_v(m[2], m[6], m[10]);
     double half = cam->kind == DWV_CAMERA_PERSPECTIVE ? 0.5 * cam->sensor_width / cam->focal_length
                                                       : 0.5 * cam->ortho_scale;
     double aspect = (double)bake->width / bake->height;
     double half_x = aspect >= 1.0 ? half : half * aspect, half_y = aspect >= 1.0 ? half / aspect : half;
-    bake->right = dwvw_scale(x, half_x);
-    bake->up = dwvw_scale(y, half_y);
-    bake->forward = dwvw_scale(z, -1.0);
+    bake->right = dwvu_scale(x, half_x);
+    bake->up = dwvu_scale(y, half_y);
+    bake->forward = dwvu_scale(z, -1.0);
 }
 
 /* Which meshes' walks the bake can reach: all for a camera, the one mesh for a UV bake. */
@@ -850,12 +837,7 @@ static int run_pilot(dwvb_bake *bake, const dwvb_shader *shaders, const int *can
     if (!run.block_sums) return -1;
     atomic_init(&run.next_block, 0u);
     atomic_init(&run.stopped, 0);
-    pthread_t ids[64];
-    uint32_t wanted = bake->threads < 64u ? bake->threads : 64u, started = 0;
-    for (; started < wanted; ++started)
-        if (pthread_create(&ids[started], NULL, pilot_worker, &run) != 0) break;
-    if (started == 0) pilot_worker(&run); /* no thread to spare: this one does it all */
-    for (uint32_t t = 0; t < started; ++t) pthread_join(ids[t], NULL);
+    dwvu_parallel_run(bake->threads < 64u ? bake->threads : 64u, pilot_worker, &run);
     for (uint32_t block = 0; block < PILOT_BLOCKS; ++block)
         for (size_t k = 0; k < per_block; ++k) {
             const pilot_sums *b = &run.block_sums[block * per_block + k];
@@ -1094,7 +1076,7 @@ dwv_result_t dwvb_bake_start(dwvb_scene *scene, const dwv_bake_options_t *option
     bake->shader.channel_counts = bake->channel_counts;
     bake->shader.needs_closest = bake->needs_closest;
     bake->shader.max_events = options->max_events;
-    clock_gettime(CLOCK_MONOTONIC, &bake->start);
+    bake->start = dwvu_clock_seconds();
     if (pthread_create(&bake->control, NULL, control, bake) != 0) {
         release_parts(bake);
         snprintf(message, size, "could not start the bake's control thread");
@@ -1111,12 +1093,9 @@ int dwvb_bake_wait(dwvb_bake *bake, double seconds)
     if (seconds < 0.0) {
         while (!bake->done) pthread_cond_wait(&bake->changed, &bake->lock);
     } else if (!bake->done && seconds > 0.0) {
-        struct timespec start;
-        clock_gettime(CLOCK_MONOTONIC, &start);
+        double start = dwvu_clock_seconds();
         for (;;) {
-            struct timespec now;
-            clock_gettime(CLOCK_MONOTONIC, &now);
-            double left = seconds - ((double)(now.tv_sec - start.tv_sec) + 1e-9 * (double)(now.tv_nsec - start.tv_nsec));
+            double left = seconds - (dwvu_clock_seconds() - start);
             if (bake->done || left <= 0.0) break;
             timed_wait(bake, left);
         }

@@ -14,7 +14,7 @@
 
 #include "bake/image.h"
 #include "bake/scene.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 typedef struct dwvb_bake dwvb_bake;
 

@@ -6,7 +6,7 @@
 #include <stdatomic.h>
 #include <stdint.h>
 
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 typedef struct dwvb_image {
     atomic_uint references;

@@ -25,7 +25,7 @@
 #ifndef DWV_BAKE_MATERIAL_H
 #define DWV_BAKE_MATERIAL_H
 
-#include "dwivedi.h"
+#include <dwivedi.h>
 #include "walk/walk.h"
 
 #define DWVB_MIN_RADIUS 1e-8

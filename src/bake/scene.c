@@ -109,8 +109,8 @@ static int make_patches(const dwvb_scene *scene, const dwvl_environment *env, ui
         cdf[t] = total;
     }
     double power[6] = {0}, weight_sum[6] = {0};
-    dwvw_vec3 point[6], normal[6];
-    for (int b = 0; b < 6; ++b) point[b] = normal[b] = dwvw_v(0.0, 0.0, 0.0);
+    dwvu_vec3 point[6], normal[6];
+    for (int b = 0; b < 6; ++b) point[b] = normal[b] = dwvu_v(0.0, 0.0, 0.0);
     if (total > 0.0 && isfinite(total)) {
         double area_per_point = total / PATCH_POINTS;
         for (uint32_t i = 0; i < PATCH_POINTS; ++i) {
@@ -124,9 +124,9 @@ static int make_patches(const dwvb_scene *scene, const dwvl_environment *env, ui
             }
             double su = sqrt(dwvk_rng_uniform_d(key, 1)), v = dwvk_rng_uniform_d(key, 2);
             double b1 = su * (1.0 - v), b2 = su * v; /* uniform on the triangle */
-            dwvw_vec3 ng = dwvg_geometric_normal(mesh, lo);
+            dwvu_vec3 ng = dwvg_geometric_normal(mesh, lo);
             if (ng.x == 0.0 && ng.y == 0.0 && ng.z == 0.0) continue;
-            dwvw_vec3 x = dwvg_point(mesh, lo, b1, b2);
+            dwvu_vec3 x = dwvg_point(mesh, lo, b1, b2);
             double radiance[3];
             /* Independent draws; pairs from 2 on (dimensions 4, 5, ...) leave 0 to 2 to the point. */
             dwvk_sampler sampler = {.key = key, .index = 0u, .stratified = 0};
@@ -138,8 +138,8 @@ static int make_patches(const dwvb_scene *scene, const dwvl_environment *env, ui
             int bin = ax >= ay && ax >= az ? (ng.x > 0.0 ? 0 : 1) : ay >= az ? (ng.y > 0.0 ? 2 : 3) : (ng.z > 0.0 ? 4 : 5);
             power[bin] += e * area_per_point;
             weight_sum[bin] += e;
-            point[bin] = dwvw_madd(point[bin], x, e);
-            normal[bin] = dwvw_madd(normal[bin], ng, e);
+            point[bin] = dwvu_madd(point[bin], x, e);
+            normal[bin] = dwvu_madd(normal[bin], ng, e);
         }
     }
     free(cdf);
@@ -147,10 +147,10 @@ static int make_patches(const dwvb_scene *scene, const dwvl_environment *env, ui
     for (int b = 0; b < 6; ++b) largest = fmax(largest, power[b]);
     int count = 0;
     for (int b = 0; b < 6; ++b) {
-        double length = dwvw_length(normal[b]);
+        double length = dwvu_length(normal[b]);
         if (!(power[b] > 1e-6 * largest) || !(length > 0.0)) continue;
-        dwvw_light_patch p = {.point = dwvw_scale(point[b], 1.0 / weight_sum[b]),
-                              .normal = dwvw_scale(normal[b], 1.0 / length), .power = power[b], .is_plane = 0};
+        dwvw_light_patch p = {.point = dwvu_scale(point[b], 1.0 / weight_sum[b]),
+                              .normal = dwvu_scale(normal[b], 1.0 / length), .power = power[b], .is_plane = 0};
         patches[count++] = p;
     }
     return count;

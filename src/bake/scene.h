@@ -8,7 +8,7 @@
 #include <stdint.h>
 
 #include "bake/material.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 #include "geom/embree.h"
 #include "geom/mesh.h"
 #include "light/light.h"

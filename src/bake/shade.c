@@ -28,7 +28,7 @@ static uint64_t mixture_terms(const dwvw_walk *walk, uint64_t per_component, uin
  * mesh, so this holds for open meshes too. The first step (the probe, which the backward
  * technique needs in full) is always a ray (its origin is on the surface: no ball there). */
 static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvw_medium *medium, const dwvw_guide *guide,
-                    uint32_t entry_prim, dwvw_vec3 x, dwvw_vec3 direction, dwvw_vec3 entry_normal, uint64_t key,
+                    uint32_t entry_prim, dwvu_vec3 x, dwvu_vec3 direction, dwvu_vec3 entry_normal, uint64_t key,
                     const dwvk_sampler *sampler, uint32_t walk_pair, dwvw_pair_cache *pairs, dwvw_walk *walk,
                     dwvg_hit *exit, dwvb_tally *tally)
 {
@@ -92,7 +92,7 @@ static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvw_medium 
          * mesh is open there, and the walk may wander off. */
         if (first && full_probe && !found) ++tally->warnings;
         first = 0;
-        dwvw_vec3 normal = dwvw_v(0.0, 0.0, 0.0);
+        dwvu_vec3 normal = dwvu_v(0.0, 0.0, 0.0);
         if (found) {
             normal = dwvg_geometric_normal(m, hit.prim);
             if (normal.x == 0.0 && normal.y == 0.0 && normal.z == 0.0) {
@@ -110,32 +110,32 @@ static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvw_medium 
 
 /* The retro-reflection lobe of Blender 3.x's Principled BSDF at a surface point. */
 typedef struct retro_lobe {
-    dwvw_vec3 n;       /* shading normal */
-    dwvw_vec3 to_view; /* unit, toward the viewer */
+    dwvu_vec3 n;       /* shading normal */
+    dwvu_vec3 to_view; /* unit, toward the viewer */
     double cos_view;
     double roughness;
 } retro_lobe;
 
-static double retro_factor(const void *context, dwvw_vec3 light)
+static double retro_factor(const void *context, dwvu_vec3 light)
 {
     const retro_lobe *lobe = context;
-    return dwvb_principled_retro_factor(dwvw_dot(lobe->n, light), lobe->cos_view, dwvw_dot(light, lobe->to_view),
+    return dwvb_principled_retro_factor(dwvu_dot(lobe->n, light), lobe->cos_view, dwvu_dot(light, lobe->to_view),
                                         lobe->roughness);
 }
 
 /* Blender 3.x Principled's diffuse without subsurface (both Fresnel terms and retro-reflection). */
-static double principled_diffuse_factor(const void *context, dwvw_vec3 light)
+static double principled_diffuse_factor(const void *context, dwvu_vec3 light)
 {
     const retro_lobe *lobe = context;
-    return dwvb_principled_diffuse_factor(dwvw_dot(lobe->n, light), lobe->cos_view, dwvw_dot(light, lobe->to_view),
+    return dwvb_principled_diffuse_factor(dwvu_dot(lobe->n, light), lobe->cos_view, dwvu_dot(light, lobe->to_view),
                                           lobe->roughness);
 }
 
 /* The exit weight of Blender 3.x's Principled BSDF; the context is the exit's shading normal. */
-static double exit_factor(const void *context, dwvw_vec3 light)
+static double exit_factor(const void *context, dwvu_vec3 light)
 {
-    const dwvw_vec3 *n = context;
-    return dwvb_principled_exit_factor(dwvw_dot(*n, light));
+    const dwvu_vec3 *n = context;
+    return dwvb_principled_exit_factor(dwvu_dot(*n, light));
 }
 
 /* The light a walk gathers where it left mesh `mesh` (exit: its hit), from the sampler's light
@@ -145,8 +145,8 @@ static void exit_light(const dwvb_shader *shader, uint32_t mesh_id, const dwvb_m
 {
     const dwvb_scene *scene = shader->scene;
     const dwvg_mesh *mesh = &scene->meshes[mesh_id];
-    dwvw_vec3 exit_ng = walk->exit_normal;
-    dwvw_vec3 exit_n = dwvg_shading_normal(mesh, exit->prim, exit->u, exit->v, exit_ng);
+    dwvu_vec3 exit_ng = walk->exit_normal;
+    dwvu_vec3 exit_n = dwvg_shading_normal(mesh, exit->prim, exit->u, exit->v, exit_ng);
     /* Cycles shades the exit as a surface point of its triangle: the same terminator offset. */
     double cutoff = scene->terminator_offsets[mesh_id];
     dwvl_terminator exit_terminator = {mesh, exit->prim, exit->u, exit->v, cutoff};
@@ -159,7 +159,7 @@ static void exit_light(const dwvb_shader *shader, uint32_t mesh_id, const dwvb_m
         dwvl_direct(&shader->env, walk->position, exit_n, exit_ng, exit_smooth, exit_top, sampler, pair, direct);
 }
 
-void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, const dwvk_sampler *sampler,
+void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, const dwvk_sampler *sampler,
                 uint32_t pair, uint64_t key_walk, double rgb[3], dwvb_tally *tally)
 {
     const dwvb_scene *scene = shader->scene;
@@ -167,24 +167,24 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, 
     uint32_t material_id = mesh->material_id;
     const dwvb_material *material = &scene->shading[material_id];
     rgb[0] = rgb[1] = rgb[2] = 0.0;
-    dwvw_vec3 ng = dwvg_geometric_normal(mesh, hit->prim);
+    dwvu_vec3 ng = dwvg_geometric_normal(mesh, hit->prim);
     if (ng.x == 0.0 && ng.y == 0.0 && ng.z == 0.0) {
         ++tally->warnings;
         return;
     }
     int ng_flipped = 0;
-    if (dwvw_dot(view, ng) > 0.0) {
+    if (dwvu_dot(view, ng) > 0.0) {
         /* The back of a face. A diffuse surface is two-sided; a subsurface one is seen from inside
          * its medium (an open or inside-out mesh): no walk is defined there. */
         if (material->subsurface) {
             ++tally->warnings;
             return;
         }
-        ng = dwvw_scale(ng, -1.0);
+        ng = dwvu_scale(ng, -1.0);
         ng_flipped = 1;
     }
-    dwvw_vec3 x = dwvg_point(mesh, hit->prim, hit->u, hit->v);
-    dwvw_vec3 n = dwvg_shading_normal(mesh, hit->prim, hit->u, hit->v, ng);
+    dwvu_vec3 x = dwvg_point(mesh, hit->prim, hit->u, hit->v);
+    dwvu_vec3 n = dwvg_shading_normal(mesh, hit->prim, hit->u, hit->v, ng);
     uint32_t light_pairs = dwvl_direct_pairs(&shader->env);
     /* Shadow rays of smooth-shaded triangles leave from the smooth surface near the terminator,
      * as in Cycles with the mesh's geometry offset (src/light/terminator.h). */
@@ -195,12 +195,12 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, 
     double top = ng_flipped ? INFINITY : dwvg_world_top(&scene->geometry, hit->mesh, hit->prim);
     if (material->principled_v1) {
         /* The Lambertian lobe and the retro-reflection lobe from the same light samples. */
-        retro_lobe lobe = {n, dwvw_scale(view, -1.0), -dwvw_dot(n, view), material->roughness};
+        retro_lobe lobe = {n, dwvu_scale(view, -1.0), -dwvu_dot(n, view), material->roughness};
         double direct[3], retro[3];
         dwvl_direct_lobe(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, retro_factor, &lobe, direct, retro);
         for (int c = 0; c < 3; ++c) rgb[c] += material->diffuse_albedo[c] * direct[c] + material->retro_albedo[c] * retro[c];
     } else if (material->principled_diffuse) {
-        retro_lobe lobe = {n, dwvw_scale(view, -1.0), -dwvw_dot(n, view), material->roughness};
+        retro_lobe lobe = {n, dwvu_scale(view, -1.0), -dwvu_dot(n, view), material->roughness};
         double diffuse[3];
         dwvl_direct_lobe(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, principled_diffuse_factor, &lobe,
                          NULL, diffuse);
@@ -217,8 +217,8 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, 
     double u[2];
     dwvk_sampler_pair(sampler, pair, u);
     double mu = sqrt(u[0]);
-    dwvw_vec3 inward = dwvw_direction_about(dwvw_scale(n, -1.0), mu, 1.0 - mu, 1.0 + mu, u[1]);
-    if (!(dwvw_dot(inward, ng) < 0.0)) return;
+    dwvu_vec3 inward = dwvk_direction_about(dwvu_scale(n, -1.0), mu, 1.0 - mu, 1.0 + mu, u[1]);
+    if (!(dwvu_dot(inward, ng) < 0.0)) return;
     /* The walk's first events take the pairs after the exit's lights (walk.h, DWVW_PAIR_*). */
     uint32_t walk_pair = pair + DWVB_SHADE_PAIRS + 2u * light_pairs;
     uint32_t exit_pair = pair + DWVB_SHADE_PAIRS + light_pairs;

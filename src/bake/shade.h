@@ -64,7 +64,7 @@ typedef struct dwvb_tally {
 /* The radiance leaving hit point `hit` along -view (view: unit direction of the ray that found
  * it, from the viewer). `sampler` drives entry and light sampling from pair `pair` on, then the
  * walk's first DWVB_STRATIFIED_EVENTS events; key_walk drives the rest of the walk. */
-void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvw_vec3 view, const dwvk_sampler *sampler,
+void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, const dwvk_sampler *sampler,
                 uint32_t pair, uint64_t key_walk, double rgb[3], dwvb_tally *tally);
 
 #endif

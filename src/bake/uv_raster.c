@@ -36,7 +36,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "api/error.h"
+#include "util/error.h"
 
 #define UNIT 256.0 /* 2^DWVB_UV_SUBPIXEL_BITS: snapped units per texel */
 #define HALF 128.0 /* a texel centre's offset in units */

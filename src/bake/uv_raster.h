@@ -13,7 +13,7 @@
 #include <stdint.h>
 
 #include "bake/image.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 /* The sizes a UV bake accepts (those of dwv_bake_options_t): each side 1 to 16384, at most 2^26
  * texels, so that a raster is at most 768 MiB and indices fit in 32 bits. */

@@ -12,7 +12,7 @@
 #include <unistd.h>
 
 #include "cli.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 static const char verb[] = "bake";
 

@@ -9,7 +9,7 @@
 #include <unistd.h>
 
 #include "cli.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 static const char VERB[] = "bench bake";
 #define THROUGHPUT_ROUNDS 3

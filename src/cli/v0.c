@@ -2,7 +2,7 @@
 #include <string.h>
 
 #include "cli.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 static void help(FILE *out)
 {

@@ -17,18 +17,18 @@
 
 /* The barycentrics (u, v) of the point of triangle abc closest to p (Ericson, Real-Time
  * Collision Detection, Sec. 5.1.5: Voronoi regions of the vertices, edges and face in turn). */
-void dwvg_closest_on_triangle(dwvw_vec3 p, dwvw_vec3 a, dwvw_vec3 b, dwvw_vec3 c, double *u, double *v)
+void dwvg_closest_on_triangle(dwvu_vec3 p, dwvu_vec3 a, dwvu_vec3 b, dwvu_vec3 c, double *u, double *v)
 {
-    dwvw_vec3 ab = dwvw_sub(b, a), ac = dwvw_sub(c, a), ap = dwvw_sub(p, a);
-    double d1 = dwvw_dot(ab, ap), d2 = dwvw_dot(ac, ap);
+    dwvu_vec3 ab = dwvu_sub(b, a), ac = dwvu_sub(c, a), ap = dwvu_sub(p, a);
+    double d1 = dwvu_dot(ab, ap), d2 = dwvu_dot(ac, ap);
     if (d1 <= 0.0 && d2 <= 0.0) { *u = 0.0; *v = 0.0; return; }
-    dwvw_vec3 bp = dwvw_sub(p, b);
-    double d3 = dwvw_dot(ab, bp), d4 = dwvw_dot(ac, bp);
+    dwvu_vec3 bp = dwvu_sub(p, b);
+    double d3 = dwvu_dot(ab, bp), d4 = dwvu_dot(ac, bp);
     if (d3 >= 0.0 && d4 <= d3) { *u = 1.0; *v = 0.0; return; }
     double vc = d1 * d4 - d3 * d2;
     if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) { *u = d1 / (d1 - d3); *v = 0.0; return; }
-    dwvw_vec3 cp = dwvw_sub(p, c);
-    double d5 = dwvw_dot(ab, cp), d6 = dwvw_dot(ac, cp);
+    dwvu_vec3 cp = dwvu_sub(p, c);
+    double d5 = dwvu_dot(ab, cp), d6 = dwvu_dot(ac, cp);
     if (d6 >= 0.0 && d5 <= d6) { *u = 0.0; *v = 1.0; return; }
     double vb = d5 * d2 - d1 * d6;
     if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) { *u = 0.0; *v = d2 / (d2 - d6); return; }
@@ -45,26 +45,26 @@ void dwvg_closest_on_triangle(dwvw_vec3 p, dwvw_vec3 a, dwvw_vec3 b, dwvw_vec3 c
 }
 
 /* The distance from p to segment ab. */
-static double segment_distance(dwvw_vec3 p, dwvw_vec3 a, dwvw_vec3 b)
+static double segment_distance(dwvu_vec3 p, dwvu_vec3 a, dwvu_vec3 b)
 {
-    dwvw_vec3 ab = dwvw_sub(b, a);
-    double length2 = dwvw_dot(ab, ab);
-    double s = length2 > 0.0 ? dwvw_dot(dwvw_sub(p, a), ab) / length2 : 0.0;
+    dwvu_vec3 ab = dwvu_sub(b, a);
+    double length2 = dwvu_dot(ab, ab);
+    double s = length2 > 0.0 ? dwvu_dot(dwvu_sub(p, a), ab) / length2 : 0.0;
     s = s < 0.0 ? 0.0 : s > 1.0 ? 1.0 : s;
-    return dwvw_length(dwvw_sub(p, dwvw_add(a, dwvw_scale(ab, s))));
+    return dwvu_length(dwvu_sub(p, dwvu_add(a, dwvu_scale(ab, s))));
 }
 
-double dwvg_triangle_distance(dwvw_vec3 p, dwvw_vec3 a, dwvw_vec3 b, dwvw_vec3 c)
+double dwvg_triangle_distance(dwvu_vec3 p, dwvu_vec3 a, dwvu_vec3 b, dwvu_vec3 c)
 {
-    dwvw_vec3 ab = dwvw_sub(b, a), ac = dwvw_sub(c, a);
-    dwvw_vec3 n = dwvw_v(ab.y * ac.z - ab.z * ac.y, ab.z * ac.x - ab.x * ac.z, ab.x * ac.y - ab.y * ac.x);
-    double area2 = dwvw_dot(n, n);
+    dwvu_vec3 ab = dwvu_sub(b, a), ac = dwvu_sub(c, a);
+    dwvu_vec3 n = dwvu_v(ab.y * ac.z - ab.z * ac.y, ab.z * ac.x - ab.x * ac.z, ab.x * ac.y - ab.y * ac.x);
+    double area2 = dwvu_dot(n, n);
     if (!(area2 > 0.0 && isfinite(area2)))
         return fmin(segment_distance(p, a, b), fmin(segment_distance(p, b, c), segment_distance(p, c, a)));
     double u, v;
     dwvg_closest_on_triangle(p, a, b, c, &u, &v);
-    dwvw_vec3 x = dwvw_add(a, dwvw_add(dwvw_scale(ab, u), dwvw_scale(ac, v)));
-    return dwvw_length(dwvw_sub(p, x));
+    dwvu_vec3 x = dwvu_add(a, dwvu_add(dwvu_scale(ab, u), dwvu_scale(ac, v)));
+    return dwvu_length(dwvu_sub(p, x));
 }
 
 /* The largest float not above x (x finite). */
@@ -161,18 +161,18 @@ static double cell_visits(const dwvg_clearance *grid, const dwvg_mesh *mesh, dou
 /* Triangle t's corners into p and its unit normal (p1 - p0) x (p2 - p0) / |...| into *n; returns
  * |(p1 - p0) x (p2 - p0)| (twice the area), or 0 with *n = 0 where that is zero or not finite (no
  * plane). */
-static double triangle_plane(const dwvg_mesh *mesh, uint32_t t, dwvw_vec3 p[3], dwvw_vec3 *n)
+static double triangle_plane(const dwvg_mesh *mesh, uint32_t t, dwvu_vec3 p[3], dwvu_vec3 *n)
 {
     const uint32_t *corner = mesh->indices + 3u * (size_t)t;
     for (int k = 0; k < 3; ++k) {
         const float *q = mesh->positions + 3u * (size_t)corner[k];
-        p[k] = dwvw_v(q[0], q[1], q[2]);
+        p[k] = dwvu_v(q[0], q[1], q[2]);
     }
-    dwvw_vec3 e1 = dwvw_sub(p[1], p[0]), e2 = dwvw_sub(p[2], p[0]);
-    dwvw_vec3 c = dwvw_v(e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x);
-    double length = dwvw_length(c);
+    dwvu_vec3 e1 = dwvu_sub(p[1], p[0]), e2 = dwvu_sub(p[2], p[0]);
+    dwvu_vec3 c = dwvu_v(e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x);
+    double length = dwvu_length(c);
     int flat = length > 0.0 && isfinite(length);
-    *n = flat ? dwvw_scale(c, 1.0 / length) : dwvw_v(0.0, 0.0, 0.0);
+    *n = flat ? dwvu_scale(c, 1.0 / length) : dwvu_v(0.0, 0.0, 0.0);
     return flat ? length : 0.0;
 }
 
@@ -183,7 +183,7 @@ static void exact_near(dwvg_clearance *grid, const dwvg_mesh *mesh, uint32_t t, 
     double tlo[3], thi[3];
     if (!finite_triangle(mesh, t, tlo, thi)) return;
     /* The distance to a triangle is at least that to its plane: a cheap test first. */
-    dwvw_vec3 p[3], n;
+    dwvu_vec3 p[3], n;
     int flat = triangle_plane(mesh, t, p, &n) > 0.0;
     uint32_t first[3], last[3];
     for (int a = 0; a < 3; ++a) cell_range(grid, a, tlo[a] - band, thi[a] + band, &first[a], &last[a]);
@@ -191,8 +191,8 @@ static void exact_near(dwvg_clearance *grid, const dwvg_mesh *mesh, uint32_t t, 
         for (uint32_t iy = first[1]; iy <= last[1]; ++iy)
             for (uint32_t ix = first[0]; ix <= last[0]; ++ix) {
                 float *cell = &grid->lower[((size_t)iz * grid->n[1] + iy) * grid->n[0] + ix];
-                dwvw_vec3 centre = dwvg_clearance_centre(grid, ix, iy, iz);
-                if (flat && fabs(dwvw_dot(dwvw_sub(centre, p[0]), n)) >= *cell) continue;
+                dwvu_vec3 centre = dwvg_clearance_centre(grid, ix, iy, iz);
+                if (flat && fabs(dwvu_dot(dwvu_sub(centre, p[0]), n)) >= *cell) continue;
                 double d = dwvg_triangle_distance(centre, p[0], p[1], p[2]);
                 if (d < *cell) *cell = float_below(d);
             }
@@ -209,10 +209,10 @@ static int find_planes(dwvg_clearance *grid, const dwvg_mesh *mesh)
     for (uint32_t t = 0; t < mesh->triangle_count; ++t) {
         double lo[3], hi[3];
         if (!finite_triangle(mesh, t, lo, hi)) return 0;
-        dwvw_vec3 p[3], n;
+        dwvu_vec3 p[3], n;
         double length = triangle_plane(mesh, t, p, &n);
         if (!(length > 0.0)) return 0;
-        double d = dwvw_dot(n, p[0]);
+        double d = dwvu_dot(n, p[0]);
         uint32_t known = count;
         for (uint32_t i = 0; i < count && known == count; ++i) {
             const double *q = grid->planes[i];

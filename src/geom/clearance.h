@@ -19,10 +19,11 @@
 #define DWV_GEOM_CLEARANCE_H
 
 #include <math.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include "mesh.h"
-#include "walk/vec3.h"
+#include "util/vec3.h"
 
 /* At most this many cells per mesh (4 bytes each: 1 MiB). */
 #define DWVG_CLEARANCE_MAX_CELLS (1u << 18)
@@ -56,14 +57,14 @@ void dwvg_clearance_free(dwvg_clearance *grid);
 
 /* The barycentrics (u, v) of the point of triangle abc closest to p (Ericson, Real-Time Collision
  * Detection, Sec. 5.1.5). */
-void dwvg_closest_on_triangle(dwvw_vec3 p, dwvw_vec3 a, dwvw_vec3 b, dwvw_vec3 c, double *u, double *v);
+void dwvg_closest_on_triangle(dwvu_vec3 p, dwvu_vec3 a, dwvu_vec3 b, dwvu_vec3 c, double *u, double *v);
 /* The distance from p to triangle abc; to its edges where it has zero area (a ray may still graze
  * it). */
-double dwvg_triangle_distance(dwvw_vec3 p, dwvw_vec3 a, dwvw_vec3 b, dwvw_vec3 c);
+double dwvg_triangle_distance(dwvu_vec3 p, dwvu_vec3 a, dwvu_vec3 b, dwvu_vec3 c);
 
-static inline dwvw_vec3 dwvg_clearance_centre(const dwvg_clearance *grid, uint32_t ix, uint32_t iy, uint32_t iz)
+static inline dwvu_vec3 dwvg_clearance_centre(const dwvg_clearance *grid, uint32_t ix, uint32_t iy, uint32_t iz)
 {
-    return dwvw_v(grid->origin[0] + (ix + 0.5) * grid->cell, grid->origin[1] + (iy + 0.5) * grid->cell,
+    return dwvu_v(grid->origin[0] + (ix + 0.5) * grid->cell, grid->origin[1] + (iy + 0.5) * grid->cell,
                   grid->origin[2] + (iz + 0.5) * grid->cell);
 }
 
@@ -72,7 +73,7 @@ static inline dwvw_vec3 dwvg_clearance_centre(const dwvg_clearance *grid, uint32
  * its step's length as the floor (a bound no longer than the step cannot spare the ray), which
  * lets the planes stop at the first one that close (they are kept largest first: the nearest,
  * in a thin box). */
-static inline double dwvg_clearance_above(const dwvg_clearance *grid, dwvw_vec3 p, double floor)
+static inline double dwvg_clearance_above(const dwvg_clearance *grid, dwvu_vec3 p, double floor)
 {
     if (grid->plane_count) {
         double bound = INFINITY;
@@ -94,12 +95,12 @@ static inline double dwvg_clearance_above(const dwvg_clearance *grid, dwvw_vec3 
     uint32_t ix = (uint32_t)fx, iy = (uint32_t)fy, iz = (uint32_t)fz;
     double bound = grid->lower[((size_t)iz * grid->n[1] + iy) * grid->n[0] + ix];
     if (!(bound > floor)) return 0.0;
-    bound -= dwvw_length(dwvw_sub(p, dwvg_clearance_centre(grid, ix, iy, iz)));
+    bound -= dwvu_length(dwvu_sub(p, dwvg_clearance_centre(grid, ix, iy, iz)));
     return bound > floor ? bound : 0.0;
 }
 
 /* A lower bound on the distance from p to the mesh (0 where none is known). */
-static inline double dwvg_clearance_at(const dwvg_clearance *grid, dwvw_vec3 p)
+static inline double dwvg_clearance_at(const dwvg_clearance *grid, dwvu_vec3 p)
 {
     return dwvg_clearance_above(grid, p, 0.0);
 }

@@ -7,13 +7,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-static dwvw_vec3 vertex(const dwvg_mesh *mesh, uint32_t index)
+static dwvu_vec3 vertex(const dwvg_mesh *mesh, uint32_t index)
 {
     const float *p = mesh->positions + 3u * (size_t)index;
-    return dwvw_v(p[0], p[1], p[2]);
+    return dwvu_v(p[0], p[1], p[2]);
 }
 
-static void corners(const dwvg_mesh *mesh, uint32_t prim, dwvw_vec3 *a, dwvw_vec3 *b, dwvw_vec3 *c)
+static void corners(const dwvg_mesh *mesh, uint32_t prim, dwvu_vec3 *a, dwvu_vec3 *b, dwvu_vec3 *c)
 {
     const uint32_t *i = mesh->indices + 3u * (size_t)prim;
     *a = vertex(mesh, i[0]);
@@ -32,49 +32,49 @@ static int in_embree_range(float x, float y, float z)
     return fabsf(x) <= EMBREE_LARGEST && fabsf(y) <= EMBREE_LARGEST && fabsf(z) <= EMBREE_LARGEST;
 }
 
-static dwvw_vec3 cross(dwvw_vec3 a, dwvw_vec3 b)
+static dwvu_vec3 cross(dwvu_vec3 a, dwvu_vec3 b)
 {
-    return dwvw_v(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+    return dwvu_v(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
 }
 
-dwvw_vec3 dwvg_geometric_normal(const dwvg_mesh *mesh, uint32_t prim)
+dwvu_vec3 dwvg_geometric_normal(const dwvg_mesh *mesh, uint32_t prim)
 {
-    dwvw_vec3 a, b, c;
+    dwvu_vec3 a, b, c;
     corners(mesh, prim, &a, &b, &c);
-    dwvw_vec3 n = cross(dwvw_sub(b, a), dwvw_sub(c, a));
-    double length = dwvw_length(n);
-    return length > 0.0 && isfinite(length) ? dwvw_scale(n, 1.0 / length) : dwvw_v(0.0, 0.0, 0.0);
+    dwvu_vec3 n = cross(dwvu_sub(b, a), dwvu_sub(c, a));
+    double length = dwvu_length(n);
+    return length > 0.0 && isfinite(length) ? dwvu_scale(n, 1.0 / length) : dwvu_v(0.0, 0.0, 0.0);
 }
 
 double dwvg_triangle_area(const dwvg_mesh *mesh, uint32_t prim)
 {
-    dwvw_vec3 a, b, c;
+    dwvu_vec3 a, b, c;
     corners(mesh, prim, &a, &b, &c);
-    double area = 0.5 * dwvw_length(cross(dwvw_sub(b, a), dwvw_sub(c, a)));
+    double area = 0.5 * dwvu_length(cross(dwvu_sub(b, a), dwvu_sub(c, a)));
     return isfinite(area) ? area : 0.0;
 }
 
-dwvw_vec3 dwvg_point(const dwvg_mesh *mesh, uint32_t prim, double u, double v)
+dwvu_vec3 dwvg_point(const dwvg_mesh *mesh, uint32_t prim, double u, double v)
 {
-    dwvw_vec3 a, b, c;
+    dwvu_vec3 a, b, c;
     corners(mesh, prim, &a, &b, &c);
-    return dwvw_add(a, dwvw_add(dwvw_scale(dwvw_sub(b, a), u), dwvw_scale(dwvw_sub(c, a), v)));
+    return dwvu_add(a, dwvu_add(dwvu_scale(dwvu_sub(b, a), u), dwvu_scale(dwvu_sub(c, a), v)));
 }
 
-dwvw_vec3 dwvg_shading_normal(const dwvg_mesh *mesh, uint32_t prim, double u, double v, dwvw_vec3 geometric)
+dwvu_vec3 dwvg_shading_normal(const dwvg_mesh *mesh, uint32_t prim, double u, double v, dwvu_vec3 geometric)
 {
     if (!mesh->normals) return geometric;
     const uint32_t *i = mesh->indices + 3u * (size_t)prim;
     const float *n0 = mesh->normals + 3u * (size_t)i[0], *n1 = mesh->normals + 3u * (size_t)i[1],
                 *n2 = mesh->normals + 3u * (size_t)i[2];
     double w = 1.0 - u - v;
-    dwvw_vec3 n = dwvw_v(w * n0[0] + u * n1[0] + v * n2[0], w * n0[1] + u * n1[1] + v * n2[1],
+    dwvu_vec3 n = dwvu_v(w * n0[0] + u * n1[0] + v * n2[0], w * n0[1] + u * n1[1] + v * n2[1],
                          w * n0[2] + u * n1[2] + v * n2[2]);
-    double length = dwvw_length(n);
+    double length = dwvu_length(n);
     if (!(length > 1e-6)) return geometric;
-    n = dwvw_scale(n, 1.0 / length);
+    n = dwvu_scale(n, 1.0 / length);
     /* A shading normal on the far side of the surface would light the wrong hemisphere. */
-    return dwvw_dot(n, geometric) > 0.0 ? n : geometric;
+    return dwvu_dot(n, geometric) > 0.0 ? n : geometric;
 }
 
 static void embree_error(void *user, enum RTCError code, const char *text)
@@ -142,9 +142,9 @@ static void find_polytope(const dwvg_world *world, const dwvg_mesh *mesh, int cl
     if (!closed || mesh->normals || mesh->triangle_count > DWVG_POLYTOPE_TRIANGLES) return;
     uint32_t plane_of[DWVG_POLYTOPE_TRIANGLES], count = 0;
     for (uint32_t t = 0; t < mesh->triangle_count; ++t) {
-        dwvw_vec3 n = dwvg_geometric_normal(mesh, t), a = vertex(mesh, mesh->indices[3u * (size_t)t]);
+        dwvu_vec3 n = dwvg_geometric_normal(mesh, t), a = vertex(mesh, mesh->indices[3u * (size_t)t]);
         if (n.x == 0.0 && n.y == 0.0 && n.z == 0.0) return;
-        double offset = dwvw_dot(n, a);
+        double offset = dwvu_dot(n, a);
         uint32_t i = 0;
         while (i < count && !(p->planes[i][0] == n.x && p->planes[i][1] == n.y && p->planes[i][2] == n.z &&
                               p->planes[i][3] == offset))
@@ -162,8 +162,8 @@ static void find_polytope(const dwvg_world *world, const dwvg_mesh *mesh, int cl
     double tolerance = 0x1p-23 * world->epsilon;
     for (uint32_t i = 0; i < count; ++i)
         for (uint32_t v = 0; v < mesh->vertex_count; ++v) {
-            dwvw_vec3 n = dwvw_v(p->planes[i][0], p->planes[i][1], p->planes[i][2]);
-            if (!(dwvw_dot(n, vertex(mesh, v)) - p->planes[i][3] <= tolerance)) return;
+            dwvu_vec3 n = dwvu_v(p->planes[i][0], p->planes[i][1], p->planes[i][2]);
+            if (!(dwvu_dot(n, vertex(mesh, v)) - p->planes[i][3] <= tolerance)) return;
         }
     uint32_t k = 0;
     for (uint32_t i = 0; i < count; ++i) {
@@ -191,12 +191,12 @@ static int make_tops(dwvg_world *world)
         world->tops[m] = malloc((mesh->triangle_count ? mesh->triangle_count : 1u) * sizeof **world->tops);
         if (!world->tops[m]) return -1;
         for (uint32_t t = 0; t < mesh->triangle_count; ++t) {
-            dwvw_vec3 n = dwvg_geometric_normal(mesh, t);
+            dwvu_vec3 n = dwvg_geometric_normal(mesh, t);
             double top = -INFINITY;
             for (uint32_t o = 0; o < world->mesh_count && top < INFINITY; ++o)
                 for (uint32_t v = 0; v < world->meshes[o].vertex_count; ++v) {
                     /* A non-finite vertex (Embree skips its triangles) counts as unbounded. */
-                    double h = dwvw_dot(n, vertex(&world->meshes[o], v));
+                    double h = dwvu_dot(n, vertex(&world->meshes[o], v));
                     top = h > top ? h : isnan(h) ? INFINITY : top;
                 }
             world->tops[m][t] = n.x == 0.0 && n.y == 0.0 && n.z == 0.0 ? INFINITY : top;
@@ -311,7 +311,7 @@ void dwvg_world_free(dwvg_world *world)
 }
 
 /* Fills an Embree ray; 0 if Embree could not trace it (see EMBREE_LARGEST, or a NaN bound). */
-static int make_ray(struct RTCRayHit *rh, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar)
+static int make_ray(struct RTCRayHit *rh, dwvu_vec3 o, dwvu_vec3 d, double tnear, double tfar)
 {
     rh->ray.org_x = (float)o.x;
     rh->ray.org_y = (float)o.y;
@@ -334,7 +334,7 @@ static int make_ray(struct RTCRayHit *rh, dwvw_vec3 o, dwvw_vec3 d, double tnear
 
 /* Inline: it is every walk ray's way to Embree, and GCC left it out of line once the polytopes
  * grew this file (some 170 instructions more per sphere walk). */
-static inline int trace(RTCScene scene, int instanced, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar, dwvg_hit *hit)
+static inline int trace(RTCScene scene, int instanced, dwvu_vec3 o, dwvu_vec3 d, double tnear, double tfar, dwvg_hit *hit)
 {
     struct RTCIntersectContext context;
     rtcInitIntersectContext(&context);
@@ -350,14 +350,14 @@ static inline int trace(RTCScene scene, int instanced, dwvw_vec3 o, dwvw_vec3 d,
     return 1;
 }
 
-static void polytope_hit(const dwvg_world *world, uint32_t mesh, uint32_t plane, dwvw_vec3 o, dwvw_vec3 d, double t,
+static void polytope_hit(const dwvg_world *world, uint32_t mesh, uint32_t plane, dwvu_vec3 o, dwvu_vec3 d, double t,
                          dwvg_hit *hit);
-static int polytope_first(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar,
+static int polytope_first(const dwvg_world *world, uint32_t mesh, dwvu_vec3 o, dwvu_vec3 d, double tnear, double tfar,
                           dwvg_hit *hit);
 
 /* A world of one mesh traces that mesh's scene: the top-level scene would only add an instance
  * (the identity transform, which leaves a ray's floats as they are) around the same BVH. */
-int dwvg_intersect(const dwvg_world *world, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar, dwvg_hit *hit)
+int dwvg_intersect(const dwvg_world *world, dwvu_vec3 o, dwvu_vec3 d, double tnear, double tfar, dwvg_hit *hit)
 {
     if (world->mesh_count == 0) return 0;
     if (world->mesh_count == 1 && world->polytopes[0].plane_count) return polytope_first(world, 0u, o, d, tnear, tfar, hit);
@@ -365,7 +365,7 @@ int dwvg_intersect(const dwvg_world *world, dwvw_vec3 o, dwvw_vec3 d, double tne
     return trace(world->top, 1, o, d, tnear, tfar, hit);
 }
 
-static int polytope_intersect(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, double tnear,
+static int polytope_intersect(const dwvg_world *world, uint32_t mesh, dwvu_vec3 o, dwvu_vec3 d, double tnear,
                               double tfar, dwvg_hit *hit)
 {
     const dwvg_polytope *p = &world->polytopes[mesh];
@@ -390,20 +390,20 @@ static int polytope_intersect(const dwvg_world *world, uint32_t mesh, dwvw_vec3 
 
 /* The hit at distance t along d from o on plane `plane` of polytope `mesh`: the triangle of that
  * plane holding the point, the one whose least barycentric is largest. */
-static void polytope_hit(const dwvg_world *world, uint32_t mesh, uint32_t plane, dwvw_vec3 o, dwvw_vec3 d, double t,
+static void polytope_hit(const dwvg_world *world, uint32_t mesh, uint32_t plane, dwvu_vec3 o, dwvu_vec3 d, double t,
                          dwvg_hit *hit)
 {
     const dwvg_polytope *p = &world->polytopes[mesh];
     const dwvg_mesh *m = &world->meshes[mesh];
-    dwvw_vec3 x = dwvw_madd(o, d, t);
+    dwvu_vec3 x = dwvu_madd(o, d, t);
     double chosen = -INFINITY;
     for (uint32_t k = p->first[plane]; k < p->first[plane + 1]; ++k) {
         uint32_t prim = p->triangles[k];
-        dwvw_vec3 a, b, c;
+        dwvu_vec3 a, b, c;
         corners(m, prim, &a, &b, &c);
-        dwvw_vec3 e1 = dwvw_sub(b, a), e2 = dwvw_sub(c, a), w = dwvw_sub(x, a);
-        double d11 = dwvw_dot(e1, e1), d12 = dwvw_dot(e1, e2), d22 = dwvw_dot(e2, e2);
-        double w1 = dwvw_dot(w, e1), w2 = dwvw_dot(w, e2), det = d11 * d22 - d12 * d12;
+        dwvu_vec3 e1 = dwvu_sub(b, a), e2 = dwvu_sub(c, a), w = dwvu_sub(x, a);
+        double d11 = dwvu_dot(e1, e1), d12 = dwvu_dot(e1, e2), d22 = dwvu_dot(e2, e2);
+        double w1 = dwvu_dot(w, e1), w2 = dwvu_dot(w, e2), det = d11 * d22 - d12 * d12;
         double u = (d22 * w1 - d12 * w2) / det, v = (d11 * w2 - d12 * w1) / det;
         double least = fmin(1.0 - u - v, fmin(u, v));
         if (least > chosen) {
@@ -421,7 +421,7 @@ static void polytope_hit(const dwvg_world *world, uint32_t mesh, uint32_t plane,
  * The line is inside between t_in, the last of the planes it enters (n.d < 0), and t_out, the
  * first it leaves (n.d > 0); it misses where t_in > t_out or it runs outside a plane it is
  * parallel to. The crossing is t_in where that is at tnear or beyond, else t_out (from inside). */
-static int polytope_first(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar,
+static int polytope_first(const dwvg_world *world, uint32_t mesh, dwvu_vec3 o, dwvu_vec3 d, double tnear, double tfar,
                           dwvg_hit *hit)
 {
     const dwvg_polytope *p = &world->polytopes[mesh];
@@ -454,7 +454,7 @@ static int polytope_first(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, d
     return 1;
 }
 
-int dwvg_intersect_mesh(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, double tnear,
+int dwvg_intersect_mesh(const dwvg_world *world, uint32_t mesh, dwvu_vec3 o, dwvu_vec3 d, double tnear,
                         double tfar, dwvg_hit *hit)
 {
     if (world->polytopes[mesh].plane_count) return polytope_intersect(world, mesh, o, d, tnear, tfar, hit);
@@ -484,7 +484,7 @@ static void leaving_filter(const struct RTCFilterFunctionNArguments *args)
 
 /* The loop that dwvg_intersect_mesh_leaving stands for: one ray after another, each from just
  * past the last hit on `prim`. */
-static int leaving_by_rays(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, uint32_t prim, double tfar,
+static int leaving_by_rays(const dwvg_world *world, uint32_t mesh, dwvu_vec3 o, dwvu_vec3 d, uint32_t prim, double tfar,
                            dwvg_hit *hit, uint32_t *rays)
 {
     double tnear = 0.0;
@@ -496,7 +496,7 @@ static int leaving_by_rays(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, 
     }
 }
 
-int dwvg_intersect_mesh_leaving(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, uint32_t prim,
+int dwvg_intersect_mesh_leaving(const dwvg_world *world, uint32_t mesh, dwvu_vec3 o, dwvu_vec3 d, uint32_t prim,
                                 double tfar, dwvg_hit *hit, uint32_t *rays)
 {
     /* A polytope's exit is never the plane o starts on, which the ray leaves downward. */
@@ -527,7 +527,7 @@ int dwvg_intersect_mesh_leaving(const dwvg_world *world, uint32_t mesh, dwvw_vec
     return 1;
 }
 
-int dwvg_occluded(const dwvg_world *world, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar)
+int dwvg_occluded(const dwvg_world *world, dwvu_vec3 o, dwvu_vec3 d, double tnear, double tfar)
 {
     if (world->mesh_count == 0 || !(tfar > tnear)) return 0;
     struct RTCIntersectContext context;
@@ -540,7 +540,7 @@ int dwvg_occluded(const dwvg_world *world, dwvw_vec3 o, dwvw_vec3 d, double tnea
 
 typedef struct closest_query {
     const dwvg_mesh *mesh;
-    dwvw_vec3 p;
+    dwvu_vec3 p;
     dwvg_hit best;
     int found;
     double degenerate; /* the distance to the nearest zero-area triangle seen */
@@ -550,7 +550,7 @@ static bool closest_callback(struct RTCPointQueryFunctionArguments *args)
 {
     closest_query *q = args->userPtr;
     uint32_t prim = args->primID;
-    dwvw_vec3 a, b, c;
+    dwvu_vec3 a, b, c;
     corners(q->mesh, prim, &a, &b, &c);
     if (!(dwvg_triangle_area(q->mesh, prim) > 0.0)) {
         q->degenerate = fmin(q->degenerate, dwvg_triangle_distance(q->p, a, b, c));
@@ -558,8 +558,8 @@ static bool closest_callback(struct RTCPointQueryFunctionArguments *args)
     }
     double u, v;
     dwvg_closest_on_triangle(q->p, a, b, c, &u, &v);
-    dwvw_vec3 x = dwvg_point(q->mesh, prim, u, v);
-    double distance = dwvw_length(dwvw_sub(x, q->p));
+    dwvu_vec3 x = dwvg_point(q->mesh, prim, u, v);
+    double distance = dwvu_length(dwvu_sub(x, q->p));
     if (!(distance < args->query->radius) && q->found) return false;
     q->best.prim = prim;
     q->best.u = u;
@@ -570,7 +570,7 @@ static bool closest_callback(struct RTCPointQueryFunctionArguments *args)
     return true;
 }
 
-int dwvg_closest_mesh_clearance(const dwvg_world *world, uint32_t mesh, dwvw_vec3 p, dwvg_hit *hit, double *clearance)
+int dwvg_closest_mesh_clearance(const dwvg_world *world, uint32_t mesh, dwvu_vec3 p, dwvg_hit *hit, double *clearance)
 {
     *clearance = 0.0;
     struct RTCPointQuery query;
@@ -591,7 +591,7 @@ int dwvg_closest_mesh_clearance(const dwvg_world *world, uint32_t mesh, dwvw_vec
     return 1;
 }
 
-int dwvg_closest_mesh(const dwvg_world *world, uint32_t mesh, dwvw_vec3 p, dwvg_hit *hit)
+int dwvg_closest_mesh(const dwvg_world *world, uint32_t mesh, dwvu_vec3 p, dwvg_hit *hit)
 {
     double clearance;
     return dwvg_closest_mesh_clearance(world, mesh, p, hit, &clearance);

@@ -12,7 +12,7 @@
 
 #include "clearance.h"
 #include "mesh.h"
-#include "walk/vec3.h"
+#include "util/vec3.h"
 
 /* A closed convex mesh of few planes without vertex normals (a box), whose walk rays are traced
  * as exits from the intersection of its planes' half-spaces (dwvg_intersect_mesh). */
@@ -61,9 +61,9 @@ void dwvg_world_free(dwvg_world *world);
 
 /* The first surface along unit d from o within (tnear, tfar): 1 and *hit, or 0. A world that is
  * one polytope (dwvg_polytope) is met by its planes, as dwvg_intersect_mesh's walk rays are. */
-int dwvg_intersect(const dwvg_world *world, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar, dwvg_hit *hit);
+int dwvg_intersect(const dwvg_world *world, dwvu_vec3 o, dwvu_vec3 d, double tnear, double tfar, dwvg_hit *hit);
 /* Whether anything blocks the segment (tnear, tfar) along d from o. */
-int dwvg_occluded(const dwvg_world *world, dwvw_vec3 o, dwvw_vec3 d, double tnear, double tfar);
+int dwvg_occluded(const dwvg_world *world, dwvu_vec3 o, dwvu_vec3 d, double tnear, double tfar);
 /* As dwvg_intersect, against one mesh only. A polytope (dwvg_polytope) is intersected by its
  * planes in double precision instead: from a point o inside, the ray leaves through the plane of
  * least t_i = (d_i - n_i.o) / (n_i.d) over those it rises along (n_i.d > 0), held at 0 or more
@@ -71,7 +71,7 @@ int dwvg_occluded(const dwvg_world *world, dwvw_vec3 o, dwvw_vec3 d, double tnea
  * that plane whose barycentrics there are least negative. That is the exit Embree finds, to
  * float rounding (Embree's t is a float; these are exact to double rounding), and no ray is
  * traced: about a tenth of the instructions on a box. */
-int dwvg_intersect_mesh(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, double tnear,
+int dwvg_intersect_mesh(const dwvg_world *world, uint32_t mesh, dwvu_vec3 o, dwvu_vec3 d, double tnear,
                         double tfar, dwvg_hit *hit);
 /* Whether every edge of the mesh's triangles is shared, by vertex index, with exactly one other
  * triangle that runs it the other way, and every triangle has area: a closed, consistently
@@ -88,14 +88,14 @@ int dwvg_mesh_closed(const dwvg_mesh *mesh);
  * hits at the same distances) or before it (the loop's first ray returns it), and at equal
  * distances, where the loop's answer depends on Embree's order of traversal, the loop itself is
  * run. Adds the rays cast to *rays. */
-int dwvg_intersect_mesh_leaving(const dwvg_world *world, uint32_t mesh, dwvw_vec3 o, dwvw_vec3 d, uint32_t prim,
+int dwvg_intersect_mesh_leaving(const dwvg_world *world, uint32_t mesh, dwvu_vec3 o, dwvu_vec3 d, uint32_t prim,
                                 double tfar, dwvg_hit *hit, uint32_t *rays);
 /* The point of `mesh` closest to p (rtcPointQuery with our own point-triangle distance): 1 and
  * *hit (t = the distance), or 0 if the mesh has no valid triangle. */
-int dwvg_closest_mesh(const dwvg_world *world, uint32_t mesh, dwvw_vec3 p, dwvg_hit *hit);
+int dwvg_closest_mesh(const dwvg_world *world, uint32_t mesh, dwvu_vec3 p, dwvg_hit *hit);
 /* The same, with the distance from p to the nearest triangle a ray could hit (zero-area ones
  * included) in *clearance (0 if none found). */
-int dwvg_closest_mesh_clearance(const dwvg_world *world, uint32_t mesh, dwvw_vec3 p, dwvg_hit *hit, double *clearance);
+int dwvg_closest_mesh_clearance(const dwvg_world *world, uint32_t mesh, dwvu_vec3 p, dwvg_hit *hit, double *clearance);
 /* Builds the clearance grid of one mesh (clearance.h, dwvg_clearance_build) with cells of at least
  * `cell_size` and at most `largest_cell`: for the meshes whose walks may take ray-free steps. 0 on
  * success or where no grid is made (its lookups then give 0), -1 out of memory. */
@@ -109,7 +109,7 @@ int dwvg_world_build_clearance(dwvg_world *world, uint32_t mesh, double cell_siz
  * 64 ulps) or the ball's (|center| + clearance). The margin is the sum of 2^-17 of each. 0 when
  * nothing is left. A segment with both ends inside the ball (convex) meets no surface of the
  * mesh: a ray along it is skipped. */
-static inline double dwvg_clear_radius(const dwvg_world *world, dwvw_vec3 center, double clearance)
+static inline double dwvg_clear_radius(const dwvg_world *world, dwvu_vec3 center, double clearance)
 {
     /* Inline (a walk asks at most steps): the largest |coordinate| by comparisons, which equal
      * fmax's for numbers; a NaN anywhere gives 0. */
@@ -135,11 +135,11 @@ static inline double dwvg_world_top(const dwvg_world *world, uint32_t mesh, uint
 
 /* The unit outward geometric normal of a triangle, (v1 - v0) x (v2 - v0) normalised (zero for a
  * degenerate one). */
-dwvw_vec3 dwvg_geometric_normal(const dwvg_mesh *mesh, uint32_t prim);
+dwvu_vec3 dwvg_geometric_normal(const dwvg_mesh *mesh, uint32_t prim);
 /* The interpolated vertex normal at barycentrics (u, v), turned to the side of `geometric`; the
  * geometric normal where the mesh has none or they cancel. */
-dwvw_vec3 dwvg_shading_normal(const dwvg_mesh *mesh, uint32_t prim, double u, double v, dwvw_vec3 geometric);
-dwvw_vec3 dwvg_point(const dwvg_mesh *mesh, uint32_t prim, double u, double v);
+dwvu_vec3 dwvg_shading_normal(const dwvg_mesh *mesh, uint32_t prim, double u, double v, dwvu_vec3 geometric);
+dwvu_vec3 dwvg_point(const dwvg_mesh *mesh, uint32_t prim, double u, double v);
 /* A triangle's area (0 for degenerate or non-finite ones). */
 double dwvg_triangle_area(const dwvg_mesh *mesh, uint32_t prim);
 

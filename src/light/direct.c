@@ -1,5 +1,7 @@
 #include "direct.h"
 
+#include "kernel/direction.h"
+
 #include <math.h>
 
 
@@ -9,7 +11,7 @@
  * smooth surface's lift (terminator.h), which is computed once, for the first ray that takes some. */
 typedef struct shadow_origins {
     const dwvl_terminator *terminator; /* NULL: a flat-shaded point */
-    dwvw_vec3 n, ng, flat, lift;
+    dwvu_vec3 n, ng, flat, lift;
     int have_lift;
     double clear; /* ng.origin above this, rising along ng: the ray meets nothing (clear_of) */
 } shadow_origins;
@@ -21,19 +23,19 @@ typedef struct shadow_origins {
  * within 2^-24, which lowers it by at most 2^-23 of the world's diameter before it is past the
  * world) with a watertight test that errs by a few ulps. The flat origin is 2^-17 of the largest
  * coordinate above its plane (the epsilon), which is the top of a convex world: it clears. */
-static int clear_of(const shadow_origins *o, dwvw_vec3 origin, dwvw_vec3 d)
+static int clear_of(const shadow_origins *o, dwvu_vec3 origin, dwvu_vec3 d)
 {
-    return dwvw_dot(d, o->ng) > 0.0 && dwvw_dot(origin, o->ng) > o->clear;
+    return dwvu_dot(d, o->ng) > 0.0 && dwvu_dot(origin, o->ng) > o->clear;
 }
 
 /* The share of the lift a shadow ray along unit `light` takes. */
-static double lift_amount(const shadow_origins *o, dwvw_vec3 light)
+static double lift_amount(const shadow_origins *o, dwvu_vec3 light)
 {
     const dwvl_terminator *t = o->terminator;
-    return t ? dwvl_terminator_amount(dwvw_dot(o->n, light), dwvw_dot(o->ng, light), t->cutoff) : 0.0;
+    return t ? dwvl_terminator_amount(dwvu_dot(o->n, light), dwvu_dot(o->ng, light), t->cutoff) : 0.0;
 }
 
-static dwvw_vec3 shadow_origin(shadow_origins *o, double amount)
+static dwvu_vec3 shadow_origin(shadow_origins *o, double amount)
 {
     if (!(amount > 0.0)) return o->flat;
     if (!o->have_lift) {
@@ -41,7 +43,7 @@ static dwvw_vec3 shadow_origin(shadow_origins *o, double amount)
         o->lift = dwvl_terminator_lift_at(t->mesh, t->prim, t->u, t->v, o->ng);
         o->have_lift = 1;
     }
-    return dwvw_madd(o->flat, o->lift, amount);
+    return dwvu_madd(o->flat, o->lift, amount);
 }
 
 /* Whether a light the shading normal faces gets a shadow ray. The lift never goes below the flat
@@ -52,18 +54,18 @@ static dwvw_vec3 shadow_origin(shadow_origins *o, double amount)
  * takes the whole lift (dwvl_terminator_amount is 1 there) and, Cycles not skipping its own
  * triangle then, is shadowed where it passes through that triangle. A flat point (no terminator,
  * or cutoff 0) is unlit there: its ray would enter the mesh at once. */
-static int shadow_ray_allowed(const shadow_origins *o, dwvw_vec3 light)
+static int shadow_ray_allowed(const shadow_origins *o, dwvu_vec3 light)
 {
-    return dwvw_dot(o->ng, light) > 0.0 || (o->terminator && o->terminator->cutoff > 0.0);
+    return dwvu_dot(o->ng, light) > 0.0 || (o->terminator && o->terminator->cutoff > 0.0);
 }
 
-void dwvl_direct_lobe(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng,
+void dwvl_direct_lobe(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, dwvu_vec3 ng,
                       const dwvl_terminator *terminator, double top, const dwvk_sampler *sampler, uint32_t pair,
                       dwvl_lobe_factor factor, const void *context, double lambert[3], double lobe[3])
 {
     double plain[3] = {0.0, 0.0, 0.0}, weighted[3] = {0.0, 0.0, 0.0};
     double eps = env->geometry ? env->geometry->epsilon : 0.0;
-    shadow_origins origins = {terminator, n, ng, dwvw_madd(x, ng, eps), dwvw_v(0.0, 0.0, 0.0), 0, INFINITY};
+    shadow_origins origins = {terminator, n, ng, dwvu_madd(x, ng, eps), dwvu_v(0.0, 0.0, 0.0), 0, INFINITY};
     if (top < INFINITY) {
         /* eps is 2^-17 of the largest coordinate: the margin is 2^-19 of it and of the origin's. */
         double coordinate = fmax(fabs(x.x), fmax(fabs(x.y), fabs(x.z))) + eps;
@@ -77,20 +79,20 @@ void dwvl_direct_lobe(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwv
         double u[2];
         dwvk_sampler_pair(sampler, pair + i, u);
         dwvl_light_sample(&env->lights[i], x, u[0], u[1], &s);
-        double cos_n = dwvw_dot(n, s.direction);
+        double cos_n = dwvu_dot(n, s.direction);
         if (!(cos_n > 0.0)) continue;
         if (!shadow_ray_allowed(&origins, s.direction)) continue;
         if (!(s.value[0] > 0.0 || s.value[1] > 0.0 || s.value[2] > 0.0)) continue;
         if (env->geometry) {
             double amount = lift_amount(&origins, s.direction);
-            dwvw_vec3 origin = shadow_origin(&origins, amount);
-            dwvw_vec3 toward = s.direction;
+            dwvu_vec3 origin = shadow_origin(&origins, amount);
+            dwvu_vec3 toward = s.direction;
             double distance = s.distance;
             if (amount > 0.0 && isfinite(distance)) {
                 /* The sampled light point, seen from the moved origin (as Cycles aims it). */
-                dwvw_vec3 to_light = dwvw_sub(dwvw_madd(x, s.direction, s.distance), origin);
-                distance = dwvw_length(to_light);
-                toward = dwvw_scale(to_light, 1.0 / distance);
+                dwvu_vec3 to_light = dwvu_sub(dwvu_madd(x, s.direction, s.distance), origin);
+                distance = dwvu_length(to_light);
+                toward = dwvu_scale(to_light, 1.0 / distance);
             }
             /* The segment stops short of the light by the offset, so that an area light lying on
              * a surface does not shadow itself. */
@@ -109,10 +111,10 @@ void dwvl_direct_lobe(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwv
         double u[2];
         dwvk_sampler_pair(sampler, pair + env->light_count, u);
         double mu = sqrt(u[0]);
-        dwvw_vec3 w = dwvw_direction_about(n, mu, 1.0 - mu, 1.0 + mu, u[1]);
+        dwvu_vec3 w = dwvk_direction_about(n, mu, 1.0 - mu, 1.0 + mu, u[1]);
         int blocked = !shadow_ray_allowed(&origins, w);
         if (!blocked && env->geometry) {
-            dwvw_vec3 origin = shadow_origin(&origins, lift_amount(&origins, w));
+            dwvu_vec3 origin = shadow_origin(&origins, lift_amount(&origins, w));
             blocked = !clear_of(&origins, origin, w) && dwvg_occluded(env->geometry, origin, w, 0.0, INFINITY);
         }
         if (!blocked) {
@@ -129,7 +131,7 @@ void dwvl_direct_lobe(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwv
     }
 }
 
-void dwvl_direct(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng,
+void dwvl_direct(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, dwvu_vec3 ng,
                  const dwvl_terminator *terminator, double top, const dwvk_sampler *sampler, uint32_t pair, double out[3])
 {
     dwvl_direct_lobe(env, x, n, ng, terminator, top, sampler, pair, NULL, NULL, out, NULL);

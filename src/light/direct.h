@@ -35,17 +35,17 @@ static inline uint32_t dwvl_direct_pairs(const dwvl_environment *env)
  * finite distance is then aimed at from the moved origin. With a terminator whose cutoff is
  * above 0, light that n faces but the flat triangle does not (ng.light <= 0) is also tested, from
  * the smooth surface, as Cycles does; without one it is taken as shadowed. */
-void dwvl_direct(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng,
+void dwvl_direct(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, dwvu_vec3 ng,
                  const dwvl_terminator *terminator, double top, const dwvk_sampler *sampler, uint32_t pair, double out[3]);
 
 /* A BRDF's factor beside the Lambertian 1/pi for light arriving along unit `light` (toward the
  * light): the BRDF is (1/pi) factor(context, light). */
-typedef double (*dwvl_lobe_factor)(const void *context, dwvw_vec3 light);
+typedef double (*dwvl_lobe_factor)(const void *context, dwvu_vec3 light);
 
 /* dwvl_direct with the same light samples (the same pairs of `sampler`) also weighted by
  * `factor`: lambert gets what dwvl_direct gives (NULL: not wanted), lobe the same integral with
  * (1/pi) factor(light) cos as the BRDF term. */
-void dwvl_direct_lobe(const dwvl_environment *env, dwvw_vec3 x, dwvw_vec3 n, dwvw_vec3 ng,
+void dwvl_direct_lobe(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, dwvu_vec3 ng,
                       const dwvl_terminator *terminator, double top, const dwvk_sampler *sampler, uint32_t pair,
                       dwvl_lobe_factor factor, const void *context, double lambert[3], double lobe[3]);
 

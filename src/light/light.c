@@ -1,18 +1,20 @@
 #include "light.h"
 
+#include "kernel/direction.h"
+
 #include <math.h>
 
 #define PI 3.14159265358979323846
 #define INV_FOUR_PI 0.07957747154594766788
 
 /* An orthonormal basis (t, s) about unit n (Duff et al. 2017). */
-static void basis(dwvw_vec3 n, dwvw_vec3 *t, dwvw_vec3 *s)
+static void basis(dwvu_vec3 n, dwvu_vec3 *t, dwvu_vec3 *s)
 {
     double sign = copysign(1.0, n.z);
     double a = -1.0 / (sign + n.z);
     double b = n.x * n.y * a;
-    *t = dwvw_v(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
-    *s = dwvw_v(b, sign + n.y * n.y * a, -n.y);
+    *t = dwvu_v(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+    *s = dwvu_v(b, sign + n.y * n.y * a, -n.y);
 }
 
 void dwvl_light_init(dwvl_light *light, const dwv_light_desc_t *desc)
@@ -23,12 +25,12 @@ void dwvl_light_init(dwvl_light *light, const dwv_light_desc_t *desc)
     light->area = 0.0;
     light->one_minus_cos_half = 0.0;
     light->chord = 0.0;
-    light->position = light->direction = light->axis_x = light->axis_y = dwvw_v(0.0, 0.0, 0.0);
+    light->position = light->direction = light->axis_x = light->axis_y = dwvu_v(0.0, 0.0, 0.0);
     for (int c = 0; c < 3; ++c) light->emission[c] = desc->color[c] * desc->strength;
     switch (desc->kind) {
     case DWV_LIGHT_SUN: {
-        dwvw_vec3 d = dwvw_v(desc->direction[0], desc->direction[1], desc->direction[2]);
-        light->direction = dwvw_scale(d, -1.0 / dwvw_length(d));
+        dwvu_vec3 d = dwvu_v(desc->direction[0], desc->direction[1], desc->direction[2]);
+        light->direction = dwvu_scale(d, -1.0 / dwvu_length(d));
         double s = sin(0.25 * desc->angle);
         light->one_minus_cos_half = 2.0 * s * s;
         /* |w - direction|^2 = 2 (1 - cos) for a unit w at angle theta <= angle / 2 from it. */
@@ -36,17 +38,17 @@ void dwvl_light_init(dwvl_light *light, const dwv_light_desc_t *desc)
         break;
     }
     case DWV_LIGHT_POINT:
-        light->position = dwvw_v(desc->position[0], desc->position[1], desc->position[2]);
+        light->position = dwvu_v(desc->position[0], desc->position[1], desc->position[2]);
         light->radius = desc->radius;
         for (int c = 0; c < 3; ++c) light->emission[c] *= INV_FOUR_PI;
         break;
     default: {
-        light->position = dwvw_v(m[3], m[7], m[11]);
-        light->axis_x = dwvw_scale(dwvw_v(m[0], m[4], m[8]), desc->size_x);
-        light->axis_y = dwvw_scale(dwvw_v(m[1], m[5], m[9]), desc->size_y);
-        light->direction = dwvw_normalize(dwvw_v(-m[2], -m[6], -m[10]));
-        dwvw_vec3 ax = light->axis_x, ay = light->axis_y;
-        double parallelogram = dwvw_length(dwvw_v(ax.y * ay.z - ax.z * ay.y, ax.z * ay.x - ax.x * ay.z,
+        light->position = dwvu_v(m[3], m[7], m[11]);
+        light->axis_x = dwvu_scale(dwvu_v(m[0], m[4], m[8]), desc->size_x);
+        light->axis_y = dwvu_scale(dwvu_v(m[1], m[5], m[9]), desc->size_y);
+        light->direction = dwvu_normalize(dwvu_v(-m[2], -m[6], -m[10]));
+        dwvu_vec3 ax = light->axis_x, ay = light->axis_y;
+        double parallelogram = dwvu_length(dwvu_v(ax.y * ay.z - ax.z * ay.y, ax.z * ay.x - ax.x * ay.z,
                                                   ax.x * ay.y - ax.y * ay.x));
         light->area = desc->kind == DWV_LIGHT_AREA_RECTANGLE ? parallelogram : 0.25 * PI * parallelogram;
         for (int c = 0; c < 3; ++c) light->emission[c] *= 0.25 / light->area;
@@ -55,7 +57,7 @@ void dwvl_light_init(dwvl_light *light, const dwv_light_desc_t *desc)
     }
 }
 
-void dwvl_light_sample(const dwvl_light *light, dwvw_vec3 x, double u1, double u2, dwvl_sample *sample)
+void dwvl_light_sample(const dwvl_light *light, dwvu_vec3 x, double u1, double u2, dwvl_sample *sample)
 {
     double factor = 0.0;
     switch (light->kind) {
@@ -63,7 +65,7 @@ void dwvl_light_sample(const dwvl_light *light, dwvw_vec3 x, double u1, double u
         /* Uniform in the cone: 1 - cos(theta) = u1 (1 - cos(half)); pdf 1 / (2 pi (1 - cos(half))).
          * radiance / pdf = S 2 pi (1 - cos h) / (pi sin^2 h) = 2 S / (1 + cos h). */
         double omc = u1 * light->one_minus_cos_half;
-        sample->direction = dwvw_direction_about(light->direction, 1.0 - omc, omc, 2.0 - omc, u2);
+        sample->direction = dwvk_direction_about(light->direction, 1.0 - omc, omc, 2.0 - omc, u2);
         sample->distance = INFINITY;
         factor = 2.0 / (2.0 - light->one_minus_cos_half);
         break;
@@ -71,22 +73,22 @@ void dwvl_light_sample(const dwvl_light *light, dwvw_vec3 x, double u1, double u
     case DWV_LIGHT_POINT: {
         /* A disc of radius r about the centre, facing x, radiance I / (pi r^2): a uniform point q
          * on it gives radiance / pdf = I cos_q / |q - x|^2 (r = 0: the point light I / d^2). */
-        dwvw_vec3 to_centre = dwvw_sub(light->position, x);
-        double d = dwvw_length(to_centre);
+        dwvu_vec3 to_centre = dwvu_sub(light->position, x);
+        double d = dwvu_length(to_centre);
         if (!(d > 0.0)) break;
-        dwvw_vec3 axis = dwvw_scale(to_centre, 1.0 / d), t, s;
-        dwvw_vec3 q = light->position;
+        dwvu_vec3 axis = dwvu_scale(to_centre, 1.0 / d), t, s;
+        dwvu_vec3 q = light->position;
         if (light->radius > 0.0) {
             basis(axis, &t, &s);
             double r = light->radius * sqrt(u1), phi = 2.0 * PI * u2;
-            q = dwvw_add(q, dwvw_add(dwvw_scale(t, r * cos(phi)), dwvw_scale(s, r * sin(phi))));
+            q = dwvu_add(q, dwvu_add(dwvu_scale(t, r * cos(phi)), dwvu_scale(s, r * sin(phi))));
         }
-        dwvw_vec3 to_q = dwvw_sub(q, x);
-        double dq = dwvw_length(to_q);
+        dwvu_vec3 to_q = dwvu_sub(q, x);
+        double dq = dwvu_length(to_q);
         if (!(dq > 0.0)) break;
-        sample->direction = dwvw_scale(to_q, 1.0 / dq);
+        sample->direction = dwvu_scale(to_q, 1.0 / dq);
         sample->distance = dq;
-        factor = dwvw_dot(sample->direction, axis) / (dq * dq);
+        factor = dwvu_dot(sample->direction, axis) / (dq * dq);
         break;
     }
     default: {
@@ -101,19 +103,19 @@ void dwvl_light_sample(const dwvl_light *light, dwvw_vec3 x, double u1, double u
             a = r * cos(phi);
             b = r * sin(phi);
         }
-        dwvw_vec3 q = dwvw_add(light->position, dwvw_add(dwvw_scale(light->axis_x, a), dwvw_scale(light->axis_y, b)));
-        dwvw_vec3 to_q = dwvw_sub(q, x);
-        double dq = dwvw_length(to_q);
+        dwvu_vec3 q = dwvu_add(light->position, dwvu_add(dwvu_scale(light->axis_x, a), dwvu_scale(light->axis_y, b)));
+        dwvu_vec3 to_q = dwvu_sub(q, x);
+        double dq = dwvu_length(to_q);
         if (!(dq > 0.0)) break;
-        sample->direction = dwvw_scale(to_q, 1.0 / dq);
+        sample->direction = dwvu_scale(to_q, 1.0 / dq);
         sample->distance = dq;
-        double cos_q = -dwvw_dot(light->direction, sample->direction);
+        double cos_q = -dwvu_dot(light->direction, sample->direction);
         if (cos_q > 0.0) factor = light->area * cos_q / (dq * dq);
         break;
     }
     }
     if (!(factor > 0.0) || !isfinite(factor)) {
-        sample->direction = dwvw_v(0.0, 0.0, 1.0);
+        sample->direction = dwvu_v(0.0, 0.0, 1.0);
         sample->distance = 0.0;
         factor = 0.0;
     }

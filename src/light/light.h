@@ -14,24 +14,24 @@
 #ifndef DWV_LIGHT_LIGHT_H
 #define DWV_LIGHT_LIGHT_H
 
-#include "dwivedi.h"
-#include "walk/vec3.h"
+#include <dwivedi.h>
+#include "util/vec3.h"
 
 typedef struct dwvl_light {
     dwv_light_kind_t kind;
     double emission[3];        /* sun: irradiance S c; point: intensity P c / (4 pi); area: radiance */
-    dwvw_vec3 direction;       /* sun: unit, toward the sun; area: unit emission direction (local -z) */
+    dwvu_vec3 direction;       /* sun: unit, toward the sun; area: unit emission direction (local -z) */
     double one_minus_cos_half; /* sun: 1 - cos(angle / 2), from 2 sin^2(angle / 4) */
     double chord;              /* sun: sqrt(2 (1 - cos(angle / 2))), the farthest any direction of
                                   the disc is from `direction` (dwvl_light_below) */
-    dwvw_vec3 position;        /* point: centre; area: centre */
+    dwvu_vec3 position;        /* point: centre; area: centre */
     double radius;             /* point */
-    dwvw_vec3 axis_x, axis_y;  /* area: full extents in the world (size x the transform's axes) */
+    dwvu_vec3 axis_x, axis_y;  /* area: full extents in the world (size x the transform's axes) */
     double area;               /* area: of the rectangle or ellipse */
 } dwvl_light;
 
 typedef struct dwvl_sample {
-    dwvw_vec3 direction; /* unit, from the shaded point toward the light */
+    dwvu_vec3 direction; /* unit, from the shaded point toward the light */
     double distance;     /* to the sampled light point; +INFINITY for the sun */
     double value[3];     /* radiance / solid-angle pdf; all 0 when the light cannot reach */
 } dwvl_sample;
@@ -42,12 +42,12 @@ void dwvl_light_init(dwvl_light *light, const dwv_light_desc_t *desc);
  * normal n (n.direction < 0 for all of them), known without sampling: a sun whose disc lies
  * below, by a margin of 1e-9 for the rounding of a sampled direction (about 1e-16); 0 for the
  * other lights. Such a light gives a surface facing n nothing. */
-static inline int dwvl_light_below(const dwvl_light *light, dwvw_vec3 n)
+static inline int dwvl_light_below(const dwvl_light *light, dwvu_vec3 n)
 {
-    return light->kind == DWV_LIGHT_SUN && dwvw_dot(n, light->direction) + light->chord < -1e-9;
+    return light->kind == DWV_LIGHT_SUN && dwvu_dot(n, light->direction) + light->chord < -1e-9;
 }
 
 /* Samples the light as seen from x with two uniform numbers. */
-void dwvl_light_sample(const dwvl_light *light, dwvw_vec3 x, double u1, double u2, dwvl_sample *sample);
+void dwvl_light_sample(const dwvl_light *light, dwvu_vec3 x, double u1, double u2, dwvl_sample *sample);
 
 #endif

@@ -18,7 +18,7 @@
 #include <stdint.h>
 
 #include "geom/mesh.h"
-#include "walk/vec3.h"
+#include "util/vec3.h"
 
 /* Where a shading point's shadow rays find their lift (dwvl_terminator_lift_at, computed only for
  * the rays that take some of it: most points are far from the terminator) and the cutoff. */
@@ -41,12 +41,12 @@ typedef struct dwvl_terminator {
  * h >= 0, and the lift is h sum_i b_i N_i (the interpolated normal, not normalised, as Cycles with
  * the object transform applied). A flat triangle (equal normals) has h = 0; every corner's lift
  * is 0. Returns zero when a vertex normal is zero (no smooth normal there). */
-dwvw_vec3 dwvl_terminator_lift(const dwvw_vec3 v[3], const dwvw_vec3 n[3], const double b[3], dwvw_vec3 ng);
+dwvu_vec3 dwvl_terminator_lift(const dwvu_vec3 v[3], const dwvu_vec3 n[3], const double b[3], dwvu_vec3 ng);
 
 /* dwvl_terminator_lift at the point (u, v) of triangle `prim` (Embree's barycentrics: weights
  * 1 - u - v, u, v on the triangle's corners in stored order), from the mesh's positions and
  * vertex normals; `ng` as above. Zero for a mesh without vertex normals (flat shading). */
-dwvw_vec3 dwvl_terminator_lift_at(const dwvg_mesh *mesh, uint32_t prim, double u, double v, dwvw_vec3 ng);
+dwvu_vec3 dwvl_terminator_lift_at(const dwvg_mesh *mesh, uint32_t prim, double u, double v, dwvu_vec3 ng);
 
 /* The share of the lift a shadow ray toward unit direction L takes, with cos_n = N.L >= 0 (the
  * shading normal) and cos_g = Ng.L (the geometric normal on the same side), after Cycles:

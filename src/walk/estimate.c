@@ -1,13 +1,12 @@
-#define _POSIX_C_SOURCE 200809L
 #include "estimate.h"
 
-#include <pthread.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "kernel/rng.h"
+#include "util/clock.h"
+#include "util/parallel.h"
 
 #define MAX_BLOCKS 65536u
 #define MAX_THREADS 256u
@@ -24,12 +23,12 @@ int dwvw_estimate_light_patches(const dwvw_shape *shape, int light, dwvw_light_p
              * lower variance (0.0077 against 0.0109 back-lit, radius 4, albedo 0.99) at a fraction
              * of the cost per event, which grows with every patch. */
             double R = shape->radius;
-            dwvw_light_patch p = {.point = dwvw_v(0.0, 0.0, R + R * toward_light),
-                                  .normal = dwvw_v(0.0, 0.0, toward_light), .power = 1.0, .is_plane = 0};
+            dwvw_light_patch p = {.point = dwvu_v(0.0, 0.0, R + R * toward_light),
+                                  .normal = dwvu_v(0.0, 0.0, toward_light), .power = 1.0, .is_plane = 0};
             patches[count++] = p;
         } else if (side == 0 || shape->kind == DWVW_SLAB) {
             double z = side == 0 ? 0.0 : shape->thickness;
-            dwvw_light_patch p = {.point = dwvw_v(0.0, 0.0, z), .normal = dwvw_v(0.0, 0.0, toward_light), .power = 1.0,
+            dwvw_light_patch p = {.point = dwvu_v(0.0, 0.0, z), .normal = dwvu_v(0.0, 0.0, toward_light), .power = 1.0,
                                   .is_plane = 1};
             patches[count++] = p;
         }
@@ -37,7 +36,7 @@ int dwvw_estimate_light_patches(const dwvw_shape *shape, int light, dwvw_light_p
     return count;
 }
 
-static double exit_score(const dwvw_estimate_setup *setup, dwvw_vec3 n)
+static double exit_score(const dwvw_estimate_setup *setup, dwvu_vec3 n)
 {
     double score = 0.0;
     if (setup->shape.kind == DWVW_SPHERE) {
@@ -56,18 +55,18 @@ typedef struct block_totals {
     uint64_t events, truncated_walks, walks;
 } block_totals;
 
-static const dwvw_vec3 ENTRY_POINT = {0.0, 0.0, 0.0}, ENTRY_NORMAL = {0.0, 0.0, -1.0}; /* outward */
+static const dwvu_vec3 ENTRY_POINT = {0.0, 0.0, 0.0}, ENTRY_NORMAL = {0.0, 0.0, -1.0}; /* outward */
 
 /* The entry direction of a walk: dimensions 0 and 1 of its key. */
-static dwvw_vec3 entry_direction(const dwvw_estimate_setup *setup, uint64_t key)
+static dwvu_vec3 entry_direction(const dwvw_estimate_setup *setup, uint64_t key)
 {
     if (setup->incidence_diffuse) {
         /* Cosine-weighted: mu = sqrt(u). */
         double u = dwvk_rng_uniform_d(key, 0), mu = sqrt(u);
-        return dwvw_direction_about(dwvw_v(0.0, 0.0, 1.0), mu, 1.0 - mu, 1.0 + mu, dwvk_rng_uniform_d(key, 1));
+        return dwvk_direction_about(dwvu_v(0.0, 0.0, 1.0), mu, 1.0 - mu, 1.0 + mu, dwvk_rng_uniform_d(key, 1));
     }
     double mu = setup->incidence_cosine;
-    return dwvw_v(sqrt((1.0 - mu) * (1.0 + mu)), 0.0, mu);
+    return dwvu_v(sqrt((1.0 - mu) * (1.0 + mu)), 0.0, mu);
 }
 
 static void general_walk(const dwvw_estimate_setup *setup, uint64_t key, dwvw_walk_end *end)
@@ -78,12 +77,12 @@ static void general_walk(const dwvw_estimate_setup *setup, uint64_t key, dwvw_wa
     int needs_closest = dwvw_guide_needs_closest(&setup->guide);
     while (walk.status == DWVW_RUNNING) {
         if (needs_closest) {
-            dwvw_vec3 n;
+            dwvu_vec3 n;
             dwvw_shape_closest(&setup->shape, walk.position, &n);
             dwvw_walk_set_closest(&walk, n);
         }
         dwvw_walk_sample(&walk);
-        dwvw_vec3 hit_normal;
+        dwvu_vec3 hit_normal;
         double hit = dwvw_shape_exit(&setup->shape, walk.position, walk.direction, &hit_normal);
         dwvw_walk_complete(&walk, hit, hit_normal);
     }
@@ -118,8 +117,8 @@ static void general_walk(const dwvw_estimate_setup *setup, uint64_t key, dwvw_wa
 /* What a run's fast path needs, worked out once per run. */
 typedef struct fast_plan {
     dwvw_walker walker;
-    dwvw_vec3 axis;          /* guided: the fixed axis */
-    dwvw_frame turned[4];    /* its frame and the frame's quarter turns */
+    dwvu_vec3 axis;          /* guided: the fixed axis */
+    dwvu_frame turned[4];    /* its frame and the frame's quarter turns */
     /* Where the turned frames are signed permutations (an axis along x, y or z: every axis of the
      * analytic shapes), component i of a direction is sign[q][i] x (c, d, mu)[index[q][i]], and
      * the cosine to the axis is axis_sign x direction[axis_index]: the same values as the full
@@ -137,12 +136,12 @@ typedef struct fast_plan {
     int lanes;               /* guided and aligned: runs in lock-step lanes (lanes_run) */
 } fast_plan;
 
-static void add_flight(dwvw_vec3 *position, dwvw_vec3 direction, double t)
+static void add_flight(dwvu_vec3 *position, dwvu_vec3 direction, double t)
 {
-    *position = dwvw_madd(*position, direction, t);
+    *position = dwvu_madd(*position, direction, t);
 }
 
-static double component(dwvw_vec3 v, int i)
+static double component(dwvu_vec3 v, int i)
 {
     return i == 0 ? v.x : i == 1 ? v.y : v.z;
 }
@@ -152,7 +151,7 @@ static void plan_alignment(fast_plan *plan)
 {
     plan->aligned = 0;
     for (int q = 0; q < 4; ++q) {
-        const dwvw_frame *f = &plan->turned[q];
+        const dwvu_frame *f = &plan->turned[q];
         for (int i = 0; i < 3; ++i) {
             double parts[3] = {component(f->t, i), component(f->s, i), component(f->n, i)};
             int nonzero = 0;
@@ -178,9 +177,9 @@ static void plan_alignment(fast_plan *plan)
     plan->aligned = nonzero == 1;
 }
 
-/* dwvw_guided_direction_turned for an aligned plan: the same values (dwvw_frame_direction's
+/* dwvw_guided_direction_turned for an aligned plan: the same values (dwvk_frame_direction's
  * products with the frame's zeros and ones left out). */
-static inline dwvw_vec3 aligned_guided_direction(const fast_plan *plan, const dwvk_dwivedi_event_f *d,
+static inline dwvu_vec3 aligned_guided_direction(const fast_plan *plan, const dwvk_dwivedi_event_f *d,
                                                  dwvk_uniform_pair_f u)
 {
     dwvk_dwivedi_event_cosine_f s = dwvk_dwivedi_event_sample_f(d, u.a);
@@ -188,13 +187,13 @@ static inline dwvw_vec3 aligned_guided_direction(const fast_plan *plan, const dw
     dwvk_unit2_f azimuth = dwvk_azimuth_quadrant_f(u.b, &q);
     double sin_theta = s.sin_theta;
     double values[3] = {(double)azimuth.c * sin_theta, (double)azimuth.s * sin_theta, (double)s.cos_theta};
-    dwvw_vec3 w = dwvw_v(plan->sign[q][0] * values[plan->index[q][0]], plan->sign[q][1] * values[plan->index[q][1]],
+    dwvu_vec3 w = dwvu_v(plan->sign[q][0] * values[plan->index[q][0]], plan->sign[q][1] * values[plan->index[q][1]],
                          plan->sign[q][2] * values[plan->index[q][2]]);
-    return dwvw_scale(w, 1.5 - 0.5 * dwvw_dot(w, w));
+    return dwvu_scale(w, 1.5 - 0.5 * dwvu_dot(w, w));
 }
 
 /* dwvw_cosine(direction, plan->axis) for an aligned plan. */
-static inline double aligned_cosine(const fast_plan *plan, dwvw_vec3 direction)
+static inline double aligned_cosine(const fast_plan *plan, dwvu_vec3 direction)
 {
     double mu = plan->axis_sign * component(direction, plan->axis_index);
     return mu < -1.0 ? -1.0 : mu > 1.0 ? 1.0 : mu;
@@ -223,7 +222,7 @@ static inline void classical_walk_in(const dwvw_estimate_setup *setup, dwvw_shap
     const dwvw_medium *m = &setup->medium;
     const double sigma = m->sigma_t[0], albedo = m->albedo[0];
     const float g = (float)m->g;
-    dwvw_vec3 position = ENTRY_POINT, direction = entry_direction(setup, key), normal;
+    dwvu_vec3 position = ENTRY_POINT, direction = entry_direction(setup, key), normal;
     double weight = 1.0;
     uint32_t events = 0;
     for (;;) {
@@ -273,7 +272,7 @@ static void classical_walk(const dwvw_estimate_setup *setup, uint64_t key, dwvw_
 
 /* The guided part of a setup when it is one component about an axis fixed for the whole walk:
  * its weight q (the rest is classical) and axis; 0 if the guided part is anything else. */
-static double fixed_guide(const dwvw_estimate_setup *setup, dwvw_vec3 *axis)
+static double fixed_guide(const dwvw_estimate_setup *setup, dwvu_vec3 *axis)
 {
     const dwvw_guide *guide = &setup->guide;
     int halfspace = setup->shape.kind == DWVW_HALFSPACE;
@@ -306,7 +305,7 @@ static inline void guided_walk_in(const dwvw_estimate_setup *setup, const fast_p
     const dwvw_medium *m = &setup->medium;
     const double sigma = m->sigma_t[0], log_per_event = plan->log_per_event;
     const uint32_t max_events = setup->max_events;
-    dwvw_vec3 position = ENTRY_POINT, direction = entry_direction(setup, key), normal;
+    dwvu_vec3 position = ENTRY_POINT, direction = entry_direction(setup, key), normal;
     uint32_t events = 0;
     /* log weight = log_constants - sigma x exponent, exponent = sum over steps of (1 - s) t. */
     double log_constants = 0.0, exponent = 0.0, log_weight = 0.0, last_factor = 1.0;
@@ -380,7 +379,7 @@ static inline void mixture_walk_in(const dwvw_estimate_setup *setup, const fast_
     const double sigma = m->sigma_t[0], albedo = m->albedo[0];
     const double q0 = setup->guide.q_classical, q1 = plan->q_guided, total = q0 + q1;
     const float g = (float)m->g;
-    dwvw_vec3 position = ENTRY_POINT, direction = entry_direction(setup, key), normal;
+    dwvu_vec3 position = ENTRY_POINT, direction = entry_direction(setup, key), normal;
     double weight = 1.0;
     uint32_t events = 0;
     for (;;) {
@@ -390,7 +389,7 @@ static inline void mixture_walk_in(const dwvw_estimate_setup *setup, const fast_
         double phase = 1.0, pdf_guided = 1.0;
         if (events > 0) {
             dwvk_uniform_pair_f u = dwvk_rng_uniform_pair_f(key, dim + DWVW_DIM_DIRECTION);
-            dwvw_vec3 previous = direction;
+            dwvu_vec3 previous = direction;
             direction = !guided       ? dwvw_classical_direction(previous, g, u)
                         : plan->aligned ? aligned_guided_direction(plan, &m->dwivedi_event, u)
                                         : dwvw_guided_direction_turned(plan->turned, &m->dwivedi_event, u);
@@ -452,7 +451,7 @@ static void mixture_walk(const dwvw_estimate_setup *setup, const fast_plan *plan
 
 dwvw_walker dwvw_estimate_walker(const dwvw_estimate_setup *setup)
 {
-    dwvw_vec3 axis;
+    dwvu_vec3 axis;
     if (setup->general_path || setup->medium.channels != 1) return DWVW_WALKER_GENERAL;
     const dwvw_guide *g = &setup->guide;
     if (g->q_classical == 1.0 && g->q_poe == 0.0 && g->q_closest == 0.0 && g->q_incident == 0.0 && g->q_backward == 0.0)
@@ -471,8 +470,8 @@ static void make_plan(const dwvw_estimate_setup *setup, dwvw_walker walker, fast
     if (walker != DWVW_WALKER_GUIDED && walker != DWVW_WALKER_MIXTURE) return;
     plan->axis = ENTRY_NORMAL;
     plan->q_guided = fixed_guide(setup, &plan->axis);
-    dwvw_frame frame = dwvw_frame_about(plan->axis);
-    for (int q = 0; q < 4; ++q) plan->turned[q] = dwvw_frame_turned(&frame, q);
+    dwvu_frame frame = dwvu_frame_about(plan->axis);
+    for (int q = 0; q < 4; ++q) plan->turned[q] = dwvu_frame_turned(&frame, q);
     plan_alignment(plan);
     plan->log_per_event = log(m->albedo[0] / m->dwivedi.albedo_eff);
     plan->inv_albedo_eff = 1.0 / m->dwivedi.albedo_eff;
@@ -575,7 +574,7 @@ static void lane_begin(guided_lanes *L, int l, const dwvw_estimate_setup *setup,
                        uint64_t index)
 {
     uint64_t key = dwvk_rng_key(setup->seed, index, 0);
-    dwvw_vec3 direction = entry_direction(setup, key);
+    dwvu_vec3 direction = entry_direction(setup, key);
     L->key[l] = key;
     /* The guided walk steps the counter of an event's direction dimension, the mixture that of its
      * first (channel) dimension. */
@@ -679,8 +678,8 @@ static DWVW_ALWAYS_INLINE int lanes_step_in(guided_lanes *L, const dwvw_estimate
         if (kind == DWVW_HALFSPACE) hit = lane_halfspace_exit(pz, wz);
         else if (kind == DWVW_SLAB) hit = lane_slab_exit(thickness, pz, wz);
         else {
-            dwvw_vec3 normal;
-            hit = dwvw_shape_exit_inline(&setup->shape, kind, dwvw_v(px, py, pz), dwvw_v(wx, wy, wz), &normal);
+            dwvu_vec3 normal;
+            hit = dwvw_shape_exit_inline(&setup->shape, kind, dwvu_v(px, py, pz), dwvu_v(wx, wy, wz), &normal);
         }
         int exited = hit <= t;
         double step = exited ? hit : t;
@@ -732,11 +731,11 @@ static int lane_end(guided_lanes *L, int l, const dwvw_estimate_setup *setup, co
 {
     double last_factor = 1.0;
     uint32_t events = L->events[l];
-    end->exit_normal = dwvw_v(0.0, 0.0, 0.0);
+    end->exit_normal = dwvu_v(0.0, 0.0, 0.0);
     if (L->exited[l]) {
-        dwvw_vec3 normal;
-        (void)dwvw_shape_exit_inline(&setup->shape, kind, dwvw_v(L->px[l], L->py[l], L->pz[l]),
-                                     dwvw_v(L->dx[l], L->dy[l], L->dz[l]), &normal);
+        dwvu_vec3 normal;
+        (void)dwvw_shape_exit_inline(&setup->shape, kind, dwvu_v(L->px[l], L->py[l], L->pz[l]),
+                                     dwvu_v(L->dx[l], L->dy[l], L->dz[l]), &normal);
         if (events > 0) last_factor = L->stretch[l] * plan->inv_albedo_eff; /* s / a */
         end->status = DWVW_EXITED;
         end->exit_normal = normal;
@@ -886,7 +885,7 @@ static DWVW_ALWAYS_INLINE int mixture_lanes_step_in(guided_lanes *L, const dwvw_
             wz[l] = L->dz[l];
         } else if (!guided[l]) {
             dwvk_uniform_pair_f u = {ua[l], ub[l]};
-            dwvw_vec3 w = dwvw_classical_direction(dwvw_v(L->dx[l], L->dy[l], L->dz[l]), 0.0f, u);
+            dwvu_vec3 w = dwvw_classical_direction(dwvu_v(L->dx[l], L->dy[l], L->dz[l]), 0.0f, u);
             wx[l] = w.x;
             wy[l] = w.y;
             wz[l] = w.z;
@@ -907,8 +906,8 @@ static DWVW_ALWAYS_INLINE int mixture_lanes_step_in(guided_lanes *L, const dwvw_
         if (kind == DWVW_HALFSPACE) hit = lane_halfspace_exit(pz, z);
         else if (kind == DWVW_SLAB) hit = lane_slab_exit(thickness, pz, z);
         else {
-            dwvw_vec3 normal;
-            hit = dwvw_shape_exit_inline(&setup->shape, kind, dwvw_v(L->px[l], L->py[l], pz), dwvw_v(wx[l], wy[l], z),
+            dwvu_vec3 normal;
+            hit = dwvw_shape_exit_inline(&setup->shape, kind, dwvu_v(L->px[l], L->py[l], pz), dwvu_v(wx[l], wy[l], z),
                                          &normal);
         }
         int exited = hit <= t;
@@ -969,11 +968,11 @@ static int mixture_lane_end(guided_lanes *L, int l, const dwvw_estimate_setup *s
 {
     uint32_t events = L->events[l];
     double weight = L->weight[l];
-    end->exit_normal = dwvw_v(0.0, 0.0, 0.0);
+    end->exit_normal = dwvu_v(0.0, 0.0, 0.0);
     if (L->exited[l]) {
-        dwvw_vec3 normal;
-        (void)dwvw_shape_exit_inline(&setup->shape, kind, dwvw_v(L->px[l], L->py[l], L->pz[l]),
-                                     dwvw_v(L->dx[l], L->dy[l], L->dz[l]), &normal);
+        dwvu_vec3 normal;
+        (void)dwvw_shape_exit_inline(&setup->shape, kind, dwvu_v(L->px[l], L->py[l], L->pz[l]),
+                                     dwvu_v(L->dx[l], L->dy[l], L->dz[l]), &normal);
         end->status = DWVW_EXITED;
         end->exit_normal = normal;
     } else if (!(weight > 0.0)) {
@@ -1101,8 +1100,7 @@ int dwvw_estimate_walks_lanes(const dwvw_estimate_setup *setup, uint64_t first, 
 
 int dwvw_estimate_run(const dwvw_estimate_setup *setup, dwvw_estimate_totals *totals)
 {
-    struct timespec start, stop;
-    clock_gettime(CLOCK_MONOTONIC, &start);
+    double start = dwvu_clock_seconds();
     run_state state;
     state.setup = setup;
     make_plan(setup, dwvw_estimate_walker(setup), &state.plan);
@@ -1116,12 +1114,7 @@ int dwvw_estimate_run(const dwvw_estimate_setup *setup, dwvw_estimate_totals *to
 
     uint32_t threads = setup->threads < 1 ? 1 : setup->threads > MAX_THREADS ? MAX_THREADS : setup->threads;
     if (threads > state.block_count) threads = state.block_count;
-    pthread_t ids[MAX_THREADS];
-    uint32_t started = 0;
-    for (; started + 1 < threads; ++started)
-        if (pthread_create(&ids[started], NULL, worker, &state) != 0) break;
-    worker(&state); /* the calling thread works too */
-    for (uint32_t i = 0; i < started; ++i) pthread_join(ids[i], NULL);
+    dwvu_parallel_run(threads, worker, &state);
 
     memset(totals, 0, sizeof *totals);
     for (uint32_t b = 0; b < state.block_count; ++b) {
@@ -1145,7 +1138,6 @@ int dwvw_estimate_run(const dwvw_estimate_setup *setup, dwvw_estimate_totals *to
         }
     }
     free(state.blocks);
-    clock_gettime(CLOCK_MONOTONIC, &stop);
-    totals->seconds = (double)(stop.tv_sec - start.tv_sec) + 1e-9 * (double)(stop.tv_nsec - start.tv_nsec);
+    totals->seconds = dwvu_clock_seconds() - start;
     return 0;
 }

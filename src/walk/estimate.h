@@ -8,6 +8,10 @@
 #include "walk.h"
 
 enum { DWVW_LIGHT_FRONT = 1, DWVW_LIGHT_BACK = 2 };
+/* The API passes DWV_LIGHT_FRONT / BACK / BOTH bits through: the same bits. */
+_Static_assert((int)DWVW_LIGHT_FRONT == DWV_LIGHT_FRONT && (int)DWVW_LIGHT_BACK == DWV_LIGHT_BACK &&
+                   (int)(DWVW_LIGHT_FRONT | DWVW_LIGHT_BACK) == DWV_LIGHT_BOTH,
+               "DWVW_LIGHT_* must equal DWV_LIGHT_* (capi/dwivedi.h)");
 
 typedef struct dwvw_estimate_setup {
     dwvw_shape shape;
@@ -38,7 +42,7 @@ typedef struct dwvw_walk_end {
     dwvw_status status;
     uint32_t events;
     double weight[DWVW_MAX_CHANNELS];
-    dwvw_vec3 exit_normal;
+    dwvu_vec3 exit_normal;
 } dwvw_walk_end;
 
 /* Which walker dwvw_estimate_run uses for a setup. The fast paths are for grey media whose guided

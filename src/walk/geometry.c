@@ -1,11 +1,11 @@
 #include "geometry.h"
 
-double dwvw_shape_exit(const dwvw_shape *shape, dwvw_vec3 p, dwvw_vec3 d, dwvw_vec3 *normal)
+double dwvw_shape_exit(const dwvw_shape *shape, dwvu_vec3 p, dwvu_vec3 d, dwvu_vec3 *normal)
 {
     return dwvw_shape_exit_inline(shape, shape->kind, p, d, normal);
 }
 
-double dwvw_shape_closest(const dwvw_shape *shape, dwvw_vec3 p, dwvw_vec3 *normal)
+double dwvw_shape_closest(const dwvw_shape *shape, dwvu_vec3 p, dwvu_vec3 *normal)
 {
     switch (shape->kind) {
     case DWVW_HALFSPACE:
@@ -19,9 +19,9 @@ double dwvw_shape_closest(const dwvw_shape *shape, dwvw_vec3 p, dwvw_vec3 *norma
         *normal = DWVW_BACK_NORMAL;
         return dwvw_positive_part(shape->thickness - p.z);
     case DWVW_SPHERE: {
-        dwvw_vec3 q = dwvw_v(p.x, p.y, p.z - shape->radius);
-        double r = dwvw_length(q);
-        *normal = r > 0.0 ? dwvw_scale(q, 1.0 / r) : DWVW_FRONT_NORMAL; /* any direction at the centre */
+        dwvu_vec3 q = dwvu_v(p.x, p.y, p.z - shape->radius);
+        double r = dwvu_length(q);
+        *normal = r > 0.0 ? dwvu_scale(q, 1.0 / r) : DWVW_FRONT_NORMAL; /* any direction at the centre */
         return dwvw_positive_part(shape->radius - r);
     }
     }

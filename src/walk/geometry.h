@@ -3,9 +3,14 @@
 #ifndef DWV_WALK_GEOMETRY_H
 #define DWV_WALK_GEOMETRY_H
 
-#include "vec3.h"
+#include <dwivedi.h>
+
+#include "util/vec3.h"
 
 typedef enum dwvw_shape_kind { DWVW_HALFSPACE = 0, DWVW_SLAB = 1, DWVW_SPHERE = 2 } dwvw_shape_kind;
+/* The API passes DWV_SHAPE_* values through as dwvw_shape_kind: the same numbers. */
+_Static_assert((int)DWVW_HALFSPACE == DWV_SHAPE_HALFSPACE && (int)DWVW_SLAB == DWV_SHAPE_SLAB && (int)DWVW_SPHERE == DWV_SHAPE_SPHERE,
+               "dwvw_shape_kind must equal the DWV_SHAPE_* values (capi/dwivedi.h)");
 
 /* The medium: half-space z >= 0; slab 0 <= z <= thickness; sphere of `radius` about (0, 0, radius).
  * All three have the point of entry at the origin with outward normal (0, 0, -1). */
@@ -17,9 +22,9 @@ typedef struct dwvw_shape {
 
 /* The distance along unit d from p (inside) to the surface, +INFINITY if none, and the outward
  * normal there. */
-double dwvw_shape_exit(const dwvw_shape *shape, dwvw_vec3 p, dwvw_vec3 d, dwvw_vec3 *normal);
-static const dwvw_vec3 DWVW_FRONT_NORMAL = {0.0, 0.0, -1.0};
-static const dwvw_vec3 DWVW_BACK_NORMAL = {0.0, 0.0, 1.0};
+double dwvw_shape_exit(const dwvw_shape *shape, dwvu_vec3 p, dwvu_vec3 d, dwvu_vec3 *normal);
+static const dwvu_vec3 DWVW_FRONT_NORMAL = {0.0, 0.0, -1.0};
+static const dwvu_vec3 DWVW_BACK_NORMAL = {0.0, 0.0, 1.0};
 
 /* max(x, 0) inline (libm's fmax is an out-of-line call, and this is on the per-event path). */
 static inline double dwvw_positive_part(double x)
@@ -29,8 +34,8 @@ static inline double dwvw_positive_part(double x)
 
 /* dwvw_shape_exit inline, with the kind given apart so that a caller that knows it at compile
  * time gets one case (the estimator's fast path, per event). */
-static inline double dwvw_shape_exit_inline(const dwvw_shape *shape, dwvw_shape_kind kind, dwvw_vec3 p, dwvw_vec3 d,
-                                            dwvw_vec3 *normal)
+static inline double dwvw_shape_exit_inline(const dwvw_shape *shape, dwvw_shape_kind kind, dwvu_vec3 p, dwvu_vec3 d,
+                                            dwvu_vec3 *normal)
 {
     switch (kind) {
     case DWVW_HALFSPACE:
@@ -47,13 +52,13 @@ static inline double dwvw_shape_exit_inline(const dwvw_shape *shape, dwvw_shape_
         /* |q + t d|^2 = R^2 with q = p - centre: t = -b + sqrt(b^2 - c), c = |q|^2 - R^2 <= 0; for
          * b > 0 the equivalent -c / (b + sqrt(b^2 - c)) avoids cancellation. */
         double R = shape->radius;
-        dwvw_vec3 q = dwvw_v(p.x, p.y, p.z - R);
-        double b = dwvw_dot(q, d);
-        double c = (dwvw_length(q) - R) * (dwvw_length(q) + R);
+        dwvu_vec3 q = dwvu_v(p.x, p.y, p.z - R);
+        double b = dwvu_dot(q, d);
+        double c = (dwvu_length(q) - R) * (dwvu_length(q) + R);
         c = c < 0.0 ? c : 0.0;
         double root = sqrt(b * b - c);
         double t = b > 0.0 ? -c / (b + root) : root - b;
-        *normal = dwvw_normalize(dwvw_madd(q, d, t));
+        *normal = dwvu_normalize(dwvu_madd(q, d, t));
         return t;
     }
     }
@@ -61,6 +66,6 @@ static inline double dwvw_shape_exit_inline(const dwvw_shape *shape, dwvw_shape_
 }
 
 /* The outward normal at the surface point closest to p, and the distance to it. */
-double dwvw_shape_closest(const dwvw_shape *shape, dwvw_vec3 p, dwvw_vec3 *normal);
+double dwvw_shape_closest(const dwvw_shape *shape, dwvu_vec3 p, dwvu_vec3 *normal);
 
 #endif

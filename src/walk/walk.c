@@ -56,7 +56,7 @@ void dwvw_guide_init(dwvw_guide *guide, dwvw_technique technique, const dwvw_med
 {
     guide->q_classical = guide->q_poe = guide->q_closest = guide->q_incident = guide->q_backward = 0.0;
     guide->q_sheet = 0.0;
-    guide->sheet_normal = dwvw_v(0.0, 0.0, 1.0);
+    guide->sheet_normal = dwvu_v(0.0, 0.0, 1.0);
     guide->patch_count = patch_count < DWVW_MAX_PATCHES ? patch_count : DWVW_MAX_PATCHES;
     for (int i = 0; i < guide->patch_count; ++i) {
         guide->patches[i] = patches[i];
@@ -103,14 +103,14 @@ int dwvw_guide_needs_closest(const dwvw_guide *guide)
 static const dwvw_guide classical_guide = {.q_classical = 1.0, .sheet_normal = {0.0, 0.0, 1.0}};
 
 void dwvw_walk_begin(dwvw_walk *walk, const dwvw_medium *medium, const dwvw_guide *guide, uint64_t key,
-                     uint32_t max_events, dwvw_vec3 point, dwvw_vec3 direction, dwvw_vec3 normal)
+                     uint32_t max_events, dwvu_vec3 point, dwvu_vec3 direction, dwvu_vec3 normal)
 {
     walk->medium = medium;
     /* The sheet's importance rises from the far face toward the lit one: a walk that enters on the
      * lit side (its entry faces the lit normal's way) has no far face to start from, and its
      * light leaves where it came in, which the linear importance does not describe (a front-lit
      * sphere's variance was 10^4 times classical's). Such a walk is classical. */
-    if (guide->q_sheet > 0.0 && dwvw_dot(normal, guide->sheet_normal) > 0.0) guide = &classical_guide;
+    if (guide->q_sheet > 0.0 && dwvu_dot(normal, guide->sheet_normal) > 0.0) guide = &classical_guide;
     walk->guide = guide;
     walk->key = key;
     walk->sampler = NULL;
@@ -149,7 +149,7 @@ void dwvw_walk_stratify(dwvw_walk *walk, const dwvk_sampler *sampler, uint32_t f
     walk->stratified_events = sampler == NULL ? 0u : events < room ? events : room;
 }
 
-void dwvw_walk_set_closest(dwvw_walk *walk, dwvw_vec3 normal)
+void dwvw_walk_set_closest(dwvw_walk *walk, dwvu_vec3 normal)
 {
     walk->closest_normal = normal;
     walk->closest_known = 1;
@@ -157,11 +157,11 @@ void dwvw_walk_set_closest(dwvw_walk *walk, dwvw_vec3 normal)
 
 /* Adds a guided component, or its weight to one with the same axis: the mixture is the same, and
  * every component costs a pdf and an exponential per channel at every event. */
-static void add_component(dwvw_walk *walk, double q, dwvw_vec3 axis)
+static void add_component(dwvw_walk *walk, double q, dwvu_vec3 axis)
 {
     if (!(q > 0.0)) return;
     for (int k = 1; k < walk->component_count; ++k) {
-        if (dwvw_dot(walk->component_axis[k], axis) >= 1.0 - 1e-12) {
+        if (dwvu_dot(walk->component_axis[k], axis) >= 1.0 - 1e-12) {
             walk->component_q[k] += q;
             return;
         }
@@ -186,8 +186,8 @@ static void add_incident_components(dwvw_walk *walk, double q)
     double log_w[DWVW_MAX_PATCHES], largest = -INFINITY;
     for (int j = 0; j < guide->patch_count; ++j) {
         const dwvw_light_patch *patch = &guide->patches[j];
-        dwvw_vec3 offset = dwvw_sub(walk->position, patch->point);
-        double distance = patch->is_plane ? fabs(dwvw_dot(offset, patch->normal)) : dwvw_length(offset);
+        dwvu_vec3 offset = dwvu_sub(walk->position, patch->point);
+        double distance = patch->is_plane ? fabs(dwvu_dot(offset, patch->normal)) : dwvu_length(offset);
         log_w[j] = patch->log_power - decay * distance;
         largest = fmax(largest, log_w[j]);
     }
@@ -205,13 +205,13 @@ static void build_components(dwvw_walk *walk)
     walk->component_count = 1;
     double backward_fraction = 0.0;
     if (guide->q_backward > 0.0 && walk->have_opposite) {
-        double depth = -dwvw_dot(dwvw_sub(walk->position, walk->entry_point), walk->entry_normal);
+        double depth = -dwvu_dot(dwvu_sub(walk->position, walk->entry_point), walk->entry_normal);
         depth = depth > 0.0 ? depth < walk->opposite_depth ? depth : walk->opposite_depth : 0.0;
         double x = m->sigma_t[m->guide_channel] * (walk->opposite_depth - 2.0 * depth) * m->dwivedi.kappa;
         backward_fraction = 1.0 / (1.0 + exp(x));
     }
     add_component(walk, guide->q_poe + guide->q_backward * (1.0 - backward_fraction), walk->entry_normal);
-    add_component(walk, guide->q_backward * backward_fraction, dwvw_scale(walk->entry_normal, -1.0));
+    add_component(walk, guide->q_backward * backward_fraction, dwvu_scale(walk->entry_normal, -1.0));
     if (guide->q_closest > 0.0) add_component(walk, guide->q_closest, walk->closest_normal);
     if (guide->q_incident > 0.0) add_incident_components(walk, guide->q_incident);
     /* With one component of weight > 0 there is nothing to draw: pick() would return it for any u. */
@@ -250,20 +250,20 @@ static int pick(const double *p, int n, double u, double *rest)
     return last;
 }
 
-static int same_bits(dwvw_vec3 a, dwvw_vec3 b)
+static int same_bits(dwvu_vec3 a, dwvu_vec3 b)
 {
     return memcmp(&a, &b, sizeof a) == 0;
 }
 
-/* dwvw_frame_about(axis), made once per walk and axis (kept in the walk's few slots, the oldest
+/* dwvu_frame_about(axis), made once per walk and axis (kept in the walk's few slots, the oldest
  * replaced): the frame is a function of the axis's bits, so a kept one is the same bit for bit. */
-static const dwvw_frame *frame_about_axis(dwvw_walk *walk, dwvw_vec3 axis)
+static const dwvu_frame *frame_about_axis(dwvw_walk *walk, dwvu_vec3 axis)
 {
     uint32_t kept = walk->frames_made < DWVW_FRAME_CACHE ? walk->frames_made : DWVW_FRAME_CACHE;
     for (uint32_t i = 0; i < kept; ++i)
         if (same_bits(walk->frames[i].n, axis)) return &walk->frames[i];
-    dwvw_frame *slot = &walk->frames[walk->frames_made++ % DWVW_FRAME_CACHE];
-    *slot = dwvw_frame_about(axis);
+    dwvu_frame *slot = &walk->frames[walk->frames_made++ % DWVW_FRAME_CACHE];
+    *slot = dwvu_frame_about(axis);
     return slot;
 }
 
@@ -297,7 +297,7 @@ static inline int walk_pair_bits(const dwvw_walk *walk, uint32_t pair, uint64_t 
 static void sheet_importance(const dwvw_walk *walk, double a[DWVW_MAX_CHANNELS])
 {
     const dwvw_medium *m = walk->medium;
-    double h = dwvw_dot(dwvw_sub(walk->position, walk->entry_point), walk->guide->sheet_normal);
+    double h = dwvu_dot(dwvu_sub(walk->position, walk->entry_point), walk->guide->sheet_normal);
     h = h > 0.0 ? h : 0.0;
     for (int c = 0; c < m->channels; ++c) a[c] = m->sigma_t[c] * h + DWVK_SHEET_EXTRAPOLATION;
 }
@@ -311,7 +311,7 @@ static double sheet_sample(dwvw_walk *walk, int channel, const double *choice, f
 {
     const dwvw_medium *m = walk->medium;
     const dwvw_guide *guide = walk->guide;
-    const dwvw_vec3 normal = guide->sheet_normal;
+    const dwvu_vec3 normal = guide->sheet_normal;
     /* two components for the tally of mixture terms (shade.c); the weight update is sheet_weight_update */
     walk->component_count = 2;
     walk->single_component = -1;
@@ -321,7 +321,7 @@ static double sheet_sample(dwvw_walk *walk, int channel, const double *choice, f
     double u_component = choice != NULL ? *choice : dwvk_rng_uniform_d(walk->key, dim + DWVW_DIM_COMPONENT);
     int classical = u_component < guide->q_classical;
     double beta = dwvk_sheet_beta(walk->sheet_a[m->guide_channel]);
-    dwvw_vec3 previous = walk->direction;
+    dwvu_vec3 previous = walk->direction;
     float g = (float)m->g;
     if (walk->events > 0) {
         dwvk_uniform_pair_f u;
@@ -337,7 +337,7 @@ static double sheet_sample(dwvw_walk *walk, int channel, const double *choice, f
         } else {
             double mu = dwvk_sheet_cosine_sample(beta, (double)u.a);
             double sin2 = (1.0 - mu) * (1.0 + mu);
-            walk->direction = dwvw_frame_direction(frame_about_axis(walk, normal), mu, sqrt(sin2 > 0.0 ? sin2 : 0.0),
+            walk->direction = dwvk_frame_direction(frame_about_axis(walk, normal), mu, sqrt(sin2 > 0.0 ? sin2 : 0.0),
                                                    dwvk_azimuth_f(u.b));
         }
         walk->phase = g == 0.0f ? DWVK_INV_FOUR_PI : dwvk_hg_pdf_f(g, (float)dwvw_cosine(previous, walk->direction));
@@ -398,7 +398,7 @@ double dwvw_walk_sample(dwvw_walk *walk)
                             stratified ? *choice : dwvk_rng_uniform_d(walk->key, dim + DWVW_DIM_COMPONENT), NULL);
     /* Per-event sampling runs in single precision (src/kernel/fastmath.h); positions, directions,
      * pdfs, weights and their exponentials stay in double. */
-    dwvw_vec3 previous = walk->direction;
+    dwvu_vec3 previous = walk->direction;
     float g = (float)m->g;
     if (walk->events > 0) {
         /* The first step keeps the entry direction: only its distance is sampled. */
@@ -630,7 +630,7 @@ double dwvw_walk_probe_reach(const dwvw_walk *walk)
     return fmax(walk->step_distance, 10.0 / sigma_min);
 }
 
-dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 hit_normal)
+dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvu_vec3 hit_normal)
 {
     const dwvw_medium *m = walk->medium;
     if (walk->events == 0 && walk->guide->q_backward > 0.0 && hit_distance < INFINITY) {
@@ -638,7 +638,7 @@ dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 h
         if (hit_distance <= dwvw_walk_probe_reach(walk)) {
             walk->have_opposite = 1;
             walk->components_vary = 1; /* the backward fraction now follows the depth */
-            walk->opposite_depth = -hit_distance * dwvw_dot(walk->direction, walk->entry_normal);
+            walk->opposite_depth = -hit_distance * dwvu_dot(walk->direction, walk->entry_normal);
         }
     }
     int exited = hit_distance <= walk->step_distance;
@@ -646,7 +646,7 @@ dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 h
 
     if (walk->guide->q_sheet > 0.0) sheet_weight_update(walk, t, exited);
     else mixture_weight_update(walk, t, exited);
-    walk->position = dwvw_madd(walk->position, walk->direction, t);
+    walk->position = dwvu_madd(walk->position, walk->direction, t);
     if (exited) {
         walk->exit_normal = hit_normal;
         return walk->status = DWVW_EXITED;

@@ -24,13 +24,15 @@
 #ifndef DWV_WALK_WALK_H
 #define DWV_WALK_WALK_H
 
+#include <dwivedi.h>
 #include <stdint.h>
 
 #include "kernel/classical.h"
-#include "kernel/dwivedi.h"
+#include "kernel/direction.h"
+#include "kernel/dwivedi_sampling.h"
 #include "kernel/rng.h"
 #include "kernel/sampler.h"
-#include "vec3.h"
+#include "util/vec3.h"
 
 #define DWVW_MAX_CHANNELS 3
 #define DWVW_MAX_PATCHES 16
@@ -74,6 +76,13 @@ typedef enum dwvw_technique {
     DWVW_SHEET = 7
 } dwvw_technique;
 #define DWVW_TECHNIQUE_COUNT 8
+/* The API passes dwv_technique_t values through as dwvw_technique: the same numbers. */
+_Static_assert((int)DWVW_AUTO == DWV_TECHNIQUE_AUTO && (int)DWVW_CLASSICAL == DWV_TECHNIQUE_CLASSICAL &&
+                   (int)DWVW_POE == DWV_TECHNIQUE_POE && (int)DWVW_CLOSEST == DWV_TECHNIQUE_CLOSEST &&
+                   (int)DWVW_INCIDENT == DWV_TECHNIQUE_INCIDENT && (int)DWVW_BACKWARD == DWV_TECHNIQUE_BACKWARD &&
+                   (int)DWVW_CYCLES == DWV_TECHNIQUE_CYCLES && (int)DWVW_SHEET == DWV_TECHNIQUE_SHEET &&
+                   (int)DWVW_TECHNIQUE_COUNT == DWV_TECHNIQUE_SHEET + 1,
+               "dwvw_technique must equal dwv_technique_t (capi/dwivedi.h)");
 /* The sheet technique's classical share in isotropic media (|g| where that is larger): its
  * direction pdf ignores the phase function's peak, and its flight reaches no farther below the
  * walk than the importance stays positive, so the classical share covers every path
@@ -95,7 +104,7 @@ typedef struct dwvw_medium {
 /* A lit part of the surface: an infinite plane (distance measured to the plane) or a patch
  * around a point; `power` is the light it receives (irradiance x area), > 0. */
 typedef struct dwvw_light_patch {
-    dwvw_vec3 point, normal;
+    dwvu_vec3 point, normal;
     double power;
     double log_power; /* log(power), kept by dwvw_guide_init */
     int is_plane;
@@ -105,7 +114,7 @@ typedef struct dwvw_light_patch {
 typedef struct dwvw_guide {
     double q_classical, q_poe, q_closest, q_incident, q_backward; /* sum to 1 with q_sheet */
     double q_sheet;
-    dwvw_vec3 sheet_normal; /* the sheet technique's lit normal: the strongest patch's */
+    dwvu_vec3 sheet_normal; /* the sheet technique's lit normal: the strongest patch's */
     int patch_count;
     dwvw_light_patch patches[DWVW_MAX_PATCHES];
 } dwvw_guide;
@@ -116,6 +125,10 @@ typedef enum dwvw_status {
     DWVW_ABSORBED = 2,   /* ended by Russian roulette or zero throughput */
     DWVW_TRUNCATED = 3   /* ended by the event cap: its weight is reported, not dropped */
 } dwvw_status;
+/* dwv_walk_step reports a dwvw_status as a dwv_walk_status_t: the same numbers. */
+_Static_assert((int)DWVW_RUNNING == DWV_WALK_RUNNING && (int)DWVW_EXITED == DWV_WALK_EXITED &&
+                   (int)DWVW_ABSORBED == DWV_WALK_ABSORBED && (int)DWVW_TRUNCATED == DWV_WALK_TRUNCATED,
+               "dwvw_status must equal dwv_walk_status_t (capi/dwivedi.h)");
 
 /* The stratified pairs of walks that draw the same ones (the channel walks of one sample, which
  * share the sampler and first pair): each pair's bits are made once, by the first walk that needs
@@ -141,21 +154,21 @@ typedef struct dwvw_walk {
     uint32_t max_events;
     uint32_t events;       /* scattering events so far */
     dwvw_status status;
-    dwvw_vec3 position, direction;
-    dwvw_vec3 entry_point, entry_normal; /* entry_normal points out of the medium */
+    dwvu_vec3 position, direction;
+    dwvu_vec3 entry_point, entry_normal; /* entry_normal points out of the medium */
     double weight[DWVW_MAX_CHANNELS];    /* throughput; on exit, the walk's estimate */
-    dwvw_vec3 exit_normal;
+    dwvu_vec3 exit_normal;
     int have_opposite;
     double opposite_depth;
     /* the pending step, between dwvw_walk_sample and dwvw_walk_complete */
-    dwvw_vec3 closest_normal;
+    dwvu_vec3 closest_normal;
     int closest_known;
     double step_distance;
     int component_count;                            /* 0 until the first step builds them */
     int components_vary;                            /* rebuilt at every event (else kept) */
     int single_component;                           /* the only component with q > 0, else -1 */
     double component_q[DWVW_MAX_COMPONENTS];
-    dwvw_vec3 component_axis[DWVW_MAX_COMPONENTS]; /* unused for component 0 (classical) */
+    dwvu_vec3 component_axis[DWVW_MAX_COMPONENTS]; /* unused for component 0 (classical) */
     double component_pdf[DWVW_MAX_COMPONENTS];     /* direction pdf per steradian */
     double component_stretch[DWVW_MAX_COMPONENTS];
     double channel_p[DWVW_MAX_CHANNELS];
@@ -165,9 +178,9 @@ typedef struct dwvw_walk {
      * the first step) */
     double sheet_a[DWVW_MAX_CHANNELS], sheet_norm[DWVW_MAX_CHANNELS], sheet_mu, sheet_direction_pdf;
     /* Frames about the guided axes met so far (an axis repeats from event to event for every
-     * technique but closest): dwvw_frame_about is a function of the axis's bits alone. */
+     * technique but closest): dwvu_frame_about is a function of the axis's bits alone. */
     uint32_t frames_made;                           /* frames made so far; the slot of the next */
-    dwvw_frame frames[DWVW_FRAME_CACHE];
+    dwvu_frame frames[DWVW_FRAME_CACHE];
 } dwvw_walk;
 
 /* Fills a medium; the caller validated the values. */
@@ -181,7 +194,7 @@ int dwvw_guide_needs_closest(const dwvw_guide *guide);
 /* Starts a walk at `point` heading along unit `direction` into the medium, whose outward normal
  * there is `normal`; weight 1 in every channel. */
 void dwvw_walk_begin(dwvw_walk *walk, const dwvw_medium *medium, const dwvw_guide *guide, uint64_t key,
-                     uint32_t max_events, dwvw_vec3 point, dwvw_vec3 direction, dwvw_vec3 normal);
+                     uint32_t max_events, dwvu_vec3 point, dwvu_vec3 direction, dwvu_vec3 normal);
 /* After dwvw_walk_begin: draws the channel, component, direction and distance of events
  * 0 .. events - 1 from `sampler`'s pairs first_pair, first_pair + 1, ... (DWVW_PAIR_* above)
  * instead of from the walk's key; the sampler must outlive the walk. Every number is still a
@@ -194,14 +207,14 @@ void dwvw_walk_stratify(dwvw_walk *walk, const dwvk_sampler *sampler, uint32_t f
  * Walks that share a cache draw the same numbers they would draw without it, bit for bit. */
 void dwvw_walk_share_pairs(dwvw_walk *walk, dwvw_pair_cache *cache);
 /* Before dwvw_walk_sample, where the guide needs it: the closest surface point's outward normal. */
-void dwvw_walk_set_closest(dwvw_walk *walk, dwvw_vec3 normal);
+void dwvw_walk_set_closest(dwvw_walk *walk, dwvu_vec3 normal);
 /* Samples the next step's direction (walk->direction) and tentative distance (return value). */
 double dwvw_walk_sample(dwvw_walk *walk);
 /* Reports what the ray along walk->direction met: the surface at `hit_distance` (+INFINITY for
  * none) with outward normal `hit_normal`. On the first step hit_distance is the probe's full
  * answer (not cut at the sampled distance), which locates the opposite interface. Returns the
  * new status. */
-dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvw_vec3 hit_normal);
+dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvu_vec3 hit_normal);
 /* After dwvw_walk_sample on the first step: the distance up to which the probe's answer is used,
  * the sampled distance (an exit) or, for the backward technique, the reach within which an
  * opposite interface counts if that is longer. A probe that looks no further and reports a hit
@@ -217,38 +230,38 @@ static inline uint32_t dwvw_event_dim(uint32_t events)
 
 /* A classical direction: the cosine to `previous` from the phase function (isotropic at g = 0),
  * the azimuth uniform. u.a drives the cosine, u.b the azimuth. */
-static inline dwvw_vec3 dwvw_classical_direction(dwvw_vec3 previous, float g, dwvk_uniform_pair_f u)
+static inline dwvu_vec3 dwvw_classical_direction(dwvu_vec3 previous, float g, dwvk_uniform_pair_f u)
 {
     float mu = g == 0.0f ? dwvk_isotropic_sample_f(u.a) : dwvk_hg_sample_f(g, u.a);
     float sin2 = (1.0f - mu) * (1.0f + mu);
-    dwvw_frame frame = dwvw_frame_about(previous);
-    return dwvw_frame_direction(&frame, mu, sqrtf(sin2 > 0.0f ? sin2 : 0.0f), dwvk_azimuth_f(u.b));
+    dwvu_frame frame = dwvu_frame_about(previous);
+    return dwvk_frame_direction(&frame, mu, sqrtf(sin2 > 0.0f ? sin2 : 0.0f), dwvk_azimuth_f(u.b));
 }
 
 /* A guided direction about frame->n (Dwivedi's cosine distribution). */
-static inline dwvw_vec3 dwvw_guided_direction(const dwvw_frame *frame, const dwvk_dwivedi_event_f *d,
+static inline dwvu_vec3 dwvw_guided_direction(const dwvu_frame *frame, const dwvk_dwivedi_event_f *d,
                                               dwvk_uniform_pair_f u)
 {
     dwvk_dwivedi_event_cosine_f s = dwvk_dwivedi_event_sample_f(d, u.a);
-    return dwvw_frame_direction(frame, s.cos_theta, s.sin_theta, dwvk_azimuth_f(u.b));
+    return dwvk_frame_direction(frame, s.cos_theta, s.sin_theta, dwvk_azimuth_f(u.b));
 }
 
 /* The same about a fixed axis, with its frame's four quarter turns made in advance
- * (turned[q] = dwvw_frame_turned(frame, q)): bit for bit dwvw_guided_direction, without turning
+ * (turned[q] = dwvu_frame_turned(frame, q)): bit for bit dwvw_guided_direction, without turning
  * the azimuth per event. */
-static inline dwvw_vec3 dwvw_guided_direction_turned(const dwvw_frame turned[4], const dwvk_dwivedi_event_f *d,
+static inline dwvu_vec3 dwvw_guided_direction_turned(const dwvu_frame turned[4], const dwvk_dwivedi_event_f *d,
                                                      dwvk_uniform_pair_f u)
 {
     dwvk_dwivedi_event_cosine_f s = dwvk_dwivedi_event_sample_f(d, u.a);
     int32_t q;
     dwvk_unit2_f azimuth = dwvk_azimuth_quadrant_f(u.b, &q);
-    return dwvw_frame_direction(&turned[q], s.cos_theta, s.sin_theta, azimuth);
+    return dwvk_frame_direction(&turned[q], s.cos_theta, s.sin_theta, azimuth);
 }
 
 /* The cosine of unit `direction` to unit `axis`, held in [-1, 1]. */
-static inline double dwvw_cosine(dwvw_vec3 direction, dwvw_vec3 axis)
+static inline double dwvw_cosine(dwvu_vec3 direction, dwvu_vec3 axis)
 {
-    double mu = dwvw_dot(direction, axis);
+    double mu = dwvu_dot(direction, axis);
     return mu < -1.0 ? -1.0 : mu > 1.0 ? 1.0 : mu;
 }
 

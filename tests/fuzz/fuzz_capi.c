@@ -14,7 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 typedef struct reader {
     const uint8_t *data;

@@ -1,6 +1,6 @@
 /* libFuzzer target: mesh files. The first byte picks OBJ (even) or PLY (odd) (or the environment
  * variable DWV_FUZZ_MESH_KIND=obj / ply fixes it); the rest is written to a file of that kind and
- * read by dwvio_mesh_file_read (src/io/mesh_file.c: our checks, then Assimp), the internal call
+ * read by dwvs_mesh_file_read (src/io/mesh_file.c: our checks, then Assimp), the internal call
  * that dwv_scene_load makes for each mesh file, so that a run does not pay for building a scene.
  * Any file must give arrays that keep their promises (indices below the vertex count) or a
  * message, never a crash.
@@ -12,8 +12,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "dwivedi.h"
-#include "io/mesh_file.h"
+#include <dwivedi.h>
+#include "scenefile/mesh_file.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -36,13 +36,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (!file) abort();
     if (size > 1 && fwrite(data + 1, 1, size - 1, file) != size - 1) abort();
     fclose(file);
-    dwvio_mesh_data mesh;
-    dwv_result_t r = dwvio_mesh_file_read(path, &mesh);
+    dwvs_mesh_data mesh;
+    dwv_result_t r = dwvs_mesh_file_read(path, &mesh);
     if (r == DWV_SUCCESS) {
         if (mesh.vertex_count < 1u || mesh.triangle_count < 1u || !mesh.positions || !mesh.indices) __builtin_trap();
         for (size_t i = 0; i < 3u * (size_t)mesh.triangle_count; ++i)
             if (mesh.indices[i] >= mesh.vertex_count) __builtin_trap();
-        dwvio_mesh_data_free(&mesh);
+        dwvs_mesh_data_free(&mesh);
     } else if (!dwv_last_error_message()[0]) {
         __builtin_trap();
     }

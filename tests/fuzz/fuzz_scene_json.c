@@ -9,7 +9,7 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 #ifndef DWV_FUZZ_BASE_DIR
 #define DWV_FUZZ_BASE_DIR "."

@@ -13,7 +13,7 @@
 #include "bake/material.h"
 #include "bake_scenes.h"
 #include "check.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 #define FOUR_PI 12.566370614359172
 

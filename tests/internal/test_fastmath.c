@@ -23,7 +23,7 @@
 #include <stdio.h>
 
 #include "check.h"
-#include "kernel/dwivedi.h"
+#include "kernel/dwivedi_sampling.h"
 #include "kernel/fastmath.h"
 
 #define EXPM1_TOLERANCE 2.4e-7

@@ -39,13 +39,13 @@ static void test_closest_and_rays(void)
     int agree = 0;
     for (uint32_t i = 0; i < 500; ++i) {
         uint64_t key = dwvk_rng_key(1, i, 0);
-        dwvw_vec3 p = dwvw_v(0.3 + 2.4 * (dwvk_rng_uniform_d(key, 0) - 0.5), -0.2 + 2.4 * (dwvk_rng_uniform_d(key, 1) - 0.5),
+        dwvu_vec3 p = dwvu_v(0.3 + 2.4 * (dwvk_rng_uniform_d(key, 0) - 0.5), -0.2 + 2.4 * (dwvk_rng_uniform_d(key, 1) - 0.5),
                              0.1 + 2.4 * (dwvk_rng_uniform_d(key, 2) - 0.5));
         double best = INFINITY;
         for (uint32_t t = 0; t < mesh->triangle_count; ++t) best = fmin(best, brute_triangle_distance(mesh, t, p, NULL));
         dwvg_hit hit;
         int found = dwvg_closest_mesh(&scene->geometry, 0, p, &hit);
-        double d = found ? dwvw_length(dwvw_sub(dwvg_point(mesh, hit.prim, hit.u, hit.v), p)) : INFINITY;
+        double d = found ? dwvu_length(dwvu_sub(dwvg_point(mesh, hit.prim, hit.u, hit.v), p)) : INFINITY;
         agree += found && fabs(d - best) <= 1e-6 && fabs(hit.t - best) <= 1e-6;
     }
     CHECK(agree == 500, "closest point agrees with brute force at %d of 500 points", agree);
@@ -55,14 +55,14 @@ static void test_closest_and_rays(void)
     for (uint32_t i = 0; i < 500; ++i) {
         uint64_t key = dwvk_rng_key(2, i, 0);
         double mu = 2.0 * dwvk_rng_uniform_d(key, 0) - 1.0;
-        dwvw_vec3 d = dwvw_direction_about(dwvw_v(0, 0, 1), mu, 1.0 - mu, 1.0 + mu, dwvk_rng_uniform_d(key, 1));
-        dwvw_vec3 c = dwvw_v(0.3, -0.2, 0.1);
+        dwvu_vec3 d = dwvk_direction_about(dwvu_v(0, 0, 1), mu, 1.0 - mu, 1.0 + mu, dwvk_rng_uniform_d(key, 1));
+        dwvu_vec3 c = dwvu_v(0.3, -0.2, 0.1);
         dwvg_hit a, b;
         int fa = dwvg_intersect_mesh(&scene->geometry, 0, c, d, 0.0, INFINITY, &a);
         int fb = dwvg_intersect(&scene->geometry, c, d, 0.0, INFINITY, &b);
         double inner = cos(3.14159265358979 / 12.0) * cos(3.14159265358979 / 24.0);
         on_surface += fa && fb && a.prim == b.prim && b.mesh == 0 && a.t >= inner - 1e-5 && a.t <= 1.0 + 1e-5 &&
-                      dwvw_dot(dwvg_geometric_normal(mesh, a.prim), d) > 0.0 &&
+                      dwvu_dot(dwvg_geometric_normal(mesh, a.prim), d) > 0.0 &&
                       dwvg_occluded(&scene->geometry, c, d, 0.0, INFINITY) && !dwvg_occluded(&scene->geometry, c, d, 0.0, 0.5 * inner);
     }
     CHECK(on_surface == 500, "rays meet the sphere from inside at %d of 500", on_surface);

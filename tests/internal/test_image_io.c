@@ -31,7 +31,7 @@
 
 #include "api/image_handle.h"
 #include "check.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 #define W 37 /* not a multiple of anything: partial ZIP chunks (16 lines) and odd rows */
 #define H 23

@@ -25,10 +25,10 @@
 static const double EXIT_ALBEDO = 41.0 / 42.0;
 
 /* A unit direction on the upper hemisphere (z > 0) from two uniforms. */
-static dwvw_vec3 upper(double u1, double u2)
+static dwvu_vec3 upper(double u1, double u2)
 {
     double z = fmax(u1, 1e-6), r = sqrt(fmax(0.0, 1.0 - z * z)), phi = 6.283185307179586 * u2;
-    return dwvw_v(r * cos(phi), r * sin(phi), z);
+    return dwvu_v(r * cos(phi), r * sin(phi), z);
 }
 
 /* The cosine-weighted hemisphere albedo of a factor g(mu) of the Lambertian BSDF. */
@@ -84,16 +84,16 @@ static void test_retro_reflection(void)
     uint64_t state = 12345u;
     double worst = 0.0;
     for (int i = 0; i < 100000; ++i) {
-        dwvw_vec3 l = upper(brute_uniform(&state), brute_uniform(&state)), v = upper(brute_uniform(&state), brute_uniform(&state));
+        dwvu_vec3 l = upper(brute_uniform(&state), brute_uniform(&state)), v = upper(brute_uniform(&state), brute_uniform(&state));
         double roughness = brute_uniform(&state);
         /* The half-vector form: R_R = 2 roughness cos^2 theta_d, theta_d between L and H. */
-        dwvw_vec3 h = dwvw_add(l, v);
-        double len = sqrt(dwvw_dot(h, h));
-        double cos_d = dwvw_dot(l, h) / len;
+        dwvu_vec3 h = dwvu_add(l, v);
+        double len = sqrt(dwvu_dot(h, h));
+        double cos_d = dwvu_dot(l, h) / len;
         double rr = 2.0 * roughness * cos_d * cos_d;
         double fl = pow(1.0 - l.z, 5.0), fv = pow(1.0 - v.z, 5.0);
         double want = rr * (fl + fv + fl * fv * (rr - 1.0));
-        double got = dwvb_principled_retro_factor(l.z, v.z, dwvw_dot(l, v), roughness);
+        double got = dwvb_principled_retro_factor(l.z, v.z, dwvu_dot(l, v), roughness);
         worst = fmax(worst, fabs(got - want));
     }
     CHECK(worst < 1e-13, "retro-reflection factor against the half-vector form: off by %.3g", worst);
@@ -117,12 +117,12 @@ static void test_principled_diffuse(void)
     uint64_t state = 777u;
     double worst = 0.0;
     for (int i = 0; i < 10000; ++i) {
-        dwvw_vec3 l = upper(brute_uniform(&state), brute_uniform(&state)), v = upper(brute_uniform(&state), brute_uniform(&state));
+        dwvu_vec3 l = upper(brute_uniform(&state), brute_uniform(&state)), v = upper(brute_uniform(&state), brute_uniform(&state));
         double roughness = brute_uniform(&state);
         double fl = pow(1.0 - l.z, 5.0), fv = pow(1.0 - v.z, 5.0);
         double want = (1.0 - 0.5 * fl) * (1.0 - 0.5 * fv) +
-                      dwvb_principled_retro_factor(l.z, v.z, dwvw_dot(l, v), roughness);
-        worst = fmax(worst, fabs(dwvb_principled_diffuse_factor(l.z, v.z, dwvw_dot(l, v), roughness) - want));
+                      dwvb_principled_retro_factor(l.z, v.z, dwvu_dot(l, v), roughness);
+        worst = fmax(worst, fabs(dwvb_principled_diffuse_factor(l.z, v.z, dwvu_dot(l, v), roughness) - want));
     }
     CHECK(worst < 1e-13, "Principled diffuse factor against pow(): off by %.3g", worst);
     /* At normal view: 2 int mu ((1 - (1 - mu)^5 / 2) + r (1 + mu)(1 - mu)^5) dmu
@@ -151,13 +151,13 @@ static void test_principled_diffuse(void)
 }
 
 typedef struct fixed_normal {
-    dwvw_vec3 n;
+    dwvu_vec3 n;
 } fixed_normal;
 
-static double exit_lobe(const void *context, dwvw_vec3 light)
+static double exit_lobe(const void *context, dwvu_vec3 light)
 {
     const fixed_normal *f = context;
-    return dwvb_principled_exit_factor(dwvw_dot(f->n, light));
+    return dwvb_principled_exit_factor(dwvu_dot(f->n, light));
 }
 
 static void test_direct_lobe(void)
@@ -170,7 +170,7 @@ static void test_direct_lobe(void)
     dwvl_light sun;
     dwvl_light_init(&sun, &desc);
     dwvl_environment env = {&sun, 1u, {0.0, 0.0, 0.0}, 0, NULL};
-    dwvw_vec3 x = dwvw_v(0.0, 0.0, 0.0), n = dwvw_v(0.0, 0.0, 1.0);
+    dwvu_vec3 x = dwvu_v(0.0, 0.0, 0.0), n = dwvu_v(0.0, 0.0, 1.0);
     fixed_normal normal = {n};
     double plain[3], lambert[3], lobe[3];
     dwvk_sampler sampler = {.key = 99u, .index = 0u, .stratified = 0};

@@ -25,7 +25,7 @@
 #include "bake_scenes.h"
 #include "brute_force.h"
 #include "check.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 #include "geom/embree.h"
 #include "kernel/rng.h"
 
@@ -140,19 +140,19 @@ static void check_bound(int kind)
     uint64_t key = dwvk_rng_key(41u + (uint64_t)kind, 0u, 0u);
     for (int i = 0; i < points; ++i) {
         /* Points over the grid's box, half of them near the surface features. */
-        dwvw_vec3 p;
+        dwvu_vec3 p;
         if (i % 2 == 0) {
-            p = dwvw_v(-1.05 + 2.1 * dwvk_rng_uniform_d(key, 8u * i), -1.05 + 2.1 * dwvk_rng_uniform_d(key, 8u * i + 1u),
+            p = dwvu_v(-1.05 + 2.1 * dwvk_rng_uniform_d(key, 8u * i), -1.05 + 2.1 * dwvk_rng_uniform_d(key, 8u * i + 1u),
                        -1.05 + 2.1 * dwvk_rng_uniform_d(key, 8u * i + 2u));
         } else {
-            p = dwvw_v(-0.6 + 1.2 * dwvk_rng_uniform_d(key, 8u * i), -1.0 + 0.3 * dwvk_rng_uniform_d(key, 8u * i + 1u),
+            p = dwvu_v(-0.6 + 1.2 * dwvk_rng_uniform_d(key, 8u * i), -1.0 + 0.3 * dwvk_rng_uniform_d(key, 8u * i + 1u),
                        -0.1 + 0.2 * dwvk_rng_uniform_d(key, 8u * i + 2u));
         }
         double exact = INFINITY;
-        dwvw_vec3 nearest = p;
+        dwvu_vec3 nearest = p;
         uint32_t nearest_prim = 0;
         for (uint32_t t = 0; t < mesh->triangle_count; ++t) {
-            dwvw_vec3 x = p;
+            dwvu_vec3 x = p;
             double d = brute_triangle_distance(mesh, t, p, &x);
             if (d < exact) {
                 exact = d;
@@ -179,13 +179,13 @@ static void check_bound(int kind)
         for (int k = 0; k < 4; ++k) {
             double z = 2.0 * dwvk_rng_uniform_d(key, 8u * i + 3u + (uint32_t)k) - 1.0, phi = 6.283185307179586 * dwvk_rng_uniform_d(key, 8u * i + 7u);
             double s = sqrt(fmax(0.0, 1.0 - z * z));
-            dwvw_vec3 w = dwvw_v(s * cos(phi + k), s * sin(phi + k), z);
+            dwvu_vec3 w = dwvu_v(s * cos(phi + k), s * sin(phi + k), z);
             blocked += dwvg_intersect_mesh(world, 0, p, w, 0.0, radius, &hit);
         }
-        dwvw_vec3 toward = dwvw_sub(nearest, p);
-        double length = dwvw_length(toward);
+        dwvu_vec3 toward = dwvu_sub(nearest, p);
+        double length = dwvu_length(toward);
         if (!(length > 0.0)) continue;
-        toward = dwvw_scale(toward, 1.0 / length);
+        toward = dwvu_scale(toward, 1.0 / length);
         blocked += dwvg_intersect_mesh(world, 0, p, toward, 0.0, radius, &hit);
         if (dwvg_triangle_area(mesh, nearest_prim) > 0.0) {
             ++aimed;

@@ -9,7 +9,7 @@
 #include <stdio.h>
 
 #include "check.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 #include "kernel/rng.h"
 
 /* x = y ^ (y >> shift) solved for y (shift >= 1): y = x ^ (x >> shift) ^ (x >> 2 shift) ^ ... */

@@ -8,8 +8,8 @@
 
 #include "api/scene_handle.h"
 #include "check.h"
-#include "dwivedi.h"
-#include "io/default_scene.h"
+#include <dwivedi.h>
+#include "scenefile/default_scene.h"
 
 #define EXAMPLES DWV_TEST_DATA_DIR "/../../examples/scenes"
 #define PI 3.14159265358979323846
@@ -26,7 +26,7 @@ static int compare(const void *x, const void *y)
 }
 
 /* Closed and consistently wound: each directed edge once, and its reverse once. */
-static int closed_manifold(const dwvio_mesh_data *m)
+static int closed_manifold(const dwvs_mesh_data *m)
 {
     size_t edges = 3u * (size_t)m->triangle_count;
     uint64_t *keys = malloc(edges * sizeof *keys), *reverse = malloc(edges * sizeof *reverse);
@@ -49,7 +49,7 @@ static int closed_manifold(const dwvio_mesh_data *m)
 }
 
 /* Signed volume by the divergence theorem: sum over triangles of a . (b x c) / 6. */
-static double signed_volume(const dwvio_mesh_data *m)
+static double signed_volume(const dwvs_mesh_data *m)
 {
     double volume = 0.0;
     for (size_t t = 0; t < m->triangle_count; ++t) {
@@ -62,7 +62,7 @@ static double signed_volume(const dwvio_mesh_data *m)
 }
 
 /* The smallest triangle area (float positions, as the scene keeps them). */
-static double smallest_area(const dwvio_mesh_data *m)
+static double smallest_area(const dwvs_mesh_data *m)
 {
     double smallest = HUGE_VAL;
     for (size_t t = 0; t < m->triangle_count; ++t) {
@@ -76,7 +76,7 @@ static double smallest_area(const dwvio_mesh_data *m)
 }
 
 /* Vertex normals unit and on the outer side of every face around them. */
-static int normals_outward(const dwvio_mesh_data *m, double *worst)
+static int normals_outward(const dwvs_mesh_data *m, double *worst)
 {
     *worst = 1.0;
     for (size_t t = 0; t < m->triangle_count; ++t) {
@@ -96,7 +96,7 @@ static int normals_outward(const dwvio_mesh_data *m, double *worst)
     return *worst > 0.0;
 }
 
-static int uvs_in_unit_square(const dwvio_mesh_data *m)
+static int uvs_in_unit_square(const dwvs_mesh_data *m)
 {
     for (size_t i = 0; i < 6u * (size_t)m->triangle_count; ++i)
         if (!(m->uvs[i] >= 0.0f && m->uvs[i] <= 1.0f)) return 0;
@@ -105,10 +105,10 @@ static int uvs_in_unit_square(const dwvio_mesh_data *m)
 
 static void test_leaf(void)
 {
-    dwvio_mesh_data leaf;
-    CHECK(dwvio_default_leaf(&leaf) == 0, "leaf");
+    dwvs_mesh_data leaf;
+    CHECK(dwvs_default_leaf(&leaf) == 0, "leaf");
     CHECK(closed_manifold(&leaf), "the leaf is not a closed, consistently wound surface");
-    const double a = DWVIO_LEAF_HALF_WIDTH, b = DWVIO_LEAF_HALF_HEIGHT, c = 0.5 * DWVIO_LEAF_THICKNESS;
+    const double a = DWVS_LEAF_HALF_WIDTH, b = DWVS_LEAF_HALF_HEIGHT, c = 0.5 * DWVS_LEAF_THICKNESS;
     /* The bend moves volume from one side of the middle surface to the other (Jacobian 1 - w/R,
      * odd in w): the ellipsoid's (4/3) pi a b c stays, up to the meshing (~1%). */
     double volume = signed_volume(&leaf), expected = 4.0 / 3.0 * PI * a * b * c;
@@ -119,7 +119,7 @@ static void test_leaf(void)
     CHECK(smallest_area(&leaf) > 1e-10, "a leaf triangle of area %.3g m^2", smallest_area(&leaf));
     /* Thickness at the middle: the two poles (first and last vertices), along -y. */
     const float *front = leaf.positions, *back = leaf.positions + 3u * (leaf.vertex_count - 1u);
-    CHECK(fabs(front[0]) < 1e-12 && fabs(back[0]) < 1e-12 && fabs((double)back[1] - front[1] - DWVIO_LEAF_THICKNESS) < 1e-7,
+    CHECK(fabs(front[0]) < 1e-12 && fabs(back[0]) < 1e-12 && fabs((double)back[1] - front[1] - DWVS_LEAF_THICKNESS) < 1e-7,
           "leaf thickness %.6g", (double)back[1] - front[1]);
     CHECK(front[1] < 0.0f, "the leaf's front pole faces -y (the camera)");
     /* Cupped toward the viewer: the rim's sides come forward (more negative y) than the middle. */
@@ -141,21 +141,21 @@ static void test_leaf(void)
             u += leaf.uvs[6u * t + 2u * k] / 3.0;
             for (int d = 0; d < 3; ++d) centroid[d] += leaf.positions[3u * leaf.indices[3u * t + k] + d] / 3.0;
         }
-        double R = DWVIO_LEAF_BEND_RADIUS;
+        double R = DWVS_LEAF_BEND_RADIUS;
         int is_front = hypot(centroid[0], centroid[1] + R) < R;
         if ((u < 0.5) != is_front) sides_ok = 0;
     }
     CHECK(sides_ok, "leaf UV islands do not follow the front and back faces");
-    dwvio_mesh_data_free(&leaf);
+    dwvs_mesh_data_free(&leaf);
 }
 
 static void test_block(void)
 {
-    dwvio_mesh_data block;
-    CHECK(dwvio_default_block(&block) == 0, "block");
+    dwvs_mesh_data block;
+    CHECK(dwvs_default_block(&block) == 0, "block");
     CHECK(closed_manifold(&block), "the block is not a closed, consistently wound surface");
     /* |x|^4 + |y|^4 + |z|^4 <= 1 has volume 8 Gamma(5/4)^3 / Gamma(7/4). */
-    double abc = DWVIO_BLOCK_HALF_SIZE_X * DWVIO_BLOCK_HALF_SIZE_Y * DWVIO_BLOCK_HALF_SIZE_Z;
+    double abc = DWVS_BLOCK_HALF_SIZE_X * DWVS_BLOCK_HALF_SIZE_Y * DWVS_BLOCK_HALF_SIZE_Z;
     double expected = 8.0 * pow(tgamma(1.25), 3) / tgamma(1.75) * abc, volume = signed_volume(&block);
     CHECK(fabs(volume / expected - 1.0) < 0.01, "block volume %.6g, expected %.6g", volume, expected);
     double worst;
@@ -164,7 +164,7 @@ static void test_block(void)
     CHECK(smallest_area(&block) > 1e-8, "a block triangle of area %.3g m^2", smallest_area(&block));
     CHECK(block.vertex_count == 6u * 24u * 24u + 2u, "welded block has %u vertices (a closed cube grid has 6 n^2 + 2)",
           block.vertex_count);
-    dwvio_mesh_data_free(&block);
+    dwvs_mesh_data_free(&block);
 }
 
 static void test_default_scene(void)
@@ -175,8 +175,8 @@ static void test_default_scene(void)
     if (!scene) return;
     const dwvb_scene *s = store(scene);
     CHECK(s->committed, "not committed");
-    CHECK(s->mesh_count == DWVIO_DEFAULT_MESHES && s->material_count == DWVIO_DEFAULT_MATERIALS &&
-              s->light_count == DWVIO_DEFAULT_LIGHTS && s->have_camera,
+    CHECK(s->mesh_count == DWVS_DEFAULT_MESHES && s->material_count == DWVS_DEFAULT_MATERIALS &&
+              s->light_count == DWVS_DEFAULT_LIGHTS && s->have_camera,
           "counts: %u meshes, %u materials, %u lights, camera %d", s->mesh_count, s->material_count, s->light_count,
           s->have_camera);
     CHECK(s->lights[0].kind == DWV_LIGHT_SUN && s->lights[1].kind == DWV_LIGHT_AREA_RECTANGLE, "light kinds");
@@ -186,9 +186,9 @@ static void test_default_scene(void)
     /* The leaf is thin: a few Cycles mean free paths (radius x scale / (4 pi)) thick. */
     for (int c = 0; c < 3; ++c) {
         double mfp = s->materials[0].subsurface_radius[c] * s->materials[0].subsurface_scale / (4.0 * PI);
-        double paths = DWVIO_LEAF_THICKNESS / mfp;
+        double paths = DWVS_LEAF_THICKNESS / mfp;
         CHECK(paths > 2.0 && paths < 8.0, "leaf channel %d: %.3g mean free paths thick", c, paths);
-        double block_paths = 2.0 * DWVIO_BLOCK_HALF_SIZE_Y / (s->materials[1].subsurface_radius[c] *
+        double block_paths = 2.0 * DWVS_BLOCK_HALF_SIZE_Y / (s->materials[1].subsurface_radius[c] *
                                                                s->materials[1].subsurface_scale / (4.0 * PI));
         CHECK(block_paths > 5.0, "block channel %d: only %.3g mean free paths across", c, block_paths);
     }

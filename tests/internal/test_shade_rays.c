@@ -38,7 +38,7 @@
 #include "bake_scenes.h"
 #include "brute_force.h"
 #include "check.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 #include "geom/embree.h"
 #include "light/direct.h"
 
@@ -59,10 +59,10 @@ static int same_hit(int found_a, const dwvg_hit *a, int found_b, const dwvg_hit 
 }
 
 /* A unit direction about unit n, cosine-weighted (as the entry's). */
-static dwvw_vec3 about(dwvw_vec3 n, uint64_t *state)
+static dwvu_vec3 about(dwvu_vec3 n, uint64_t *state)
 {
     double mu = sqrt(brute_uniform(state));
-    return dwvw_direction_about(n, mu, 1.0 - mu, 1.0 + mu, brute_uniform(state));
+    return dwvk_direction_about(n, mu, 1.0 - mu, 1.0 + mu, brute_uniform(state));
 }
 
 /* --- 1. the probe ------------------------------------------------------------------------- */
@@ -90,8 +90,8 @@ static void check_leaving(const char *name, const test_mesh *m)
             u = 1.0 - u;
             v = 1.0 - v;
         }
-        dwvw_vec3 x = dwvg_point(&mesh, prim, u, v);
-        dwvw_vec3 d = about(dwvw_scale(dwvg_geometric_normal(&mesh, prim), -1.0), &state);
+        dwvu_vec3 x = dwvg_point(&mesh, prim, u, v);
+        dwvu_vec3 d = about(dwvu_scale(dwvg_geometric_normal(&mesh, prim), -1.0), &state);
         /* The loop, as run_walk cast it before. */
         dwvg_hit loop;
         int found_loop;
@@ -158,14 +158,14 @@ static void check_one_mesh(void)
     int rays = 6000, same = 0, same_occluded = 0, hits = 0, occluded = 0;
     for (int i = 0; i < rays; ++i) {
         /* From a shell around the sphere, aimed at it or past it; every fourth along an axis. */
-        dwvw_vec3 o = dwvw_scale(about(dwvw_v(0.0, 0.0, 1.0), &state), 1.2 + 2.0 * brute_uniform(&state));
-        if (brute_uniform(&state) < 0.5) o = dwvw_scale(o, -1.0);
-        dwvw_vec3 d = dwvw_normalize(dwvw_sub(dwvw_scale(about(dwvw_v(1.0, 0.0, 0.0), &state), 1.6 * brute_uniform(&state)), o));
+        dwvu_vec3 o = dwvu_scale(about(dwvu_v(0.0, 0.0, 1.0), &state), 1.2 + 2.0 * brute_uniform(&state));
+        if (brute_uniform(&state) < 0.5) o = dwvu_scale(o, -1.0);
+        dwvu_vec3 d = dwvu_normalize(dwvu_sub(dwvu_scale(about(dwvu_v(1.0, 0.0, 0.0), &state), 1.6 * brute_uniform(&state)), o));
         if (i % 4 == 0) {
             int axis = (i / 4) % 3;
             double sign = (i / 12) % 2 ? 1.0 : -1.0;
-            d = dwvw_v(axis == 0 ? sign : -0.0, axis == 1 ? sign : 0.0, axis == 2 ? sign : -0.0);
-            o = dwvw_v(axis == 0 ? -2.0 * sign : 1.4 * brute_uniform(&state), axis == 1 ? -2.0 * sign : 0.0,
+            d = dwvu_v(axis == 0 ? sign : -0.0, axis == 1 ? sign : 0.0, axis == 2 ? sign : -0.0);
+            o = dwvu_v(axis == 0 ? -2.0 * sign : 1.4 * brute_uniform(&state), axis == 1 ? -2.0 * sign : 0.0,
                        axis == 2 ? -2.0 * sign : -1.4 * brute_uniform(&state));
         }
         double tfar = 4.0 * brute_uniform(&state);
@@ -201,7 +201,7 @@ static void check_planes(void)
     uint64_t state = 3u;
     int points = 20000, below = 0, inside = 0, exact_inside = 0;
     for (int i = 0; i < points; ++i) {
-        dwvw_vec3 p = dwvw_v(-2.2 + 4.4 * brute_uniform(&state), -1.2 + 2.4 * brute_uniform(&state),
+        dwvu_vec3 p = dwvu_v(-2.2 + 4.4 * brute_uniform(&state), -1.2 + 2.4 * brute_uniform(&state),
                              -0.03 + 0.06 * brute_uniform(&state));
         double exact = INFINITY;
         for (uint32_t t = 0; t < box.triangle_count; ++t) exact = fmin(exact, brute_triangle_distance(&box, t, p, NULL));
@@ -215,7 +215,7 @@ static void check_planes(void)
     CHECK(below == points && inside > 1000 && exact_inside == inside,
           "box: the planes' bound %d of %d times at most the distance (and above a floor as asked), exact at %d of %d inside", below, points,
           exact_inside, inside);
-    CHECK(dwvg_clearance_at(&c, dwvw_v(NAN, 0.0, 0.0)) == 0.0 && dwvg_clearance_at(&c, dwvw_v(0.0, INFINITY, 0.0)) == 0.0,
+    CHECK(dwvg_clearance_at(&c, dwvu_v(NAN, 0.0, 0.0)) == 0.0 && dwvg_clearance_at(&c, dwvu_v(0.0, INFINITY, 0.0)) == 0.0,
           "box: a point not finite has clearance 0");
     dwvg_clearance_free(&c);
     dwvg_mesh_free(&box);
@@ -238,7 +238,7 @@ static void check_planes(void)
         size_t cells = (size_t)c.n[0] * c.n[1] * c.n[2];
         for (size_t i = 0; i < cells; ++i) reached += (double)c.lower[i] == c.largest;
         for (int i = 0; i < points; ++i) {
-            dwvw_vec3 p = dwvw_v(-1.2 + 2.4 * brute_uniform(&state), -1.2 + 2.4 * brute_uniform(&state),
+            dwvu_vec3 p = dwvu_v(-1.2 + 2.4 * brute_uniform(&state), -1.2 + 2.4 * brute_uniform(&state),
                                  -1.2 + 2.4 * brute_uniform(&state));
             double bound = dwvg_clearance_at(&c, p), floor = 0.3 * brute_uniform(&state);
             above += bound > c.largest || dwvg_clearance_above(&c, p, floor) != (bound > floor ? bound : 0.0);
@@ -269,9 +269,9 @@ static void check_tops(const char *name, const dwvg_mesh *meshes, uint32_t count
     CHECK(world.tops != NULL, "%s: no tops", name);
     int on_plane = 0, triangles = 0;
     for (uint32_t t = 0; t < meshes[0].triangle_count; ++t) {
-        dwvw_vec3 n = dwvg_geometric_normal(&meshes[0], t);
+        dwvu_vec3 n = dwvg_geometric_normal(&meshes[0], t);
         const float *a = meshes[0].positions + 3u * meshes[0].indices[3u * t];
-        double plane = dwvw_dot(n, dwvw_v(a[0], a[1], a[2]));
+        double plane = dwvu_dot(n, dwvu_v(a[0], a[1], a[2]));
         on_plane += fabs(dwvg_world_top(&world, 0u, t) - plane) <= 1e-6;
         ++triangles;
     }
@@ -287,11 +287,11 @@ static void check_tops(const char *name, const dwvg_mesh *meshes, uint32_t count
             u = 1.0 - u;
             v = 1.0 - v;
         }
-        dwvw_vec3 x = dwvg_point(mesh, prim, u, v), ng = dwvg_geometric_normal(mesh, prim);
+        dwvu_vec3 x = dwvg_point(mesh, prim, u, v), ng = dwvg_geometric_normal(mesh, prim);
         /* A sun whose disc reaches from the normal's side down to grazing and below. */
-        dwvw_vec3 to_sun = about(ng, &state);
+        dwvu_vec3 to_sun = about(ng, &state);
         double tilt = brute_uniform(&state);
-        to_sun = dwvw_normalize(dwvw_madd(to_sun, ng, -tilt * dwvw_dot(to_sun, ng) * 1.1));
+        to_sun = dwvu_normalize(dwvu_madd(to_sun, ng, -tilt * dwvu_dot(to_sun, ng) * 1.1));
         dwv_light_desc_t desc = DWV_LIGHT_DESC_INIT;
         for (int k = 0; k < 3; ++k) desc.direction[k] = -(k == 0 ? to_sun.x : k == 1 ? to_sun.y : to_sun.z);
         desc.angle = 10.0 * 3.14159265358979323846 / 180.0;
@@ -350,15 +350,15 @@ static void check_clear_radius(void)
         double largest = fmax(fabs(c[0]), fmax(fabs(c[1]), fabs(c[2]))) + clearance;
         double radius = clearance - (world.epsilon + 0x1p-17 * largest);
         double reference = radius > 0.0 && radius < INFINITY ? radius : 0.0;
-        double got = dwvg_clear_radius(&world, dwvw_v(c[0], c[1], c[2]), clearance);
+        double got = dwvg_clear_radius(&world, dwvu_v(c[0], c[1], c[2]), clearance);
         same += memcmp(&got, &reference, sizeof got) == 0;
         positive += got > 0.0;
     }
     CHECK(same == points && positive > points / 2, "clear radius: %d of %d as with fmax (%d positive)", same, points,
           positive);
-    CHECK(dwvg_clear_radius(&world, dwvw_v(0.0, NAN, 0.0), 0.1) == 0.0 &&
-              dwvg_clear_radius(&world, dwvw_v(0.0, 0.0, NAN), 0.1) == 0.0 &&
-              dwvg_clear_radius(&world, dwvw_v(INFINITY, 0.0, 0.0), 0.1) == 0.0,
+    CHECK(dwvg_clear_radius(&world, dwvu_v(0.0, NAN, 0.0), 0.1) == 0.0 &&
+              dwvg_clear_radius(&world, dwvu_v(0.0, 0.0, NAN), 0.1) == 0.0 &&
+              dwvg_clear_radius(&world, dwvu_v(INFINITY, 0.0, 0.0), 0.1) == 0.0,
           "clear radius: a centre not finite gets 0");
 }
 
@@ -433,10 +433,10 @@ static void check_polytopes(void)
     uint64_t state = 31u;
     int rays = 20000, agree = 0, found = 0, inside = 0;
     for (int i = 0; i < rays; ++i) {
-        dwvw_vec3 o = dwvw_v(-1.99 + 3.98 * brute_uniform(&state), -1.99 + 3.98 * brute_uniform(&state),
+        dwvu_vec3 o = dwvu_v(-1.99 + 3.98 * brute_uniform(&state), -1.99 + 3.98 * brute_uniform(&state),
                              -0.0099 + 0.0198 * brute_uniform(&state));
-        dwvw_vec3 d = about(dwvw_v(0.0, 0.0, brute_uniform(&state) < 0.5 ? 1.0 : -1.0), &state);
-        if (i % 3 == 0) d = dwvw_normalize(dwvw_v(brute_uniform(&state) - 0.5, brute_uniform(&state) - 0.5, 1e-3 * (brute_uniform(&state) - 0.5)));
+        dwvu_vec3 d = about(dwvu_v(0.0, 0.0, brute_uniform(&state) < 0.5 ? 1.0 : -1.0), &state);
+        if (i % 3 == 0) d = dwvu_normalize(dwvu_v(brute_uniform(&state) - 0.5, brute_uniform(&state) - 0.5, 1e-3 * (brute_uniform(&state) - 0.5)));
         double tfar = i % 2 ? INFINITY : 0.05 * brute_uniform(&state);
         dwvg_hit a, e;
         world.polytopes[0] = planes;
@@ -449,7 +449,7 @@ static void check_polytopes(void)
             ++agree;
             continue;
         }
-        dwvw_vec3 na = dwvg_geometric_normal(&box, a.prim), ne = dwvg_geometric_normal(&box, e.prim);
+        dwvu_vec3 na = dwvg_geometric_normal(&box, a.prim), ne = dwvg_geometric_normal(&box, e.prim);
         agree += na.x == ne.x && na.y == ne.y && na.z == ne.z && fabs(a.t - e.t) <= 1e-6 * (1.0 + e.t);
         inside += a.u >= -1e-9 && a.v >= -1e-9 && a.u + a.v <= 1.0 + 1e-9;
     }
@@ -465,15 +465,15 @@ static void check_polytopes(void)
             u = 1.0 - u;
             v = 1.0 - v;
         }
-        dwvw_vec3 x = dwvg_point(&box, prim, u, v);
-        dwvw_vec3 d = about(dwvw_scale(dwvg_geometric_normal(&box, prim), -1.0), &state);
+        dwvu_vec3 x = dwvg_point(&box, prim, u, v);
+        dwvu_vec3 d = about(dwvu_scale(dwvg_geometric_normal(&box, prim), -1.0), &state);
         dwvg_hit a, e;
         uint32_t count = 0;
         int found_a = dwvg_intersect_mesh_leaving(&world, 0u, x, d, prim, INFINITY, &a, &count);
         world.polytopes[0].plane_count = 0;
         int found_e = dwvg_intersect_mesh_leaving(&world, 0u, x, d, prim, INFINITY, &e, &count);
         world.polytopes[0] = planes;
-        dwvw_vec3 na = dwvg_geometric_normal(&box, a.prim), ne = dwvg_geometric_normal(&box, e.prim);
+        dwvu_vec3 na = dwvg_geometric_normal(&box, a.prim), ne = dwvg_geometric_normal(&box, e.prim);
         probes_agree += found_a && found_e && na.x == ne.x && na.y == ne.y && na.z == ne.z &&
                         fabs(a.t - e.t) <= 1e-6 * (1.0 + e.t);
     }
@@ -481,21 +481,21 @@ static void check_polytopes(void)
     /* Camera rays (dwvg_intersect) from around the box and from inside it. */
     int cameras = 20000, cameras_agree = 0, cameras_hit = 0;
     for (int i = 0; i < cameras; ++i) {
-        dwvw_vec3 o, d;
+        dwvu_vec3 o, d;
         if (i % 4) {
-            o = dwvw_scale(about(dwvw_v(0.0, 0.0, 1.0), &state), 3.0);
-            if (i % 2) o = dwvw_scale(o, -1.0);
-            d = dwvw_normalize(dwvw_sub(dwvw_v(5.0 * brute_uniform(&state) - 2.5, 5.0 * brute_uniform(&state) - 2.5, 0.0), o));
+            o = dwvu_scale(about(dwvu_v(0.0, 0.0, 1.0), &state), 3.0);
+            if (i % 2) o = dwvu_scale(o, -1.0);
+            d = dwvu_normalize(dwvu_sub(dwvu_v(5.0 * brute_uniform(&state) - 2.5, 5.0 * brute_uniform(&state) - 2.5, 0.0), o));
         } else {
-            o = dwvw_v(3.0 * brute_uniform(&state) - 1.5, 3.0 * brute_uniform(&state) - 1.5, 0.018 * brute_uniform(&state) - 0.009);
-            d = about(dwvw_v(0.0, 0.0, 1.0), &state);
+            o = dwvu_v(3.0 * brute_uniform(&state) - 1.5, 3.0 * brute_uniform(&state) - 1.5, 0.018 * brute_uniform(&state) - 0.009);
+            d = about(dwvu_v(0.0, 0.0, 1.0), &state);
         }
         dwvg_hit a, e;
         int found_a = dwvg_intersect(&world, o, d, 0.0, INFINITY, &a);
         world.polytopes[0].plane_count = 0;
         int found_e = dwvg_intersect(&world, o, d, 0.0, INFINITY, &e);
         world.polytopes[0] = planes;
-        dwvw_vec3 na = dwvg_geometric_normal(&box, found_a ? a.prim : 0u), ne = dwvg_geometric_normal(&box, found_e ? e.prim : 0u);
+        dwvu_vec3 na = dwvg_geometric_normal(&box, found_a ? a.prim : 0u), ne = dwvg_geometric_normal(&box, found_e ? e.prim : 0u);
         cameras_agree += found_a == found_e && (!found_a || (na.x == ne.x && na.y == ne.y && na.z == ne.z &&
                                                             fabs(a.t - e.t) <= 1e-6 * (1.0 + e.t)));
         cameras_hit += found_a;
@@ -539,28 +539,28 @@ static void check_suns_below(void)
     int normals = 3000, below = 0, far_below = 0, wrong = 0, rising = 0;
     for (int i = 0; i < normals; ++i) {
         dwv_light_desc_t desc = DWV_LIGHT_DESC_INIT;
-        dwvw_vec3 d = about(dwvw_v(0.0, 0.0, brute_uniform(&state) < 0.5 ? 1.0 : -1.0), &state);
+        dwvu_vec3 d = about(dwvu_v(0.0, 0.0, brute_uniform(&state) < 0.5 ? 1.0 : -1.0), &state);
         desc.direction[0] = d.x;
         desc.direction[1] = d.y;
         desc.direction[2] = d.z;
         desc.angle = (i % 3) * 0.25; /* 0, 14 and 29 degrees across */
         dwvl_light sun;
         dwvl_light_init(&sun, &desc);
-        dwvw_vec3 n = about(dwvw_v(1.0, 0.0, 0.0), &state);
-        if (brute_uniform(&state) < 0.5) n = dwvw_scale(n, -1.0);
+        dwvu_vec3 n = about(dwvu_v(1.0, 0.0, 0.0), &state);
+        if (brute_uniform(&state) < 0.5) n = dwvu_scale(n, -1.0);
         int says = dwvl_light_below(&sun, n);
         below += says;
         /* Directions of the disc (half-angle angle / 2) are within the chord 2 sin(angle / 4) of
          * its centre: all below once the centre is that far below. */
-        if (dwvw_dot(n, sun.direction) < -2.0 * sin(0.25 * desc.angle) - 1e-6) {
+        if (dwvu_dot(n, sun.direction) < -2.0 * sin(0.25 * desc.angle) - 1e-6) {
             ++far_below;
             wrong += !says;
         }
         if (!says) continue;
         for (int k = 0; k < 200; ++k) {
             dwvl_sample sample;
-            dwvl_light_sample(&sun, dwvw_v(0.0, 0.0, 0.0), brute_uniform(&state), brute_uniform(&state), &sample);
-            rising += dwvw_dot(n, sample.direction) >= 0.0;
+            dwvl_light_sample(&sun, dwvu_v(0.0, 0.0, 0.0), brute_uniform(&state), brute_uniform(&state), &sample);
+            rising += dwvu_dot(n, sample.direction) >= 0.0;
         }
     }
     CHECK(rising == 0 && below > normals / 8 && wrong == 0 && far_below >= below,

@@ -31,10 +31,10 @@
 /* Cycles' default "Shadow Terminator > Geometry Offset". */
 static const double CYCLES_GEOMETRY_OFFSET = 0.1;
 
-static dwvw_vec3 unit_vector(uint64_t *state)
+static dwvu_vec3 unit_vector(uint64_t *state)
 {
     double z = 2.0 * brute_uniform(state) - 1.0, r = sqrt(fmax(0.0, 1.0 - z * z)), phi = 6.283185307179586 * brute_uniform(state);
-    return dwvw_v(r * cos(phi), r * sin(phi), z);
+    return dwvu_v(r * cos(phi), r * sin(phi), z);
 }
 
 static void random_barycentrics(uint64_t *state, double b[3])
@@ -45,42 +45,42 @@ static void random_barycentrics(uint64_t *state, double b[3])
     b[0] = 1.0 - b[1] - b[2];
 }
 
-static double distance(dwvw_vec3 a, dwvw_vec3 b)
+static double distance(dwvu_vec3 a, dwvu_vec3 b)
 {
-    return dwvw_length(dwvw_sub(a, b));
+    return dwvu_length(dwvu_sub(a, b));
 }
 
 static void test_flat(void)
 {
     uint64_t state = 1u;
     for (int trial = 0; trial < 200; ++trial) {
-        dwvw_vec3 v[3] = {unit_vector(&state), unit_vector(&state), unit_vector(&state)};
-        dwvw_vec3 ng = dwvw_normalize(
-            dwvw_v((v[1].y - v[0].y) * (v[2].z - v[0].z) - (v[1].z - v[0].z) * (v[2].y - v[0].y),
+        dwvu_vec3 v[3] = {unit_vector(&state), unit_vector(&state), unit_vector(&state)};
+        dwvu_vec3 ng = dwvu_normalize(
+            dwvu_v((v[1].y - v[0].y) * (v[2].z - v[0].z) - (v[1].z - v[0].z) * (v[2].y - v[0].y),
                    (v[1].z - v[0].z) * (v[2].x - v[0].x) - (v[1].x - v[0].x) * (v[2].z - v[0].z),
                    (v[1].x - v[0].x) * (v[2].y - v[0].y) - (v[1].y - v[0].y) * (v[2].x - v[0].x)));
-        dwvw_vec3 flat[3] = {ng, ng, ng};
+        dwvu_vec3 flat[3] = {ng, ng, ng};
         double b[3];
         random_barycentrics(&state, b);
-        dwvw_vec3 lift = dwvl_terminator_lift(v, flat, b, ng);
-        CHECK(dwvw_length(lift) < 1e-12, "trial %d: a flat triangle is lifted by %g", trial, dwvw_length(lift));
+        dwvu_vec3 lift = dwvl_terminator_lift(v, flat, b, ng);
+        CHECK(dwvu_length(lift) < 1e-12, "trial %d: a flat triangle is lifted by %g", trial, dwvu_length(lift));
     }
 }
 
 static void test_cylinder_patch(void)
 {
     const double s = 0.6, c = 0.8;
-    dwvw_vec3 v[3] = {dwvw_v(0.0, 0.0, 0.0), dwvw_v(1.0, 0.0, 0.0), dwvw_v(0.0, 1.0, 0.0)};
-    dwvw_vec3 n[3] = {dwvw_v(-s, 0.0, c), dwvw_v(s, 0.0, c), dwvw_v(-s, 0.0, c)};
-    dwvw_vec3 ng = dwvw_v(0.0, 0.0, 1.0);
+    dwvu_vec3 v[3] = {dwvu_v(0.0, 0.0, 0.0), dwvu_v(1.0, 0.0, 0.0), dwvu_v(0.0, 1.0, 0.0)};
+    dwvu_vec3 n[3] = {dwvu_v(-s, 0.0, c), dwvu_v(s, 0.0, c), dwvu_v(-s, 0.0, c)};
+    dwvu_vec3 ng = dwvu_v(0.0, 0.0, 1.0);
     /* Hand-computed: (0.25, 0.5, 0.25): h = 0.5 s = 0.3, normal (0, 0, 0.8): lift (0, 0, 0.24);
      * (0.5, 0.25, 0.25): h = 0.25 s = 0.15, normal (-0.3, 0, 0.8): lift (-0.045, 0, 0.12). */
     double b1[3] = {0.25, 0.5, 0.25}, b2[3] = {0.5, 0.25, 0.25};
-    dwvw_vec3 lift = dwvl_terminator_lift(v, n, b1, ng);
-    CHECK(distance(lift, dwvw_v(0.0, 0.0, 0.24)) < 1e-12, "ridge: lift (%g, %g, %g), expected (0, 0, 0.24)", lift.x,
+    dwvu_vec3 lift = dwvl_terminator_lift(v, n, b1, ng);
+    CHECK(distance(lift, dwvu_v(0.0, 0.0, 0.24)) < 1e-12, "ridge: lift (%g, %g, %g), expected (0, 0, 0.24)", lift.x,
           lift.y, lift.z);
     lift = dwvl_terminator_lift(v, n, b2, ng);
-    CHECK(distance(lift, dwvw_v(-0.045, 0.0, 0.12)) < 1e-12, "side: lift (%g, %g, %g), expected (-0.045, 0, 0.12)",
+    CHECK(distance(lift, dwvu_v(-0.045, 0.0, 0.12)) < 1e-12, "side: lift (%g, %g, %g), expected (-0.045, 0, 0.12)",
           lift.x, lift.y, lift.z);
     /* Everywhere on it: h = s min(b1, 1 - b1) along (s (2 b1 - 1), 0, c). */
     uint64_t state = 7u;
@@ -89,12 +89,12 @@ static void test_cylinder_patch(void)
         double b[3];
         random_barycentrics(&state, b);
         double h = s * fmin(b[1], 1.0 - b[1]);
-        dwvw_vec3 expected = dwvw_scale(dwvw_v(s * (2.0 * b[1] - 1.0), 0.0, c), h);
+        dwvu_vec3 expected = dwvu_scale(dwvu_v(s * (2.0 * b[1] - 1.0), 0.0, c), h);
         worst = fmax(worst, distance(dwvl_terminator_lift(v, n, b, ng), expected));
     }
     CHECK(worst < 1e-12, "the curved patch's lift is off its closed form by up to %g", worst);
     /* Concave (s < 0): the envelope's rises lift it as the convex one, never below the plane. */
-    dwvw_vec3 concave[3] = {dwvw_v(s, 0.0, c), dwvw_v(-s, 0.0, c), dwvw_v(s, 0.0, c)};
+    dwvu_vec3 concave[3] = {dwvu_v(s, 0.0, c), dwvu_v(-s, 0.0, c), dwvu_v(s, 0.0, c)};
     lift = dwvl_terminator_lift(v, concave, b1, ng);
     CHECK(lift.z >= 0.0, "concave patch: lift (%g, %g, %g) goes inward", lift.x, lift.y, lift.z);
 }
@@ -106,37 +106,37 @@ static void test_outward(void)
     double worst_inward = 0.0, worst_mirror = 0.0, worst_corner = 0.0;
     for (int trial = 0; trial < trials; ++trial) {
         /* A small triangle on the unit sphere, its normals the sphere's. */
-        dwvw_vec3 centre = unit_vector(&state);
-        dwvw_vec3 v[3], n[3];
+        dwvu_vec3 centre = unit_vector(&state);
+        dwvu_vec3 v[3], n[3];
         for (int k = 0; k < 3; ++k) {
-            n[k] = dwvw_normalize(dwvw_madd(centre, unit_vector(&state), 0.3));
+            n[k] = dwvu_normalize(dwvu_madd(centre, unit_vector(&state), 0.3));
             v[k] = n[k];
         }
-        dwvw_vec3 e1 = dwvw_sub(v[1], v[0]), e2 = dwvw_sub(v[2], v[0]);
-        dwvw_vec3 ng = dwvw_v(e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x);
-        if (!(dwvw_length(ng) > 1e-6)) continue;
-        ng = dwvw_normalize(ng);
-        if (dwvw_dot(ng, centre) < 0.0) ng = dwvw_scale(ng, -1.0); /* outward */
+        dwvu_vec3 e1 = dwvu_sub(v[1], v[0]), e2 = dwvu_sub(v[2], v[0]);
+        dwvu_vec3 ng = dwvu_v(e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x);
+        if (!(dwvu_length(ng) > 1e-6)) continue;
+        ng = dwvu_normalize(ng);
+        if (dwvu_dot(ng, centre) < 0.0) ng = dwvu_scale(ng, -1.0); /* outward */
         /* A sliver's plane cuts the sphere in a wide circle and its normal is far from the
          * vertices': keep the triangles the sphere's patches resemble. */
-        if (fmin(fmin(dwvw_dot(n[0], ng), dwvw_dot(n[1], ng)), dwvw_dot(n[2], ng)) < 0.9) continue;
+        if (fmin(fmin(dwvu_dot(n[0], ng), dwvu_dot(n[1], ng)), dwvu_dot(n[2], ng)) < 0.9) continue;
         ++convex;
         double b[3];
         random_barycentrics(&state, b);
-        dwvw_vec3 lift = dwvl_terminator_lift(v, n, b, ng);
-        worst_inward = fmin(worst_inward, dwvw_dot(lift, ng));
-        interior_lifted += dwvw_dot(lift, ng) > 0.0;
+        dwvu_vec3 lift = dwvl_terminator_lift(v, n, b, ng);
+        worst_inward = fmin(worst_inward, dwvu_dot(lift, ng));
+        interior_lifted += dwvu_dot(lift, ng) > 0.0;
         /* Its corners stay where they are (the triangle lies below every corner's tangent plane). */
         for (int k = 0; k < 3; ++k) {
             double corner[3] = {k == 0, k == 1, k == 2};
-            worst_corner = fmax(worst_corner, dwvw_length(dwvl_terminator_lift(v, n, corner, ng)));
+            worst_corner = fmax(worst_corner, dwvu_length(dwvl_terminator_lift(v, n, corner, ng)));
         }
         /* Random normals (not a convex patch): still never inward. */
-        dwvw_vec3 m[3] = {unit_vector(&state), unit_vector(&state), unit_vector(&state)};
+        dwvu_vec3 m[3] = {unit_vector(&state), unit_vector(&state), unit_vector(&state)};
         lift = dwvl_terminator_lift(v, m, b, ng);
-        worst_inward = fmin(worst_inward, dwvw_dot(lift, ng));
+        worst_inward = fmin(worst_inward, dwvu_dot(lift, ng));
         /* Only the side being shaded matters, not which way the stored normals point. */
-        dwvw_vec3 reversed[3] = {dwvw_scale(m[0], -1.0), dwvw_scale(m[1], -1.0), dwvw_scale(m[2], -1.0)};
+        dwvu_vec3 reversed[3] = {dwvu_scale(m[0], -1.0), dwvu_scale(m[1], -1.0), dwvu_scale(m[2], -1.0)};
         worst_mirror = fmax(worst_mirror, distance(dwvl_terminator_lift(v, reversed, b, ng), lift));
     }
     CHECK(worst_inward >= 0.0, "a lift goes inward by %g", -worst_inward);
@@ -145,11 +145,11 @@ static void test_outward(void)
     CHECK(convex > trials / 2 && interior_lifted == convex, "only %d of %d points inside convex triangles are lifted",
           interior_lifted, convex);
     /* A zero vertex normal (no smooth normal there): no lift. */
-    dwvw_vec3 v[3] = {dwvw_v(0.0, 0.0, 0.0), dwvw_v(1.0, 0.0, 0.0), dwvw_v(0.0, 1.0, 0.0)};
-    dwvw_vec3 n[3] = {dwvw_v(-0.6, 0.0, 0.8), dwvw_v(0.0, 0.0, 0.0), dwvw_v(-0.6, 0.0, 0.8)};
+    dwvu_vec3 v[3] = {dwvu_v(0.0, 0.0, 0.0), dwvu_v(1.0, 0.0, 0.0), dwvu_v(0.0, 1.0, 0.0)};
+    dwvu_vec3 n[3] = {dwvu_v(-0.6, 0.0, 0.8), dwvu_v(0.0, 0.0, 0.0), dwvu_v(-0.6, 0.0, 0.8)};
     double b[3] = {1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0};
-    dwvw_vec3 lift = dwvl_terminator_lift(v, n, b, dwvw_v(0.0, 0.0, 1.0));
-    CHECK(dwvw_length(lift) == 0.0, "a zero vertex normal still lifts by %g", dwvw_length(lift));
+    dwvu_vec3 lift = dwvl_terminator_lift(v, n, b, dwvu_v(0.0, 0.0, 1.0));
+    CHECK(dwvu_length(lift) == 0.0, "a zero vertex normal still lifts by %g", dwvu_length(lift));
 }
 
 static void test_amount(void)
@@ -240,19 +240,19 @@ static void test_sphere_terminator(void)
     dwvl_light sun;
     dwvl_light_init(&sun, &desc);
     dwvl_environment env = {&sun, 1u, {0.0, 0.0, 0.0}, 0, &world};
-    dwvw_vec3 to_sun = dwvw_v(1.0, 0.0, 0.0);
+    dwvu_vec3 to_sun = dwvu_v(1.0, 0.0, 0.0);
     int below = 0, below_lit_flat = 0, below_lit_smooth = 0, lit = 0, lit_changed = 0;
     uint64_t state = 5u;
     dwvk_sampler sampler = {.key = 1u, .index = 0u, .stratified = 0};
     for (uint32_t prim = 0; prim < mesh.triangle_count; ++prim) {
-        dwvw_vec3 ng = dwvg_geometric_normal(&mesh, prim);
+        dwvu_vec3 ng = dwvg_geometric_normal(&mesh, prim);
         if (ng.x == 0.0 && ng.y == 0.0 && ng.z == 0.0) continue; /* the poles' degenerate triangles */
         for (int k = 0; k < 20; ++k) {
             double b[3];
             random_barycentrics(&state, b);
-            dwvw_vec3 x = dwvg_point(&mesh, prim, b[1], b[2]);
-            dwvw_vec3 n = dwvg_shading_normal(&mesh, prim, b[1], b[2], ng);
-            double cos_n = dwvw_dot(n, to_sun), cos_g = dwvw_dot(ng, to_sun);
+            dwvu_vec3 x = dwvg_point(&mesh, prim, b[1], b[2]);
+            dwvu_vec3 n = dwvg_shading_normal(&mesh, prim, b[1], b[2], ng);
+            double cos_n = dwvu_dot(n, to_sun), cos_g = dwvu_dot(ng, to_sun);
             if (!(cos_n > 0.0)) continue;
             dwvl_terminator terminator = {&mesh, prim, b[1], b[2], CYCLES_GEOMETRY_OFFSET};
             double flat[3], smooth[3];

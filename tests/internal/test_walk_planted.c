@@ -15,7 +15,7 @@
 #include <string.h>
 
 #include "check.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 #include "kernel/rng.h"
 #include "walk/estimate.h"
 #include "walk/geometry.h"
@@ -82,7 +82,7 @@ static run_result run_walks(const dwvw_medium *medium, const dwvw_guide *guide, 
                             double pdf_factor)
 {
     const dwvw_shape halfspace = {DWVW_HALFSPACE, 0.0, 0.0};
-    const dwvw_vec3 origin = {0.0, 0.0, 0.0}, inward = {0.0, 0.0, 1.0}, outward = {0.0, 0.0, -1.0};
+    const dwvu_vec3 origin = {0.0, 0.0, 0.0}, inward = {0.0, 0.0, 1.0}, outward = {0.0, 0.0, -1.0};
     int needs_closest = dwvw_guide_needs_closest(guide);
     double sum = 0.0, sum_squares = 0.0;
     run_result result = {0.0, 0.0, 0u};
@@ -91,12 +91,12 @@ static run_result run_walks(const dwvw_medium *medium, const dwvw_guide *guide, 
         dwvw_walk_begin(&walk, medium, guide, dwvk_rng_key(seed, i, 0), 1000000u, origin, inward, outward);
         while (walk.status == DWVW_RUNNING) {
             if (needs_closest) {
-                dwvw_vec3 n;
+                dwvu_vec3 n;
                 dwvw_shape_closest(&halfspace, walk.position, &n);
                 dwvw_walk_set_closest(&walk, n);
             }
             dwvw_walk_sample(&walk);
-            dwvw_vec3 hit_normal;
+            dwvu_vec3 hit_normal;
             double hit = dwvw_shape_exit(&halfspace, walk.position, walk.direction, &hit_normal);
             for (int k = 1; k < walk.component_count; ++k) walk.component_pdf[k] *= pdf_factor;
             dwvw_walk_complete(&walk, hit, hit_normal);

@@ -131,19 +131,19 @@ static double uniform(uint64_t key, uint32_t *dim)
     return dwvk_rng_uniform_d(key, (*dim)++);
 }
 
-static dwvw_vec3 random_unit(uint64_t key, uint32_t *dim)
+static dwvu_vec3 random_unit(uint64_t key, uint32_t *dim)
 {
     double z = 2.0 * uniform(key, dim) - 1.0, phi = 2.0 * 3.14159265358979323846 * uniform(key, dim);
     double r = sqrt(fmax(0.0, 1.0 - z * z));
-    return dwvw_v(r * cos(phi), r * sin(phi), z);
+    return dwvu_v(r * cos(phi), r * sin(phi), z);
 }
 
-static long double dot_l(dwvw_vec3 a, dwvw_vec3 b)
+static long double dot_l(dwvu_vec3 a, dwvu_vec3 b)
 {
     return (long double)a.x * b.x + (long double)a.y * b.y + (long double)a.z * b.z;
 }
 
-static int same_vec(dwvw_vec3 a, dwvw_vec3 b)
+static int same_vec(dwvu_vec3 a, dwvu_vec3 b)
 {
     return memcmp(&a, &b, sizeof a) == 0;
 }
@@ -154,8 +154,8 @@ typedef struct step_case {
     dwvw_medium medium;
     dwvw_guide guide;
     dwvw_walk walk;
-    dwvw_vec3 normal;   /* the lit normal expected (the strongest patch's) */
-    dwvw_vec3 previous; /* the direction before the step */
+    dwvu_vec3 normal;   /* the lit normal expected (the strongest patch's) */
+    dwvu_vec3 previous; /* the direction before the step */
     double t;
     int exited, overridden_p, overridden_t;
 } step_case;
@@ -187,7 +187,7 @@ static int make_case(uint64_t index, step_case *s)
     dwvw_light_patch patches[3];
     int patch_count = 1 + (int)(3.0 * uniform(key, &dim)) % 3, strongest = 0;
     for (int i = 0; i < patch_count; ++i) {
-        patches[i].point = dwvw_v(uniform(key, &dim), uniform(key, &dim), uniform(key, &dim));
+        patches[i].point = dwvu_v(uniform(key, &dim), uniform(key, &dim), uniform(key, &dim));
         patches[i].normal = random_unit(key, &dim);
         patches[i].power = 0.1 + uniform(key, &dim);
         patches[i].log_power = 0.0;
@@ -206,13 +206,13 @@ static int make_case(uint64_t index, step_case *s)
     if (!guide_ok) return 0;
 
     /* an entry on the far side (entry normal . lit normal < 0), heading in */
-    dwvw_vec3 entry_normal = random_unit(key, &dim);
-    double facing = dwvw_dot(entry_normal, s->normal);
-    if (fabs(facing) < 1e-3) entry_normal = dwvw_normalize(dwvw_madd(entry_normal, s->normal, -0.5));
-    if (dwvw_dot(entry_normal, s->normal) > 0.0) entry_normal = dwvw_scale(entry_normal, -1.0);
-    dwvw_vec3 entry_direction = random_unit(key, &dim);
-    if (dwvw_dot(entry_direction, entry_normal) > 0.0) entry_direction = dwvw_scale(entry_direction, -1.0);
-    dwvw_vec3 entry_point = dwvw_v(10.0 * uniform(key, &dim) - 5.0, 10.0 * uniform(key, &dim) - 5.0,
+    dwvu_vec3 entry_normal = random_unit(key, &dim);
+    double facing = dwvu_dot(entry_normal, s->normal);
+    if (fabs(facing) < 1e-3) entry_normal = dwvu_normalize(dwvu_madd(entry_normal, s->normal, -0.5));
+    if (dwvu_dot(entry_normal, s->normal) > 0.0) entry_normal = dwvu_scale(entry_normal, -1.0);
+    dwvu_vec3 entry_direction = random_unit(key, &dim);
+    if (dwvu_dot(entry_direction, entry_normal) > 0.0) entry_direction = dwvu_scale(entry_direction, -1.0);
+    dwvu_vec3 entry_point = dwvu_v(10.0 * uniform(key, &dim) - 5.0, 10.0 * uniform(key, &dim) - 5.0,
                                    10.0 * uniform(key, &dim) - 5.0);
     dwvw_walk *w = &s->walk;
     dwvw_walk_begin(w, &s->medium, &s->guide, dwvk_rng_key(SEED, 2u, index), 1000000u, entry_point, entry_direction,
@@ -228,9 +228,9 @@ static int make_case(uint64_t index, step_case *s)
         w->events = 1u + (uint32_t)(40.0 * uniform(key, &dim));
         double optical = uniform(key, &dim) < 0.2 ? -3.0 * uniform(key, &dim) : 12.0 * uniform(key, &dim);
         double h = optical / s->medium.sigma_t[s->medium.guide_channel];
-        dwvw_vec3 lateral = random_unit(key, &dim);
-        lateral = dwvw_sub(lateral, dwvw_scale(s->normal, dwvw_dot(lateral, s->normal)));
-        w->position = dwvw_add(dwvw_madd(entry_point, s->normal, h), dwvw_scale(lateral, 3.0 * uniform(key, &dim)));
+        dwvu_vec3 lateral = random_unit(key, &dim);
+        lateral = dwvu_sub(lateral, dwvu_scale(s->normal, dwvu_dot(lateral, s->normal)));
+        w->position = dwvu_add(dwvu_madd(entry_point, s->normal, h), dwvu_scale(lateral, 3.0 * uniform(key, &dim)));
         w->direction = random_unit(key, &dim);
     }
     s->previous = w->direction;
@@ -264,7 +264,7 @@ static int make_case(uint64_t index, step_case *s)
     } else if (choice < 0.45 && mu < -1e-3) {
         s->overridden_t = 1;
         int c = (int)(channels * uniform(key, &dim)) % channels;
-        double h = fmax(0.0, dwvw_dot(dwvw_sub(w->position, w->entry_point), s->normal));
+        double h = fmax(0.0, dwvu_dot(dwvu_sub(w->position, w->entry_point), s->normal));
         double a = s->medium.sigma_t[c] * h + DWVK_SHEET_EXTRAPOLATION;
         t = a / -mu / s->medium.sigma_t[c] * (1.0 + 1e-3 * (2.0 * uniform(key, &dim) - 1.0));
     }
@@ -280,7 +280,7 @@ static long double direct_ratio(const step_case *s, int cw, int planted, long do
     const dwvw_walk *w = &s->walk;
     const dwvw_medium *m = &s->medium;
     long double t = s->t;
-    long double h = dot_l(dwvw_sub(w->position, w->entry_point), s->normal);
+    long double h = dot_l(dwvu_sub(w->position, w->entry_point), s->normal);
     h = h > 0.0L ? h : 0.0L;
     long double mu = dot_l(w->direction, s->normal);
     mu = mu < -1.0L ? -1.0L : mu > 1.0L ? 1.0L : mu;
@@ -339,7 +339,7 @@ static void test_weight_update(void)
             continue;
         }
         long double mu = dot_l(w->direction, s.normal);
-        long double h = dot_l(dwvw_sub(w->position, w->entry_point), s.normal);
+        long double h = dot_l(dwvu_sub(w->position, w->entry_point), s.normal);
         ++kinds[w->events > 0][s.exited];
         below += h < 0.0L;
         negative_mu += mu < 0.0L;
@@ -359,10 +359,10 @@ static void test_weight_update(void)
             }
         }
         double start[3] = {w->weight[0], w->weight[1], w->weight[2]};
-        dwvw_vec3 expected_position = dwvw_madd(w->position, w->direction, s.t);
+        dwvu_vec3 expected_position = dwvu_madd(w->position, w->direction, s.t);
         uint32_t events = w->events;
         double hit = s.exited ? s.t : (i & 1u) ? INFINITY : 2.0 * s.t + 1.0;
-        dwvw_status status = dwvw_walk_complete(w, hit, dwvw_v(0.0, 0.0, 1.0));
+        dwvw_status status = dwvw_walk_complete(w, hit, dwvu_v(0.0, 0.0, 1.0));
         CHECK(status == (s.exited ? DWVW_EXITED : DWVW_RUNNING), "case %llu: status %d", (unsigned long long)i,
               (int)status);
         CHECK(same_vec(w->position, expected_position) && w->events == events + !s.exited,
@@ -439,8 +439,8 @@ static void test_roulette(void)
             largest = fmaxl(largest, ratio[c]);
         }
         if (!(largest > 1e-250L && largest < 1e250L)) continue;
-        dwvw_vec3 moved = dwvw_madd(w->position, w->direction, s.t);
-        long double h = dot_l(dwvw_sub(moved, w->entry_point), s.normal);
+        dwvu_vec3 moved = dwvu_madd(w->position, w->direction, s.t);
+        long double h = dot_l(dwvu_sub(moved, w->entry_point), s.normal);
         long double importance = ((long double)m->sigma_t[m->guide_channel] * fmaxl(h, 0.0L) + DWVK_SHEET_EXTRAPOLATION) /
                                  DWVK_SHEET_EXTRAPOLATION;
         /* scale the weights so that L = largest x importance is uniform in (0, 0.7) */
@@ -456,7 +456,7 @@ static void test_roulette(void)
             ++near; /* too close to call in long double against the walk's doubles */
             continue;
         }
-        dwvw_status status = dwvw_walk_complete(w, INFINITY, dwvw_v(0.0, 0.0, 1.0));
+        dwvw_status status = dwvw_walk_complete(w, INFINITY, dwvu_v(0.0, 0.0, 1.0));
         ++cases;
         int expect_survive = !(product < DWVW_ROULETTE_THRESHOLD) || (long double)u < survive;
         int planted_survive = !(largest * scale < DWVW_ROULETTE_THRESHOLD) || (long double)u < survive_planted;
@@ -565,9 +565,9 @@ static double bin_integral(stats_function f, void *context, double m0, double m1
 static void state_step(const sample_state *st, const dwvw_medium *medium, const dwvw_guide *guide, uint64_t index,
                        double *mu, double *tau)
 {
-    const dwvw_vec3 origin = {0.0, 0.0, 0.0}, outward = {0.0, 0.0, -1.0};
+    const dwvu_vec3 origin = {0.0, 0.0, 0.0}, outward = {0.0, 0.0, -1.0};
     double c = st->entry_cosine;
-    dwvw_vec3 direction = dwvw_v(sqrt((1.0 - c) * (1.0 + c)), 0.0, c);
+    dwvu_vec3 direction = dwvu_v(sqrt((1.0 - c) * (1.0 + c)), 0.0, c);
     dwvw_walk walk;
     dwvw_walk_begin(&walk, medium, guide, dwvk_rng_key(SEED, 3u, index), 1000000u, origin, direction, outward);
     if (!st->first_step) {
@@ -575,7 +575,7 @@ static void state_step(const sample_state *st, const dwvw_medium *medium, const 
         dwvw_walk_sample(&walk);
         walk.step_distance = st->optical_height / medium->sigma_t[0];
         walk.weight[0] = START_WEIGHT;
-        dwvw_walk_complete(&walk, INFINITY, dwvw_v(0.0, 0.0, 1.0));
+        dwvw_walk_complete(&walk, INFINITY, dwvu_v(0.0, 0.0, 1.0));
     }
     double d = dwvw_walk_sample(&walk);
     *mu = walk.direction.z;
@@ -587,7 +587,7 @@ static void test_sampling_state(const sample_state *st)
     const double sigma = SAMPLE_SIGMA, albedo = 0.99;
     dwvw_medium medium;
     dwvw_medium_init(&medium, 1, &sigma, &albedo, st->g);
-    dwvw_light_patch patch = {.point = dwvw_v(0.0, 0.0, 1.25), .normal = dwvw_v(0.0, 0.0, 1.0), .power = 1.0,
+    dwvw_light_patch patch = {.point = dwvu_v(0.0, 0.0, 1.25), .normal = dwvu_v(0.0, 0.0, 1.0), .power = 1.0,
                               .is_plane = 1};
     dwvw_guide guide;
     dwvw_guide_init(&guide, DWVW_SHEET, &medium, &patch, 1);
@@ -597,16 +597,16 @@ static void test_sampling_state(const sample_state *st)
 
     /* the state reached as intended */
     {
-        const dwvw_vec3 origin = {0.0, 0.0, 0.0}, outward = {0.0, 0.0, -1.0};
+        const dwvu_vec3 origin = {0.0, 0.0, 0.0}, outward = {0.0, 0.0, -1.0};
         double c = st->entry_cosine;
         dwvw_walk walk;
-        dwvw_walk_begin(&walk, &medium, &guide, 1u, 1000000u, origin, dwvw_v(sqrt((1.0 - c) * (1.0 + c)), 0.0, c),
+        dwvw_walk_begin(&walk, &medium, &guide, 1u, 1000000u, origin, dwvu_v(sqrt((1.0 - c) * (1.0 + c)), 0.0, c),
                         outward);
         if (!st->first_step) {
             dwvw_walk_sample(&walk);
             walk.step_distance = st->optical_height / sigma;
             walk.weight[0] = START_WEIGHT;
-            dwvw_status status = dwvw_walk_complete(&walk, INFINITY, dwvw_v(0.0, 0.0, 1.0));
+            dwvw_status status = dwvw_walk_complete(&walk, INFINITY, dwvu_v(0.0, 0.0, 1.0));
             CHECK(status == DWVW_RUNNING && walk.events == 1u &&
                       fabs(walk.position.z - st->optical_height / sigma) <= 1e-15 &&
                       walk.position.x == 0.0 && walk.position.y == 0.0,
@@ -733,9 +733,9 @@ static void test_sampling(void)
 /* Two walks of the same key, one with each guide, stepped together in the slab; 1 if they agree bit
  * for bit at every step. */
 static int walks_agree(const dwvw_medium *medium, const dwvw_guide *a, const dwvw_guide *b, const dwvw_shape *slab,
-                       uint64_t key, dwvw_vec3 direction, dwvw_vec3 normal, uint32_t *steps)
+                       uint64_t key, dwvu_vec3 direction, dwvu_vec3 normal, uint32_t *steps)
 {
-    const dwvw_vec3 origin = {0.0, 0.0, 0.0};
+    const dwvu_vec3 origin = {0.0, 0.0, 0.0};
     dwvw_walk wa, wb;
     dwvw_walk_begin(&wa, medium, a, key, 100000u, origin, direction, normal);
     dwvw_walk_begin(&wb, medium, b, key, 100000u, origin, direction, normal);
@@ -743,7 +743,7 @@ static int walks_agree(const dwvw_medium *medium, const dwvw_guide *a, const dwv
     while (same && wa.status == DWVW_RUNNING && wb.status == DWVW_RUNNING) {
         double da = dwvw_walk_sample(&wa), db = dwvw_walk_sample(&wb);
         same &= memcmp(&da, &db, sizeof da) == 0 && same_vec(wa.direction, wb.direction);
-        dwvw_vec3 na, nb;
+        dwvu_vec3 na, nb;
         double ha = dwvw_shape_exit(slab, wa.position, wa.direction, &na);
         double hb = dwvw_shape_exit(slab, wb.position, wb.direction, &nb);
         dwvw_walk_complete(&wa, ha, na);
@@ -765,8 +765,8 @@ static void test_lit_side(void)
         int channels;
         const double *sigma, *albedo;
         double g;
-        dwvw_vec3 lit;    /* the lit patch's normal */
-        dwvw_vec3 entry;  /* the entry's outward normal */
+        dwvu_vec3 lit;    /* the lit patch's normal */
+        dwvu_vec3 entry;  /* the entry's outward normal */
     } cases[] = {
         {"grey g 0, front-lit", 1, &grey_sigma, &grey_albedo, 0.0, {0.0, 0.0, -1.0}, {0.0, 0.0, -1.0}},
         {"grey g -0.4, front-lit", 1, &grey_sigma, &grey_albedo, -0.4, {0.0, 0.0, -1.0}, {0.0, 0.0, -1.0}},
@@ -779,17 +779,17 @@ static void test_lit_side(void)
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         dwvw_medium medium;
         dwvw_medium_init(&medium, cases[i].channels, cases[i].sigma, cases[i].albedo, cases[i].g);
-        dwvw_light_patch patch = {.point = dwvw_v(0.0, 0.0, 0.0), .normal = cases[i].lit, .power = 1.0, .is_plane = 1};
+        dwvw_light_patch patch = {.point = dwvu_v(0.0, 0.0, 0.0), .normal = cases[i].lit, .power = 1.0, .is_plane = 1};
         dwvw_guide sheet, classical;
         dwvw_guide_init(&sheet, DWVW_SHEET, &medium, &patch, 1);
         dwvw_guide_init(&classical, DWVW_CLASSICAL, &medium, &patch, 1);
-        CHECK(sheet.q_sheet > 0.0 && dwvw_dot(cases[i].entry, sheet.sheet_normal) > 0.0, "%s: not a lit-side entry",
+        CHECK(sheet.q_sheet > 0.0 && dwvu_dot(cases[i].entry, sheet.sheet_normal) > 0.0, "%s: not a lit-side entry",
               cases[i].name);
         int same = 0;
         for (uint64_t k = 0; k < 128; ++k) {
             uint64_t key = dwvk_rng_key(SEED, 4u + i, k);
             uint32_t dim = 0;
-            dwvw_vec3 direction = k % 2 ? random_unit(key, &dim) : dwvw_v(0.0, 0.0, 1.0);
+            dwvu_vec3 direction = k % 2 ? random_unit(key, &dim) : dwvu_v(0.0, 0.0, 1.0);
             if (direction.z < 0.0) direction.z = -direction.z;
             same += walks_agree(&medium, &sheet, &classical, &slab, dwvk_rng_key(SEED, 8u + i, k), direction,
                                 cases[i].entry, &steps);
@@ -805,14 +805,14 @@ static void test_lit_side(void)
     {
         dwvw_medium medium;
         dwvw_medium_init(&medium, 1, &grey_sigma, &grey_albedo, 0.0);
-        dwvw_light_patch patch = {.point = dwvw_v(0.0, 0.0, SLAB_MFP), .normal = dwvw_v(0.0, 0.0, 1.0), .power = 1.0,
+        dwvw_light_patch patch = {.point = dwvu_v(0.0, 0.0, SLAB_MFP), .normal = dwvu_v(0.0, 0.0, 1.0), .power = 1.0,
                                   .is_plane = 1};
         dwvw_guide sheet, classical;
         dwvw_guide_init(&sheet, DWVW_SHEET, &medium, &patch, 1);
         dwvw_guide_init(&classical, DWVW_CLASSICAL, &medium, &patch, 1);
         for (uint64_t k = 0; k < 128; ++k)
-            differ += !walks_agree(&medium, &sheet, &classical, &slab, dwvk_rng_key(SEED, 12u, k), dwvw_v(0.0, 0.0, 1.0),
-                                   dwvw_v(0.0, 0.0, -1.0), &steps);
+            differ += !walks_agree(&medium, &sheet, &classical, &slab, dwvk_rng_key(SEED, 12u, k), dwvu_v(0.0, 0.0, 1.0),
+                                   dwvu_v(0.0, 0.0, -1.0), &steps);
     }
     CHECK(differ > 120, "control: only %d of 128 far-side sheet walks differ from classical ones", differ);
 

@@ -55,7 +55,7 @@ static one_walk run_walk_shared(const dwvw_medium *medium, const dwvw_guide *gui
                                 uint64_t key, const dwvk_sampler *sampler, uint32_t stratified_events,
                                 dwvw_pair_cache *pairs)
 {
-    const dwvw_vec3 origin = {0.0, 0.0, 0.0}, inward = {0.0, 0.0, 1.0}, outward = {0.0, 0.0, -1.0};
+    const dwvu_vec3 origin = {0.0, 0.0, 0.0}, inward = {0.0, 0.0, 1.0}, outward = {0.0, 0.0, -1.0};
     dwvw_walk walk;
     dwvw_walk_begin(&walk, medium, guide, key, 100000u, origin, inward, outward);
     dwvw_walk_stratify(&walk, sampler, FIRST_PAIR, stratified_events);
@@ -63,12 +63,12 @@ static one_walk run_walk_shared(const dwvw_medium *medium, const dwvw_guide *gui
     int needs_closest = dwvw_guide_needs_closest(guide);
     while (walk.status == DWVW_RUNNING) {
         if (needs_closest) {
-            dwvw_vec3 n;
+            dwvu_vec3 n;
             dwvw_shape_closest(sphere, walk.position, &n);
             dwvw_walk_set_closest(&walk, n);
         }
         dwvw_walk_sample(&walk);
-        dwvw_vec3 normal;
+        dwvu_vec3 normal;
         double hit = dwvw_shape_exit(sphere, walk.position, walk.direction, &normal);
         dwvw_walk_complete(&walk, hit, normal);
     }

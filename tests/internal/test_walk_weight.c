@@ -63,7 +63,7 @@ static void make_case(uint64_t index, step_case *s)
     w->max_events = 1000000u;
     w->events = 1u;
     w->status = DWVW_RUNNING;
-    w->direction = dwvw_v(0.0, 0.0, 1.0);
+    w->direction = dwvu_v(0.0, 0.0, 1.0);
     w->component_count = 1 + (int)(uniform(key, &dim) * DWVW_MAX_COMPONENTS);
     if (w->component_count > DWVW_MAX_COMPONENTS) w->component_count = DWVW_MAX_COMPONENTS;
     w->single_component = -1;
@@ -135,7 +135,7 @@ static void test_weight_update(void)
             continue;
         }
         double hit = s.exited ? s.t : INFINITY;
-        dwvw_status status = dwvw_walk_complete(&s.walk, hit, dwvw_v(0.0, 0.0, 1.0));
+        dwvw_status status = dwvw_walk_complete(&s.walk, hit, dwvu_v(0.0, 0.0, 1.0));
         CHECK(status == (s.exited ? DWVW_EXITED : DWVW_RUNNING), "case %llu: status %d", (unsigned long long)i,
               (int)status);
         double planted_error = 0.0;

@@ -6,7 +6,7 @@
 
 #include <string.h>
 
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 static const char PRIMER_NAME[] = "no-such-technique-primer";
 

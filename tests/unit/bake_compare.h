@@ -8,7 +8,7 @@
 #include <string.h>
 
 #include "check.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 /* A bake's image and figures, for tests that compare bakes. */
 typedef struct test_result {

@@ -8,7 +8,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 typedef struct test_mesh {
     uint32_t vertex_count, triangle_count;

@@ -12,7 +12,7 @@
 #include "api_checks.h"
 #include "bake_scenes.h"
 #include "check.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 static double now(void)
 {

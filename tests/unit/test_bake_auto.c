@@ -39,7 +39,7 @@
 
 #include "bake_scenes.h"
 #include "check.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 typedef enum expected { EXPECT_CLASSICAL, EXPECT_ENTRY, EXPECT_GUIDED, EXPECT_INCIDENT, EXPECT_SHEET } expected;
 

@@ -7,7 +7,7 @@
 
 #include "bake_scenes.h"
 #include "check.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 static double coverage(dwv_camera_kind_t kind, uint32_t width, uint32_t height)
 {

@@ -12,7 +12,7 @@
 
 #include "bake_scenes.h"
 #include "check.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 #define PI 3.14159265358979323846
 

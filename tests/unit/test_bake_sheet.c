@@ -14,7 +14,7 @@
 #include "bake_compare.h"
 #include "bake_scenes.h"
 #include "check.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 typedef test_result result;
 

@@ -11,7 +11,7 @@
 #include "bake_compare.h"
 #include "bake_scenes.h"
 #include "check.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 /* bake_scenes.h's wax sphere at a coarser tessellation. */
 static dwv_scene_t *wax_sphere(int flat_channel, int grey)

@@ -7,7 +7,7 @@
 
 #include "api_checks.h"
 #include "check.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 /* Small valid options: every refusal below changes exactly one thing. */
 static dwv_estimate_options_t valid_options(void)

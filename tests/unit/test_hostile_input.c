@@ -21,7 +21,7 @@
 
 #include "api_checks.h"
 #include "check.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 static const dwv_result_t NULLP = DWV_ERROR_NULL_POINTER, INVALID = DWV_ERROR_INVALID_ARGUMENT,
                           RANGE = DWV_ERROR_OUT_OF_RANGE, SIZE = DWV_ERROR_STRUCT_SIZE,

@@ -21,7 +21,7 @@
 #include "api_checks.h"
 #include "bake_scenes.h"
 #include "check.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 static dwv_material_t wax(void)
 {

@@ -11,7 +11,7 @@
 #include <stdlib.h>
 
 #include "check.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 #include "stats.h"
 
 #define SEED 0x243f6a8885a308d3ull

@@ -11,7 +11,7 @@
 #include <stdlib.h>
 
 #include "check.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 #include "stats.h"
 
 #define SEED 0xc1a55ec5ull

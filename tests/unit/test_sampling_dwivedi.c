@@ -17,7 +17,7 @@
 #include <stdlib.h>
 
 #include "check.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 #include "stats.h"
 
 #define SEED 0x5eed0d1ce5ull

@@ -10,7 +10,7 @@
 #include <stdio.h>
 
 #include "check.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 static const double albedos[] = {0.0, 1e-300, 1e-12, 1e-3, 0.5599999999, 0.56, 0.9999, 1.0 - 1e-12, 1.0};
 #define ALBEDO_COUNT ((int)(sizeof albedos / sizeof albedos[0]))

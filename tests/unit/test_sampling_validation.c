@@ -11,7 +11,7 @@
 #include <string.h>
 
 #include "check.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 #define SENTINEL "sentinel-no-such-method"
 

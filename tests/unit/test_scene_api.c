@@ -8,7 +8,7 @@
 
 #include "api_checks.h"
 #include "check.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 static const float tetra_positions[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
 static const uint32_t tetra_indices[] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};

@@ -13,7 +13,7 @@
 
 #include "api_checks.h"
 #include "check.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 #define EXAMPLES DWV_TEST_DATA_DIR "/../../examples/scenes"
 

@@ -18,7 +18,7 @@
 #include <string.h>
 
 #include "check.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 enum { THREADS = 4, KERNEL_INPUTS = 2000, REFCOUNT_ROUNDS = 20000, WALK_STEPS_WALKS = 200 };
 

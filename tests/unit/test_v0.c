@@ -11,7 +11,7 @@
 #include <string.h>
 
 #include "check.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 /* ---- the reference table ------------------------------------------------------------------- */
 

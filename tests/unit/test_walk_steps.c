@@ -12,7 +12,7 @@
 
 #include "api_checks.h"
 #include "check.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 enum { WALKS = 3000 };
 /* Sampled directions are unit only to single precision (the per-event path runs in float): within

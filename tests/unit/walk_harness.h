@@ -15,7 +15,7 @@
 #include <string.h>
 
 #include "check.h"
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 /* ---- estimates ----------------------------------------------------------------------------- */
 

@@ -65,8 +65,8 @@ OCIO::ConstConfigRcPtr load_file(const std::string &path, const std::string &ori
 OCIO::ConstConfigRcPtr default_config()
 {
     static const OCIO::ConstConfigRcPtr config = [] {
-        std::istringstream text(std::string(reinterpret_cast<const char *>(dwvio_default_ocio_config),
-                                             dwvio_default_ocio_config_size));
+        std::istringstream text(std::string(reinterpret_cast<const char *>(dwvo_default_ocio_config),
+                                             dwvo_default_ocio_config_size));
         return OCIO::Config::CreateFromStream(text);
     }();
     return config;
@@ -227,7 +227,7 @@ void copy_message(const std::string &text, char *message, size_t size)
 
 } // namespace
 
-extern "C" dwv_result_t dwvio_to_display(const float *rgba, uint32_t width, uint32_t height,
+extern "C" dwv_result_t dwvo_to_display(const float *rgba, uint32_t width, uint32_t height,
                                          const dwv_display_options_t *options, uint8_t *out, char *message,
                                          size_t size)
 {

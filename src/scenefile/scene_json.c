@@ -9,7 +9,7 @@
  * of values (its memory, about 64 bytes each). Then cJSON parses, and the schema walk below
  * rejects unknown keys, duplicate keys, wrong types and numbers that overflowed to infinity. */
 #define _POSIX_C_SOURCE 200809L
-#include "io/scene_json.h"
+#include "scenefile/scene_json.h"
 
 #include <float.h>
 #include <math.h>
@@ -20,9 +20,9 @@
 
 #include <cjson/cJSON.h>
 
-#include "api/error.h"
-#include "io/mesh_file.h"
-#include "io/transform.h"
+#include "util/error.h"
+#include "scenefile/mesh_file.h"
+#include "scenefile/transform.h"
 
 #define PATH_SIZE 192  /* a JSON path in a message */
 #define SHOWN_BYTES 40 /* of a user's string shown in a message, before "..." */
@@ -189,8 +189,8 @@ static dwv_result_t prescan(const unsigned char *s, size_t n, int *unclosed)
         case '"': in_string = 1; break;
         case '[':
         case '{':
-            if (++depth > DWVIO_SCENE_MAX_DEPTH)
-                return fail_text(s, i, "arrays and objects nested deeper than %u levels", DWVIO_SCENE_MAX_DEPTH);
+            if (++depth > DWVS_SCENE_MAX_DEPTH)
+                return fail_text(s, i, "arrays and objects nested deeper than %u levels", DWVS_SCENE_MAX_DEPTH);
             ++values;
             break;
         case ']':
@@ -198,9 +198,9 @@ static dwv_result_t prescan(const unsigned char *s, size_t n, int *unclosed)
             if (depth) --depth;
             break;
         case ',':
-            if (++values > DWVIO_SCENE_MAX_VALUES)
+            if (++values > DWVS_SCENE_MAX_VALUES)
                 return fail_text(s, i, "more than %u values; large meshes belong in OBJ or PLY files",
-                                 DWVIO_SCENE_MAX_VALUES);
+                                 DWVS_SCENE_MAX_VALUES);
             break;
         default: break;
         }
@@ -445,7 +445,7 @@ static dwv_result_t read_transform(const cJSON *item, const char *path, double m
         DWV_TRY(opt_vector(look, p, "eye", 3, eye));
         DWV_TRY(opt_vector(look, p, "target", 3, target));
         DWV_TRY(opt_vector(look, p, "up", 3, up));
-        int bad = dwvio_transform_look_at(eye, target, up, m);
+        int bad = dwvs_transform_look_at(eye, target, up, m);
         if (bad == -1) return fail_at(DWV_ERROR_INVALID_ARGUMENT, p, "eye and target coincide");
         if (bad) return fail_at(DWV_ERROR_INVALID_ARGUMENT, p, "up is zero or parallel to the view direction");
         return DWV_SUCCESS;
@@ -461,7 +461,7 @@ static dwv_result_t read_transform(const cJSON *item, const char *path, double m
     } else {
         DWV_TRY(opt_vector(item, path, "scale", 3, s));
     }
-    dwvio_transform_trs(t, r, s, m);
+    dwvs_transform_trs(t, r, s, m);
     return DWV_SUCCESS;
 }
 
@@ -623,8 +623,8 @@ static dwv_result_t read_mesh(parser *ps, const cJSON *item, const char *path, n
         path_key(p, path, "file");
         DWV_TRY(read_string(file, p, &file_name));
         DWV_TRY(resolve_path(ps->base_dir, file_name, p, resolved));
-        dwvio_mesh_data data;
-        r = dwvio_mesh_file_read(resolved, &data);
+        dwvs_mesh_data data;
+        r = dwvs_mesh_file_read(resolved, &data);
         if (r != DWV_SUCCESS) return prefix_capi(r, p);
         mesh.vertex_count = data.vertex_count;
         mesh.triangle_count = data.triangle_count;
@@ -639,7 +639,7 @@ static dwv_result_t read_mesh(parser *ps, const cJSON *item, const char *path, n
             r = prefix_capi(r, where);
         }
         record->has_uvs = data.uvs != NULL;
-        dwvio_mesh_data_free(&data);
+        dwvs_mesh_data_free(&data);
     } else {
         float *positions = NULL, *normals = NULL, *uvs = NULL;
         uint32_t *indices = NULL;
@@ -955,14 +955,14 @@ static dwv_result_t read_scene(parser *ps, const cJSON *root)
     return r == DWV_SUCCESS ? r : prefix_capi(r, "scene");
 }
 
-dwv_result_t dwvio_scene_from_json(const char *json, size_t size, const char *base_dir, dwv_scene_t **scene,
+dwv_result_t dwvs_scene_from_json(const char *json, size_t size, const char *base_dir, dwv_scene_t **scene,
                                    dwv_bake_options_t *options)
 {
     *scene = NULL;
     const unsigned char *text = (const unsigned char *)json;
     if (size == 0) return dwv_fail(DWV_ERROR_FORMAT, "the scene text is empty");
-    if (size > DWVIO_SCENE_MAX_BYTES)
-        return dwv_fail(DWV_ERROR_FORMAT, "the scene text is %zu bytes, more than %u", size, DWVIO_SCENE_MAX_BYTES);
+    if (size > DWVS_SCENE_MAX_BYTES)
+        return dwv_fail(DWV_ERROR_FORMAT, "the scene text is %zu bytes, more than %u", size, DWVS_SCENE_MAX_BYTES);
     size_t skip = 0;
     if (size >= 3 && text[0] == 0xefu && text[1] == 0xbbu && text[2] == 0xbfu) skip = 3; /* a UTF-8 BOM */
     int unclosed = 0;

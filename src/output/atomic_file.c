@@ -49,7 +49,7 @@ static char *folder_of(const char *path)
     return folder;
 }
 
-dwv_result_t dwvio_check_output_path(const char *target, char *message, size_t size)
+dwv_result_t dwvo_check_output_path(const char *target, char *message, size_t size)
 {
     size_t length = strlen(target);
     if (length == 0u) return io_fail(DWV_ERROR_IO, message, size, "the output path is empty");
@@ -92,11 +92,11 @@ static uint64_t unique_bits(void)
     return z ^ (z >> 31);
 }
 
-dwv_result_t dwvio_atomic_open(dwvio_atomic_file *file, const char *target, char *message, size_t size)
+dwv_result_t dwvo_atomic_open(dwvo_atomic_file *file, const char *target, char *message, size_t size)
 {
     memset(file, 0, sizeof *file);
     file->fd = -1;
-    dwv_result_t checked = dwvio_check_output_path(target, message, size);
+    dwv_result_t checked = dwvo_check_output_path(target, message, size);
     if (checked != DWV_SUCCESS) return checked;
     size_t length = strlen(target);
     const char *slash = strrchr(target, '/');
@@ -130,7 +130,7 @@ dwv_result_t dwvio_atomic_open(dwvio_atomic_file *file, const char *target, char
     return DWV_SUCCESS;
 }
 
-static int write_failed(dwvio_atomic_file *file, int error)
+static int write_failed(dwvo_atomic_file *file, int error)
 {
     if (!file->failed)
         snprintf(file->message, sizeof file->message, "writing '%s': %s", file->temp, strerror(error));
@@ -138,7 +138,7 @@ static int write_failed(dwvio_atomic_file *file, int error)
     return -1;
 }
 
-int dwvio_atomic_write(dwvio_atomic_file *file, const void *data, size_t size)
+int dwvo_atomic_write(dwvo_atomic_file *file, const void *data, size_t size)
 {
     if (file->failed) return -1;
     const unsigned char *bytes = data;
@@ -155,7 +155,7 @@ int dwvio_atomic_write(dwvio_atomic_file *file, const void *data, size_t size)
     return 0;
 }
 
-int dwvio_atomic_pwrite(dwvio_atomic_file *file, const void *data, size_t size, uint64_t offset)
+int dwvo_atomic_pwrite(dwvo_atomic_file *file, const void *data, size_t size, uint64_t offset)
 {
     if (file->failed) return -1;
     const unsigned char *bytes = data;
@@ -174,7 +174,7 @@ int dwvio_atomic_pwrite(dwvio_atomic_file *file, const void *data, size_t size, 
     return 0;
 }
 
-static void release(dwvio_atomic_file *file)
+static void release(dwvo_atomic_file *file)
 {
     free(file->target);
     free(file->temp);
@@ -182,7 +182,7 @@ static void release(dwvio_atomic_file *file)
     file->fd = -1;
 }
 
-void dwvio_atomic_abort(dwvio_atomic_file *file)
+void dwvo_atomic_abort(dwvo_atomic_file *file)
 {
     if (!file->temp) return;
     if (file->fd >= 0) close(file->fd);
@@ -190,7 +190,7 @@ void dwvio_atomic_abort(dwvio_atomic_file *file)
     release(file);
 }
 
-dwv_result_t dwvio_atomic_commit(dwvio_atomic_file *file, char *message, size_t size)
+dwv_result_t dwvo_atomic_commit(dwvo_atomic_file *file, char *message, size_t size)
 {
     if (!file->temp) return io_fail(DWV_ERROR_INTERNAL, message, size, "commit of a file that is not open");
     dwv_result_t result = DWV_SUCCESS;

@@ -1,6 +1,6 @@
 /* Transforms as Blender builds them: object matrices from location, rotation and scale, and
  * look-at frames for cameras and lights. */
-#include "io/transform.h"
+#include "scenefile/transform.h"
 
 #include <math.h>
 
@@ -16,7 +16,7 @@ static double length3(const double a[3])
     return sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
 }
 
-void dwvio_transform_trs(const double t[3], const double r_degrees[3], const double s[3], double m[12])
+void dwvs_transform_trs(const double t[3], const double r_degrees[3], const double s[3], double m[12])
 {
     const double to_radians = 3.14159265358979323846 / 180.0;
     double cx = cos(r_degrees[0] * to_radians), sx = sin(r_degrees[0] * to_radians);
@@ -32,7 +32,7 @@ void dwvio_transform_trs(const double t[3], const double r_degrees[3], const dou
     }
 }
 
-int dwvio_transform_look_at(const double eye[3], const double target[3], const double up[3], double m[12])
+int dwvs_transform_look_at(const double eye[3], const double target[3], const double up[3], double m[12])
 {
     double z[3] = {eye[0] - target[0], eye[1] - target[1], eye[2] - target[2]}, x[3], y[3];
     double lz = length3(z);

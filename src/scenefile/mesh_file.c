@@ -1,7 +1,7 @@
 /* OBJ and PLY meshes through Assimp's C API: triangulated, node transforms applied, every mesh of
  * the file concatenated into one set of arrays for dwv_scene_add_mesh. */
 #define _POSIX_C_SOURCE 200809L
-#include "io/mesh_file.h"
+#include "scenefile/mesh_file.h"
 
 #include <errno.h>
 #include <math.h>
@@ -17,14 +17,14 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
-#include "api/error.h"
-#include "io/ply_check.h"
+#include "util/error.h"
+#include "scenefile/ply_check.h"
 
 /* Assimp keeps its last error in one global string, so imports are taken one at a time: the
  * message read after a failed import is then that import's own. */
 static pthread_mutex_t assimp_lock = PTHREAD_MUTEX_INITIALIZER;
 
-void dwvio_mesh_data_free(dwvio_mesh_data *mesh)
+void dwvs_mesh_data_free(dwvs_mesh_data *mesh)
 {
     if (!mesh) return;
     free(mesh->positions);
@@ -75,7 +75,7 @@ static int has_polygons(const struct aiScene *scene)
     return 0;
 }
 
-static dwv_result_t convert(const struct aiScene *scene, const char *path, dwvio_mesh_data *out)
+static dwv_result_t convert(const struct aiScene *scene, const char *path, dwvs_mesh_data *out)
 {
     uint64_t vertices = 0, triangles = 0;
     int normals = 1, uvs = 1;
@@ -86,9 +86,9 @@ static dwv_result_t convert(const struct aiScene *scene, const char *path, dwvio
         if (!mesh->mNormals) normals = 0;
         if (!mesh->mTextureCoords[0]) uvs = 0;
         /* Checked as we go so that the sums cannot overflow on hostile counts. */
-        if (vertices > DWVIO_MESH_MAX_ELEMENTS || triangles > DWVIO_MESH_MAX_ELEMENTS)
+        if (vertices > DWVS_MESH_MAX_ELEMENTS || triangles > DWVS_MESH_MAX_ELEMENTS)
             return dwv_fail(DWV_ERROR_FORMAT, "mesh file '%s': more than %u vertices or triangles", path,
-                            DWVIO_MESH_MAX_ELEMENTS);
+                            DWVS_MESH_MAX_ELEMENTS);
     }
     if (triangles == 0)
         return dwv_fail(DWV_ERROR_FORMAT, "mesh file '%s': no triangles in it", path);
@@ -100,7 +100,7 @@ static dwv_result_t convert(const struct aiScene *scene, const char *path, dwvio
     out->normals = normals ? malloc((size_t)vertices * 3u * sizeof(float)) : NULL;
     out->uvs = uvs ? malloc((size_t)triangles * 6u * sizeof(float)) : NULL;
     if (!out->positions || !out->indices || (normals && !out->normals) || (uvs && !out->uvs)) {
-        dwvio_mesh_data_free(out);
+        dwvs_mesh_data_free(out);
         return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "mesh file '%s': no memory for %llu vertices and %llu triangles",
                         path, (unsigned long long)vertices, (unsigned long long)triangles);
     }
@@ -126,7 +126,7 @@ static dwv_result_t convert(const struct aiScene *scene, const char *path, dwvio
             for (unsigned c = 0; c < 3u; ++c) {
                 unsigned i = face->mIndices[c];
                 if (i >= mesh->mNumVertices) { /* Assimp validates this; a cheap second look */
-                    dwvio_mesh_data_free(out);
+                    dwvs_mesh_data_free(out);
                     return dwv_fail(DWV_ERROR_FORMAT, "mesh file '%s': a face refers to vertex %u of %u", path,
                                     i, mesh->mNumVertices);
                 }
@@ -143,7 +143,7 @@ static dwv_result_t convert(const struct aiScene *scene, const char *path, dwvio
     return DWV_SUCCESS;
 }
 
-dwv_result_t dwvio_mesh_file_read(const char *path, dwvio_mesh_data *mesh)
+dwv_result_t dwvs_mesh_file_read(const char *path, dwvs_mesh_data *mesh)
 {
     memset(mesh, 0, sizeof *mesh);
     if (!has_extension(path, ".obj") && !has_extension(path, ".ply"))
@@ -156,7 +156,7 @@ dwv_result_t dwvio_mesh_file_read(const char *path, dwvio_mesh_data *mesh)
     FILE *probe = fopen(path, "rb");
     if (!probe) return dwv_fail(DWV_ERROR_IO, "mesh file '%s': %s", path, strerror(errno));
     fclose(probe);
-    if (has_extension(path, ".ply")) DWV_TRY(dwvio_ply_check(path));
+    if (has_extension(path, ".ply")) DWV_TRY(dwvs_ply_check(path));
 
     /* Bake the node hierarchy into the vertices; drop points and lines; let Assimp check its own
      * output (indices in range and the like). */

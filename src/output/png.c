@@ -7,9 +7,10 @@
 #include <string.h>
 
 #include "atomic_file.h"
+#include "util/version.h"
 
 typedef struct png_sink {
-    dwvio_atomic_file file;
+    dwvo_atomic_file file;
     char png_message[256];
 } png_sink;
 
@@ -31,7 +32,7 @@ static void on_png_warning(png_structp png, png_const_charp msg)
 static void write_to_sink(png_structp png, png_bytep data, size_t length)
 {
     png_sink *sink = png_get_io_ptr(png);
-    if (dwvio_atomic_write(&sink->file, data, length) != 0) png_error(png, sink->file.message);
+    if (dwvo_atomic_write(&sink->file, data, length) != 0) png_error(png, sink->file.message);
 }
 
 static void flush_sink(png_structp png)
@@ -51,7 +52,7 @@ static int encode(png_structp png, png_infop info, const uint8_t *rgba, uint32_t
     memset(&text, 0, sizeof text);
     char key[] = "Software";
     char value[64];
-    snprintf(value, sizeof value, "dwivedi %s", dwv_version_string());
+    snprintf(value, sizeof value, "dwivedi %s", DWVU_VERSION_STRING);
     text.compression = PNG_TEXT_COMPRESSION_NONE;
     text.key = key;
     text.text = value;
@@ -66,18 +67,18 @@ static int encode(png_structp png, png_infop info, const uint8_t *rgba, uint32_t
     return 0;
 }
 
-dwv_result_t dwvio_write_png_rgba8(const uint8_t *rgba, uint32_t width, uint32_t height, const char *path,
+dwv_result_t dwvo_write_png_rgba8(const uint8_t *rgba, uint32_t width, uint32_t height, const char *path,
                                    char *message, size_t size)
 {
     png_sink sink;
     memset(&sink, 0, sizeof sink);
-    dwv_result_t result = dwvio_atomic_open(&sink.file, path, message, size);
+    dwv_result_t result = dwvo_atomic_open(&sink.file, path, message, size);
     if (result != DWV_SUCCESS) return result;
     png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &sink, on_png_error, on_png_warning);
     png_infop info = png ? png_create_info_struct(png) : NULL;
     if (!png || !info) {
         png_destroy_write_struct(&png, NULL);
-        dwvio_atomic_abort(&sink.file);
+        dwvo_atomic_abort(&sink.file);
         snprintf(message, size, "cannot write '%s': no memory for libpng", path);
         return DWV_ERROR_OUT_OF_MEMORY;
     }
@@ -86,8 +87,8 @@ dwv_result_t dwvio_write_png_rgba8(const uint8_t *rgba, uint32_t width, uint32_t
     if (encoded != 0) {
         snprintf(message, size, "cannot write '%s': %s", path,
                  sink.file.failed ? sink.file.message : sink.png_message);
-        dwvio_atomic_abort(&sink.file);
+        dwvo_atomic_abort(&sink.file);
         return DWV_ERROR_IO;
     }
-    return dwvio_atomic_commit(&sink.file, message, size);
+    return dwvo_atomic_commit(&sink.file, message, size);
 }

@@ -1,12 +1,12 @@
 /* Colour-managed display images through OpenColorIO (display.cpp, C++ behind a C interface: no
  * C++ exception ever leaves it). */
-#ifndef DWV_IO_DISPLAY_H
-#define DWV_IO_DISPLAY_H
+#ifndef DWV_OUTPUT_DISPLAY_H
+#define DWV_OUTPUT_DISPLAY_H
 
 #include <stddef.h>
 #include <stdint.h>
 
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -20,12 +20,12 @@ extern "C" {
  * (DWV_ERROR_UNKNOWN_NAME with the valid names in the message). Non-finite inputs never reach the
  * bytes as garbage: NaN becomes 0 and, after the exposure, values are clamped to +-65504 (the
  * largest half float), so +infinity shows as the brightest value the view makes. */
-dwv_result_t dwvio_to_display(const float *rgba, uint32_t width, uint32_t height,
+dwv_result_t dwvo_to_display(const float *rgba, uint32_t width, uint32_t height,
                               const dwv_display_options_t *options, uint8_t *out, char *message, size_t size);
 
 /* The default config compiled into the library (data/ocio/config.ocio), NUL-terminated. */
-extern const unsigned char dwvio_default_ocio_config[];
-extern const size_t dwvio_default_ocio_config_size;
+extern const unsigned char dwvo_default_ocio_config[];
+extern const size_t dwvo_default_ocio_config_size;
 
 #ifdef __cplusplus
 }

@@ -17,15 +17,15 @@
  * Both share a grey diffuse ground (shadows, and a plain diffuse surface shaded directly) and a
  * dim bluish world, so that the leaf's front is dark except for what comes through it.
  * The resolution and samples are the CLI's default bake: a few tens of seconds on two cores. */
-#include "io/default_scene.h"
+#include "scenefile/default_scene.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "api/error.h"
-#include "io/transform.h"
+#include "util/error.h"
+#include "scenefile/transform.h"
 
 #define PI 3.14159265358979323846
 
@@ -35,7 +35,7 @@
 #define DEFAULT_HEIGHT 270u
 #define DEFAULT_SAMPLES 128u
 
-static int allocate(dwvio_mesh_data *mesh, uint32_t vertices, uint32_t triangles)
+static int allocate(dwvs_mesh_data *mesh, uint32_t vertices, uint32_t triangles)
 {
     memset(mesh, 0, sizeof *mesh);
     mesh->vertex_count = vertices;
@@ -45,7 +45,7 @@ static int allocate(dwvio_mesh_data *mesh, uint32_t vertices, uint32_t triangles
     mesh->indices = calloc((size_t)triangles * 3u, sizeof(uint32_t));
     mesh->uvs = calloc((size_t)triangles * 6u, sizeof(float));
     if (!mesh->positions || !mesh->normals || !mesh->indices || !mesh->uvs) {
-        dwvio_mesh_data_free(mesh);
+        dwvs_mesh_data_free(mesh);
         return -1;
     }
     return 0;
@@ -53,7 +53,7 @@ static int allocate(dwvio_mesh_data *mesh, uint32_t vertices, uint32_t triangles
 
 /* Smooth vertex normals: the area-weighted mean of the faces around each vertex (the cross
  * product's length is twice the area, so summing unnormalised face normals weights by area). */
-static void smooth_normals(dwvio_mesh_data *mesh)
+static void smooth_normals(dwvs_mesh_data *mesh)
 {
     size_t nv = mesh->vertex_count;
     double *sum = calloc(nv * 3u, sizeof *sum);
@@ -88,10 +88,10 @@ static void smooth_normals(dwvio_mesh_data *mesh)
 #define LEAF_RINGS 48u    /* latitude steps from the front pole to the back pole (even) */
 #define LEAF_SEGMENTS 96u /* longitude steps around */
 
-int dwvio_default_leaf(dwvio_mesh_data *mesh)
+int dwvs_default_leaf(dwvs_mesh_data *mesh)
 {
-    const double a = DWVIO_LEAF_HALF_WIDTH, b = DWVIO_LEAF_HALF_HEIGHT, c = 0.5 * DWVIO_LEAF_THICKNESS;
-    const double R = DWVIO_LEAF_BEND_RADIUS;
+    const double a = DWVS_LEAF_HALF_WIDTH, b = DWVS_LEAF_HALF_HEIGHT, c = 0.5 * DWVS_LEAF_THICKNESS;
+    const double R = DWVS_LEAF_BEND_RADIUS;
     const uint32_t rings = LEAF_RINGS, segments = LEAF_SEGMENTS;
     uint32_t vertices = 2u + (rings - 1u) * segments;
     uint32_t triangles = 2u * segments + 2u * segments * (rings - 2u);
@@ -100,7 +100,7 @@ int dwvio_default_leaf(dwvio_mesh_data *mesh)
     /* Vertex (ring i in 1..rings-1, segment j), poles 0 (front) and vertices - 1 (back). */
     double *flat = malloc((size_t)vertices * 2u * sizeof *flat); /* (u/a, v/b) for UVs */
     if (!flat) {
-        dwvio_mesh_data_free(mesh);
+        dwvs_mesh_data_free(mesh);
         return -1;
     }
     for (uint32_t k = 0; k < vertices; ++k) {
@@ -191,14 +191,14 @@ static int compare_positions(const void *x, const void *y)
     return c ? c : (a->index < b->index ? -1 : (a->index > b->index));
 }
 
-int dwvio_default_block(dwvio_mesh_data *mesh)
+int dwvs_default_block(dwvs_mesh_data *mesh)
 {
-    const double half[3] = {DWVIO_BLOCK_HALF_SIZE_X, DWVIO_BLOCK_HALF_SIZE_Y, DWVIO_BLOCK_HALF_SIZE_Z};
+    const double half[3] = {DWVS_BLOCK_HALF_SIZE_X, DWVS_BLOCK_HALF_SIZE_Y, DWVS_BLOCK_HALF_SIZE_Z};
     const uint32_t n = BLOCK_GRID, side = n + 1u;
     const uint32_t raw = 6u * side * side, triangles = 12u * n * n;
     keyed *points = malloc((size_t)raw * sizeof *points);
     uint32_t *remap = malloc((size_t)raw * sizeof *remap);
-    dwvio_mesh_data grid;
+    dwvs_mesh_data grid;
     if (!points || !remap || allocate(&grid, raw, triangles)) {
         free(points);
         free(remap);
@@ -260,7 +260,7 @@ int dwvio_default_block(dwvio_mesh_data *mesh)
     if (allocate(mesh, distinct, triangles)) {
         free(points);
         free(remap);
-        dwvio_mesh_data_free(&grid);
+        dwvs_mesh_data_free(&grid);
         return -1;
     }
     for (uint32_t k = 0; k < raw; ++k) memcpy(mesh->positions + 3u * remap[k], grid.positions + 3u * k, 3u * sizeof(float));
@@ -279,13 +279,13 @@ int dwvio_default_block(dwvio_mesh_data *mesh)
     }
     free(points);
     free(remap);
-    dwvio_mesh_data_free(&grid);
+    dwvs_mesh_data_free(&grid);
     return 0;
 }
 
 /* ---- the scene ------------------------------------------------------------------------------ */
 
-static dwv_result_t add_mesh(dwv_scene_t *scene, const dwvio_mesh_data *data, uint32_t material,
+static dwv_result_t add_mesh(dwv_scene_t *scene, const dwvs_mesh_data *data, uint32_t material,
                              const double transform[12], const char *what)
 {
     dwv_mesh_t mesh = DWV_MESH_INIT;
@@ -337,19 +337,19 @@ static dwv_result_t build(dwv_scene_t *scene)
     /* Meshes: the leaf left of centre, tilted back 12 degrees (its back toward the sun) and
      * turned a little toward the block; the block right of centre, turned 25 degrees so that two
      * of its faces and a rounded edge face the camera; a ground under both that reaches past the top of the frame. */
-    dwvio_mesh_data data;
+    dwvs_mesh_data data;
     double m[12];
-    if (dwvio_default_leaf(&data)) return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "no memory for the leaf");
-    dwvio_transform_trs((const double[3]){-0.058, 0.0, 0.078}, (const double[3]){-12.0, 0.0, -12.0},
+    if (dwvs_default_leaf(&data)) return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "no memory for the leaf");
+    dwvs_transform_trs((const double[3]){-0.058, 0.0, 0.078}, (const double[3]){-12.0, 0.0, -12.0},
                         (const double[3]){1.0, 1.0, 1.0}, m);
     dwv_result_t r = add_mesh(scene, &data, leaf_id, m, "leaf");
-    dwvio_mesh_data_free(&data);
+    dwvs_mesh_data_free(&data);
     DWV_TRY(r);
-    if (dwvio_default_block(&data)) return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "no memory for the block");
-    dwvio_transform_trs((const double[3]){0.062, 0.012, DWVIO_BLOCK_HALF_SIZE_Z + 0.0005},
+    if (dwvs_default_block(&data)) return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "no memory for the block");
+    dwvs_transform_trs((const double[3]){0.062, 0.012, DWVS_BLOCK_HALF_SIZE_Z + 0.0005},
                         (const double[3]){0.0, 0.0, 25.0}, (const double[3]){1.0, 1.0, 1.0}, m);
     r = add_mesh(scene, &data, wax_id, m, "wax block");
-    dwvio_mesh_data_free(&data);
+    dwvs_mesh_data_free(&data);
     DWV_TRY(r);
     static const float ground_positions[12] = {-4.0f, -1.0f, 0.0f, 4.0f, -1.0f, 0.0f,
                                                4.0f,  8.0f,  0.0f, -4.0f, 8.0f, 0.0f};
@@ -379,7 +379,7 @@ static dwv_result_t build(dwv_scene_t *scene)
     area.kind = DWV_LIGHT_AREA_RECTANGLE;
     area.strength = 0.4;
     area.size_x = area.size_y = 0.12;
-    if (dwvio_transform_look_at((const double[3]){0.17, -0.09, 0.13}, (const double[3]){0.062, 0.012, 0.034},
+    if (dwvs_transform_look_at((const double[3]){0.17, -0.09, 0.13}, (const double[3]){0.062, 0.012, 0.034},
                                 (const double[3]){0.0, 0.0, 1.0}, area.transform))
         return dwv_fail(DWV_ERROR_INTERNAL, "the area light's frame is degenerate");
     DWV_TRY(dwv_scene_add_light(scene, &area));
@@ -388,14 +388,14 @@ static dwv_result_t build(dwv_scene_t *scene)
 
     /* Camera: 50 mm lens on a 36 mm sensor, 42 cm in front and a little above, framing both. */
     dwv_camera_t camera = DWV_CAMERA_INIT;
-    if (dwvio_transform_look_at((const double[3]){0.0, -0.42, 0.16}, (const double[3]){0.0, 0.0, 0.062},
+    if (dwvs_transform_look_at((const double[3]){0.0, -0.42, 0.16}, (const double[3]){0.0, 0.0, 0.062},
                                 (const double[3]){0.0, 0.0, 1.0}, camera.transform))
         return dwv_fail(DWV_ERROR_INTERNAL, "the camera's frame is degenerate");
     DWV_TRY(dwv_scene_set_camera(scene, &camera));
     return dwv_scene_commit(scene);
 }
 
-dwv_result_t dwvio_default_scene(dwv_scene_t **scene, dwv_bake_options_t *options)
+dwv_result_t dwvs_default_scene(dwv_scene_t **scene, dwv_bake_options_t *options)
 {
     *scene = NULL;
     dwv_scene_t *made;

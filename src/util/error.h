@@ -1,8 +1,8 @@
 /* Per-thread error messages and argument checks shared by every capi entry point. */
-#ifndef DWV_API_ERROR_H
-#define DWV_API_ERROR_H
+#ifndef DWV_UTIL_ERROR_H
+#define DWV_UTIL_ERROR_H
 
-#include "dwivedi.h"
+#include <dwivedi.h>
 
 /* Keeps a printf-formatted message for the calling thread and returns `result`. */
 dwv_result_t dwv_fail(dwv_result_t result, const char *format, ...)

@@ -1,7 +1,7 @@
 /* Dwivedi sampling of the cosine to an axis, with its pdf, in double and single precision.
  * Pure and inline: the walk calls these per scattering event. */
-#ifndef DWV_KERNEL_DWIVEDI_H
-#define DWV_KERNEL_DWIVEDI_H
+#ifndef DWV_KERNEL_DWIVEDI_SAMPLING_H
+#define DWV_KERNEL_DWIVEDI_SAMPLING_H
 
 #include <math.h>
 #include <tgmath.h>
@@ -51,13 +51,13 @@ static inline dwvk_dwivedi_f dwvk_dwivedi_to_float(dwvk_dwivedi_d d)
 
 #define DWVK_REAL double
 #define DWVK_SUFFIX(name) name##_d
-#include "dwivedi_real.h"
+#include "dwivedi_sampling_real.h"
 #undef DWVK_REAL
 #undef DWVK_SUFFIX
 
 #define DWVK_REAL float
 #define DWVK_SUFFIX(name) name##_f
-#include "dwivedi_real.h"
+#include "dwivedi_sampling_real.h"
 #undef DWVK_REAL
 #undef DWVK_SUFFIX
 

@@ -9,15 +9,15 @@
  * items. Binary bodies must hold every byte the header implies; ASCII bodies one instance per line
  * with exactly its tokens, each a number. Only a file that passes goes to Assimp. */
 #define _POSIX_C_SOURCE 200809L
-#include "io/ply_check.h"
+#include "scenefile/ply_check.h"
 
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "api/error.h"
-#include "io/mesh_file.h"
+#include "util/error.h"
+#include "scenefile/mesh_file.h"
 
 #define MAX_HEADER_BYTES (1u << 16)
 #define MAX_ELEMENTS 16u
@@ -92,7 +92,7 @@ static int parse_count(const char *s, uint64_t *out)
     for (; *s; ++s) {
         if (*s < '0' || *s > '9') return 0;
         v = 10u * v + (uint64_t)(*s - '0');
-        if (v > DWVIO_MESH_MAX_ELEMENTS) return 0;
+        if (v > DWVS_MESH_MAX_ELEMENTS) return 0;
     }
     *out = v;
     return 1;
@@ -153,7 +153,7 @@ static dwv_result_t read_header(const char *path, const unsigned char *text, siz
             if (!parse_count(tokens[2], &e->count))
                 return dwv_fail(DWV_ERROR_FORMAT,
                                 "mesh file '%s': PLY header line %u: the count '%.20s' is not a number up to %u", path,
-                                line_number, tokens[2], DWVIO_MESH_MAX_ELEMENTS);
+                                line_number, tokens[2], DWVS_MESH_MAX_ELEMENTS);
             continue;
         }
         if (strcmp(tokens[0], "property") == 0) {
@@ -328,7 +328,7 @@ static dwv_result_t check_ascii(const char *path, const unsigned char *text, siz
     return DWV_SUCCESS;
 }
 
-dwv_result_t dwvio_ply_check(const char *path)
+dwv_result_t dwvs_ply_check(const char *path)
 {
     FILE *file = fopen(path, "rb");
     if (!file) return dwv_fail(DWV_ERROR_IO, "mesh file '%s': %s", path, strerror(errno));
@@ -338,9 +338,9 @@ dwv_result_t dwvio_ply_check(const char *path)
     dwv_result_t r = DWV_SUCCESS;
     while (text) {
         if (size == capacity) {
-            if (capacity >= DWVIO_PLY_MAX_BYTES) {
+            if (capacity >= DWVS_PLY_MAX_BYTES) {
                 r = dwv_fail(DWV_ERROR_FORMAT, "mesh file '%s': larger than %llu bytes", path,
-                             (unsigned long long)DWVIO_PLY_MAX_BYTES);
+                             (unsigned long long)DWVS_PLY_MAX_BYTES);
                 break;
             }
             unsigned char *bigger = realloc(text, capacity * 2u);

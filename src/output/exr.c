@@ -32,10 +32,11 @@
 #include <string.h>
 
 #include "atomic_file.h"
+#include "util/version.h"
 
 /* What the error handler and the write function share for one file. */
 typedef struct exr_sink {
-    dwvio_atomic_file file;
+    dwvo_atomic_file file;
 } exr_sink;
 
 /* OpenEXR's first message on this thread. OpenEXR delivers messages on the thread that caused
@@ -54,43 +55,17 @@ static int64_t write_to_sink(exr_const_context_t ctxt, void *userdata, const voi
                              uint64_t offset, exr_stream_error_func_ptr_t error_cb)
 {
     exr_sink *sink = userdata;
-    if (sz > (uint64_t)INT64_MAX || dwvio_atomic_pwrite(&sink->file, buffer, (size_t)sz, offset) != 0) {
+    if (sz > (uint64_t)INT64_MAX || dwvo_atomic_pwrite(&sink->file, buffer, (size_t)sz, offset) != 0) {
         if (error_cb) error_cb(ctxt, EXR_ERR_WRITE_IO, "%s", sink->file.message);
         return -1;
     }
     return (int64_t)sz;
 }
 
-/* The names of DWV_FEATURE_* bits, as capi/dwivedi.h lists them. */
-static const char *const feature_names[] = {"embree",        "subsurface",    "closest_point",
-                                            "incident_patches", "rgb_walks", "guided",
-                                            "world_light",   "direct_lights", "diffuse_surfaces",
-                                            "channel_walks"};
-
-static void features_string(uint32_t bits, char *out, size_t size)
-{
-    size_t used = 0u;
-    out[0] = '\0';
-    for (size_t i = 0; i < 32u; ++i) {
-        if (!(bits & (1u << i))) continue;
-        char unknown[24];
-        const char *name = feature_names[0];
-        if (i < sizeof feature_names / sizeof *feature_names) {
-            name = feature_names[i];
-        } else {
-            snprintf(unknown, sizeof unknown, "bit%zu", i);
-            name = unknown;
-        }
-        int n = snprintf(out + used, size - used, "%s%s", used ? "," : "", name);
-        if (n < 0 || (size_t)n >= size - used) return;
-        used += (size_t)n;
-    }
-}
-
 /* "seconds relative_error spp\n" per point; NULL when out of memory. */
-static char *error_series_string(const dwvb_image *image)
+static char *error_series_string(const dwvo_exr_image *image)
 {
-    uint32_t count = image->stats.error_vs_time_count;
+    uint32_t count = image->stats->error_vs_time_count;
     size_t size = (size_t)count * 72u + 1u;
     char *text = malloc(size);
     if (!text) return NULL;
@@ -120,20 +95,18 @@ static char *error_series_string(const dwvb_image *image)
         }                                                                                             \
     } while (0)
 
-static dwv_result_t set_metadata(exr_context_t ctxt, int part, const dwvb_image *image, exr_sink *sink,
+static dwv_result_t set_metadata(exr_context_t ctxt, int part, const dwvo_exr_image *image, exr_sink *sink,
                                  const char *path, char *message, size_t size)
 {
     dwv_result_t result = DWV_SUCCESS;
-    const dwv_bake_stats_t *stats = &image->stats;
+    const dwv_bake_stats_t *stats = image->stats;
     /* Rec.709 / sRGB primaries and the D65 white point (ITU-R BT.709-6, Table 1 items 1.3, 1.4). */
     const exr_attr_chromaticities_t rec709 = {0.640f, 0.330f, 0.300f, 0.600f, 0.150f, 0.060f, 0.3127f, 0.3290f};
-    char features[512], number[32];
+    char number[32];
     char *series = NULL;
-    const char *technique = dwv_technique_name(stats->technique);
-    if (stats->samples_per_pixel == 0u) technique = "none"; /* caller-made pixels, not a bake */
     EXR_CHECK(exr_attr_set_chromaticities(ctxt, part, "chromaticities", &rec709), "chromaticities");
-    EXR_CHECK(exr_attr_set_string(ctxt, part, "dwivedi:version", dwv_version_string()), "metadata");
-    EXR_CHECK(exr_attr_set_string(ctxt, part, "dwivedi:technique", technique ? technique : "unknown"), "metadata");
+    EXR_CHECK(exr_attr_set_string(ctxt, part, "dwivedi:version", DWVU_VERSION_STRING), "metadata");
+    EXR_CHECK(exr_attr_set_string(ctxt, part, "dwivedi:technique", image->technique), "metadata");
     int32_t spp = stats->samples_per_pixel > (uint64_t)INT32_MAX ? INT32_MAX : (int32_t)stats->samples_per_pixel;
     EXR_CHECK(exr_attr_set_int(ctxt, part, "dwivedi:samples", spp), "metadata");
     snprintf(number, sizeof number, "%" PRIu64, stats->samples);
@@ -143,8 +116,7 @@ static dwv_result_t set_metadata(exr_context_t ctxt, int part, const dwvb_image 
     EXR_CHECK(exr_attr_set_double(ctxt, part, "dwivedi:seconds", stats->seconds), "metadata");
     double error = stats->samples_per_pixel == 0u ? INFINITY : stats->estimated_relative_error;
     EXR_CHECK(exr_attr_set_double(ctxt, part, "dwivedi:estimated_relative_error", error), "metadata");
-    features_string(stats->features, features, sizeof features);
-    EXR_CHECK(exr_attr_set_string(ctxt, part, "dwivedi:features", features), "metadata");
+    EXR_CHECK(exr_attr_set_string(ctxt, part, "dwivedi:features", image->features), "metadata");
     EXR_CHECK(exr_attr_set_int(ctxt, part, "dwivedi:feature_bits", (int32_t)stats->features), "metadata");
     series = error_series_string(image);
     if (!series) {
@@ -166,7 +138,7 @@ typedef struct channel_source {
     int32_t stride; /* bytes from one pixel to the next */
 } channel_source;
 
-dwv_result_t dwvio_write_exr(const dwvb_image *image, const char *path, char *message, size_t size)
+dwv_result_t dwvo_write_exr(const dwvo_exr_image *image, const char *path, char *message, size_t size)
 {
     exr_sink *sink = calloc(1, sizeof *sink);
     if (!sink) {
@@ -174,7 +146,7 @@ dwv_result_t dwvio_write_exr(const dwvb_image *image, const char *path, char *me
         return DWV_ERROR_OUT_OF_MEMORY;
     }
     exr_message[0] = '\0';
-    dwv_result_t result = dwvio_atomic_open(&sink->file, path, message, size);
+    dwv_result_t result = dwvo_atomic_open(&sink->file, path, message, size);
     if (result != DWV_SUCCESS) {
         free(sink);
         return result;
@@ -259,9 +231,9 @@ done:
         }
     }
     if (result == DWV_SUCCESS)
-        result = dwvio_atomic_commit(&sink->file, message, size);
+        result = dwvo_atomic_commit(&sink->file, message, size);
     else
-        dwvio_atomic_abort(&sink->file);
+        dwvo_atomic_abort(&sink->file);
     free(sink);
     return result;
 }

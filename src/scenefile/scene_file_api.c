@@ -8,10 +8,10 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "dwivedi.h"
-#include "error.h"
-#include "io/default_scene.h"
-#include "io/scene_json.h"
+#include <dwivedi.h>
+#include "util/error.h"
+#include "scenefile/default_scene.h"
+#include "scenefile/scene_json.h"
 
 #define MESSAGE_SIZE 400
 
@@ -37,10 +37,10 @@ dwv_result_t dwv_scene_load_json(const char *json, uint64_t size, const char *ba
     *scene = NULL;
     DWV_TRY(dwv_check_pointer(fn, "json", json));
     DWV_TRY(check_options(fn, options));
-    if (size > DWVIO_SCENE_MAX_BYTES)
+    if (size > DWVS_SCENE_MAX_BYTES)
         return dwv_fail(DWV_ERROR_FORMAT, "%s: the scene text is %llu bytes, more than %u", fn,
-                        (unsigned long long)size, DWVIO_SCENE_MAX_BYTES);
-    return dwvio_scene_from_json(json, (size_t)size, base_dir ? base_dir : ".", scene, options);
+                        (unsigned long long)size, DWVS_SCENE_MAX_BYTES);
+    return dwvs_scene_from_json(json, (size_t)size, base_dir ? base_dir : ".", scene, options);
 }
 
 /* The folder of `path` ("." if it names none), for relative mesh paths. */
@@ -56,7 +56,7 @@ static char *folder_of(const char *path)
     return folder;
 }
 
-/* Reads at most DWVIO_SCENE_MAX_BYTES + 1 bytes (so a larger file, or a pipe that never ends,
+/* Reads at most DWVS_SCENE_MAX_BYTES + 1 bytes (so a larger file, or a pipe that never ends,
  * is refused without reading it all). */
 static dwv_result_t read_text(const char *path, char **text, size_t *size)
 {
@@ -84,8 +84,8 @@ static dwv_result_t read_text(const char *path, char **text, size_t *size)
         }
         size_t got = fread(buffer + n, 1, capacity - n, file);
         n += got;
-        if (n > DWVIO_SCENE_MAX_BYTES) {
-            result = dwv_fail(DWV_ERROR_FORMAT, "the file is larger than %u bytes", DWVIO_SCENE_MAX_BYTES);
+        if (n > DWVS_SCENE_MAX_BYTES) {
+            result = dwv_fail(DWV_ERROR_FORMAT, "the file is larger than %u bytes", DWVS_SCENE_MAX_BYTES);
             break;
         }
         if (got == 0) {
@@ -121,7 +121,7 @@ dwv_result_t dwv_scene_load(const char *path, dwv_scene_t **scene, dwv_bake_opti
         free(text);
         return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "%s: out of memory", fn);
     }
-    r = dwvio_scene_from_json(text, size, folder, scene, options);
+    r = dwvs_scene_from_json(text, size, folder, scene, options);
     free(folder);
     free(text);
     return r == DWV_SUCCESS ? r : prefixed(r, path);
@@ -133,6 +133,6 @@ dwv_result_t dwv_scene_create_default(dwv_scene_t **scene, dwv_bake_options_t *o
     DWV_TRY(dwv_check_pointer(fn, "scene", scene));
     *scene = NULL;
     DWV_TRY(check_options(fn, options));
-    dwv_result_t r = dwvio_default_scene(scene, options);
+    dwv_result_t r = dwvs_default_scene(scene, options);
     return r == DWV_SUCCESS ? r : prefixed(r, fn);
 }
