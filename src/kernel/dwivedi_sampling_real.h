@@ -1,4 +1,4 @@
-/* Body of src/kernel/dwivedi.h for one precision: included with DWVK_REAL (double or float) and
+/* Body of src/kernel/dwivedi_sampling.h for one precision: included with DWVK_REAL (double or float) and
  * DWVK_SUFFIX(name) defined. <tgmath.h> picks exp/expm1/... of that precision. */
 
 typedef DWVK_REAL DWVK_SUFFIX(dwvk_real);

@@ -1,4 +1,4 @@
-/* Triangle meshes read from OBJ and PLY files with Assimp's C API (src/io knows nothing of the
+/* Triangle meshes read from OBJ and PLY files with Assimp's C API (src/scenefile knows nothing of the
  * scene store: the caller hands the arrays to dwv_scene_add_mesh, which validates them). */
 #ifndef DWV_SCENEFILE_MESH_FILE_H
 #define DWV_SCENEFILE_MESH_FILE_H

@@ -1,5 +1,5 @@
 /* capi entry points of scene files and the default scene. They are clients of the public
- * dwv_scene_* calls (src/io builds scenes only through them), plus the checks of their own
+ * dwv_scene_* calls (src/scenefile builds scenes only through them), plus the checks of their own
  * arguments and the reading of the file. */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>

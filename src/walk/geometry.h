@@ -9,7 +9,8 @@
 
 typedef enum dwvw_shape_kind { DWVW_HALFSPACE = 0, DWVW_SLAB = 1, DWVW_SPHERE = 2 } dwvw_shape_kind;
 /* The API passes DWV_SHAPE_* values through as dwvw_shape_kind: the same numbers. */
-_Static_assert((int)DWVW_HALFSPACE == DWV_SHAPE_HALFSPACE && (int)DWVW_SLAB == DWV_SHAPE_SLAB && (int)DWVW_SPHERE == DWV_SHAPE_SPHERE,
+_Static_assert((int)DWVW_HALFSPACE == DWV_SHAPE_HALFSPACE && (int)DWVW_SLAB == DWV_SHAPE_SLAB &&
+                   (int)DWVW_SPHERE == DWV_SHAPE_SPHERE,
                "dwvw_shape_kind must equal the DWV_SHAPE_* values (capi/dwivedi.h)");
 
 /* The medium: half-space z >= 0; slab 0 <= z <= thickness; sphere of `radius` about (0, 0, radius).

@@ -197,7 +197,7 @@ class CyclesTest(harness.unittest.TestCase):
         self.assertLessEqual(worst, 1.0 / 255 + 1e-6)
 
     # PNG colour is not premultiplied: Blender divides by alpha before the view transform, and so
-    # does the library (src/io/display.cpp, docs/output.md).
+    # does the library (src/output/display.cpp, docs/output.md).
     def test_display_png_partly_covered_pixels(self):
         ours, theirs = self.display_pngs()
         worst, count = self.worst(ours, theirs, opaque=False)

@@ -1,6 +1,6 @@
 /* libFuzzer target: mesh files. The first byte picks OBJ (even) or PLY (odd) (or the environment
  * variable DWV_FUZZ_MESH_KIND=obj / ply fixes it); the rest is written to a file of that kind and
- * read by dwvs_mesh_file_read (src/io/mesh_file.c: our checks, then Assimp), the internal call
+ * read by dwvs_mesh_file_read (src/scenefile/mesh_file.c: our checks, then Assimp), the internal call
  * that dwv_scene_load makes for each mesh file, so that a run does not pay for building a scene.
  * Any file must give arrays that keep their promises (indices below the vertex count) or a
  * message, never a crash.

@@ -1,6 +1,6 @@
 /* The walk's per-event single-precision kernels against double-precision libm, over their whole
  * domains where that is feasible (every 24-bit uniform the walk can draw), and the error bounds
- * their comments state (src/kernel/fastmath.h, src/kernel/dwivedi.h):
+ * their comments state (src/kernel/fastmath.h, src/kernel/dwivedi_sampling.h):
  *   dwvk_expm1_fast_f       relative error < 2.4e-7 on [-80, 80]
  *   dwvk_exp_fast (double)  relative error < 5e-16 on [-708, 709.78] against long double's expl
  *                           (the table-driven fast part and the edge path beyond |x| = 708.39);

@@ -131,7 +131,8 @@ static dwvb_image *make_image(void)
     img->stats.events = 12345678901234ull;
     img->stats.seconds = 1.25;
     img->stats.estimated_relative_error = 0.0123;
-    img->stats.features = DWV_FEATURE_EMBREE | DWV_FEATURE_SUBSURFACE | DWV_FEATURE_GUIDED;
+    /* Every name from dwv_feature_name (the sheet's too), and a bit no version names yet. */
+    img->stats.features = DWV_FEATURE_EMBREE | DWV_FEATURE_SUBSURFACE | DWV_FEATURE_GUIDED | DWV_FEATURE_SHEET | (1u << 20);
     dwv_error_point_t p1 = {0.5, 0.05, 16}, p2 = {1.25, 0.0123, 64};
     dwvb_image_add_error_point(img, p1);
     dwvb_image_add_error_point(img, p2);
@@ -280,7 +281,7 @@ static void test_exr_round_trip(void)
     CHECK(ch.width == W && ch.height == H, "size %d x %d", ch.width, ch.height);
     CHECK(ch.count == 8, "8 channels, got %d", ch.count);
     /* A dot makes a layer ("x.R" is R of layer x), and Blender 3.4 loads a file with layers only
-     * as render passes, with no pixels for bpy.data.images.load: see src/io/exr.c. */
+     * as render passes, with no pixels for bpy.data.images.load: see src/output/exr.c. */
     for (int k = 0; k < ch.count; ++k) CHECK(strchr(ch.names[k], '.') == NULL, "channel '%s' has no dot", ch.names[k]);
     const char *floats[] = {"R", "G", "B", "A", "variance_R", "variance_G", "variance_B"};
     for (int k = 0; k < 7; ++k) {
@@ -315,7 +316,7 @@ static void test_exr_round_trip(void)
                   strncmp(s, dwv_version_string(), (size_t)n) == 0,
               "version %.*s", n, s ? s : "");
         CHECK(exr_attr_get_string(c, 0, "dwivedi:features", &n, &s) == 0 && s &&
-                  strncmp(s, "embree,subsurface,guided", (size_t)n) == 0 && n == 24,
+                  strncmp(s, "embree,subsurface,guided,sheet,bit20", (size_t)n) == 0 && n == 36,
               "features %.*s", n, s ? s : "");
         CHECK(exr_attr_get_string(c, 0, "dwivedi:events", &n, &s) == 0 && s && strncmp(s, "12345678901234", (size_t)n) == 0,
               "events %.*s", n, s ? s : "");
@@ -345,7 +346,7 @@ static void test_exr_round_trip(void)
                                   "    samples, 32-bit unsigned integer", "zip", "dwivedi:technique (type string): \"incident\"",
                                   "dwivedi:samples (type int): 64", "dwivedi:seconds (type double): 1.25",
                                   "dwivedi:estimated_relative_error (type double)", "dwivedi:version (type string)",
-                                  "dwivedi:features (type string): \"embree,subsurface,guided\"", "dwivedi:error_vs_time"};
+                                  "dwivedi:features (type string): \"embree,subsurface,guided,sheet,bit20\"", "dwivedi:error_vs_time"};
         for (size_t k = 0; k < sizeof expected / sizeof *expected; ++k)
             CHECK(strstr(header, expected[k]) != NULL, "exrheader shows '%s':\n%s", expected[k], header);
         free(header);
