@@ -79,6 +79,8 @@ dwv_result_t dwvs_opt_number(const cJSON *object, const char *parent, const char
 dwv_result_t dwvs_opt_vector(const cJSON *object, const char *parent, const char *key, size_t n, double *out);
 dwv_result_t dwvs_opt_u32(const cJSON *object, const char *parent, const char *key, uint32_t lo, uint32_t hi,
                           uint32_t *out);
+dwv_result_t dwvs_opt_choice(const cJSON *object, const char *parent, const char *key, const char *const *names,
+                             size_t count, size_t *out);
 /* The object's "transform" (a matrix, a look_at, or translate/rotate/scale) into the 3 x 4
  * row-major m; m is left alone when the key is absent. */
 dwv_result_t dwvs_opt_transform(const cJSON *object, const char *parent, double m[12]);

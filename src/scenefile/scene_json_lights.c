@@ -39,11 +39,7 @@ static dwv_result_t read_light(dwvs_parser *ps, const cJSON *item, const char *p
         DWV_TRY(dwvs_opt_number(item, path, "radius", &light.radius));
     } else {
         size_t shape = 0;
-        const cJSON *shape_item = dwvs_member(item, "shape");
-        if (shape_item) {
-            dwvs_path_key(p, path, "shape");
-            DWV_TRY(dwvs_read_choice(shape_item, p, shapes, 2, &shape));
-        }
+        DWV_TRY(dwvs_opt_choice(item, path, "shape", shapes, 2, &shape));
         light.kind = shape == 0 ? DWV_LIGHT_AREA_RECTANGLE : DWV_LIGHT_AREA_DISK;
         DWV_TRY(dwvs_opt_transform(item, path, light.transform));
         DWV_TRY(dwvs_opt_number(item, path, "size_x", &light.size_x));
@@ -86,8 +82,7 @@ dwv_result_t dwvs_read_camera(dwvs_parser *ps, const cJSON *item)
     if (!cJSON_IsObject(item))
         return dwvs_fail_at(DWV_ERROR_FORMAT, "camera", "expected an object, found %s", dwvs_type_name(item));
     size_t kind = 0;
-    const cJSON *kind_item = dwvs_member(item, "kind");
-    if (kind_item) DWV_TRY(dwvs_read_choice(kind_item, "camera.kind", kinds, 2, &kind));
+    DWV_TRY(dwvs_opt_choice(item, "camera", "kind", kinds, 2, &kind));
     if (kind == 0)
         DWV_TRY(dwvs_check_keys(item, "camera", perspective_keys, sizeof perspective_keys / sizeof perspective_keys[0]));
     else

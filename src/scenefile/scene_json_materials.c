@@ -15,14 +15,9 @@ static dwv_result_t read_material(dwvs_parser *ps, const cJSON *item, const char
     static const char *const exits[] = {"lambert", "principled_v1"};
     DWV_TRY(dwvs_check_keys(item, path, keys, sizeof keys / sizeof keys[0]));
     dwv_material_t m = DWV_MATERIAL_INIT;
-    const cJSON *kind = dwvs_member(item, "kind");
-    if (kind) {
-        char p[PATH_SIZE];
-        size_t k = 0;
-        dwvs_path_key(p, path, "kind");
-        DWV_TRY(dwvs_read_choice(kind, p, kinds, 2, &k));
-        m.kind = k == 0 ? DWV_MATERIAL_SUBSURFACE : DWV_MATERIAL_DIFFUSE;
-    }
+    size_t kind = 0, exit = 0; /* DWV_MATERIAL_INIT's: subsurface, lambert */
+    DWV_TRY(dwvs_opt_choice(item, path, "kind", kinds, 2, &kind));
+    m.kind = kind == 0 ? DWV_MATERIAL_SUBSURFACE : DWV_MATERIAL_DIFFUSE;
     DWV_TRY(dwvs_opt_vector(item, path, "base_color", 3, m.base_color));
     DWV_TRY(dwvs_opt_number(item, path, "subsurface_weight", &m.subsurface_weight));
     DWV_TRY(dwvs_opt_vector(item, path, "subsurface_color", 3, m.subsurface_color));
@@ -30,14 +25,8 @@ static dwv_result_t read_material(dwvs_parser *ps, const cJSON *item, const char
     DWV_TRY(dwvs_opt_number(item, path, "subsurface_scale", &m.subsurface_scale));
     DWV_TRY(dwvs_opt_number(item, path, "subsurface_anisotropy", &m.subsurface_anisotropy));
     DWV_TRY(dwvs_opt_number(item, path, "subsurface_ior", &m.subsurface_ior));
-    const cJSON *exit = dwvs_member(item, "subsurface_exit");
-    if (exit) {
-        char p[PATH_SIZE];
-        size_t k = 0;
-        dwvs_path_key(p, path, "subsurface_exit");
-        DWV_TRY(dwvs_read_choice(exit, p, exits, 2, &k));
-        m.subsurface_exit = k == 0 ? DWV_SUBSURFACE_EXIT_LAMBERT : DWV_SUBSURFACE_EXIT_PRINCIPLED_V1;
-    }
+    DWV_TRY(dwvs_opt_choice(item, path, "subsurface_exit", exits, 2, &exit));
+    m.subsurface_exit = exit == 0 ? DWV_SUBSURFACE_EXIT_LAMBERT : DWV_SUBSURFACE_EXIT_PRINCIPLED_V1;
     DWV_TRY(dwvs_opt_number(item, path, "roughness", &m.roughness));
     uint32_t id;
     dwv_result_t r = dwv_scene_add_material(ps->scene, &m, &id);

@@ -211,6 +211,16 @@ dwv_result_t dwvs_opt_u32(const cJSON *object, const char *parent, const char *k
     return dwvs_read_u32(item, p, lo, hi, out);
 }
 
+dwv_result_t dwvs_opt_choice(const cJSON *object, const char *parent, const char *key, const char *const *names,
+                             size_t count, size_t *out)
+{
+    const cJSON *item = dwvs_member(object, key);
+    if (!item) return DWV_SUCCESS;
+    char p[PATH_SIZE];
+    dwvs_path_key(p, parent, key);
+    return dwvs_read_choice(item, p, names, count, out);
+}
+
 /* An array of numbers whose length is a multiple of `group`, as floats. */
 
 /* ---- transforms ----------------------------------------------------------------------------- */
