@@ -33,6 +33,9 @@ dwv_result_t dwvb_bake_finish(dwvb_bake *bake, dwvb_image **image, char *message
 /* Cancels if running, waits, frees. */
 void dwvb_bake_free(dwvb_bake *bake);
 
+/* The bake's resolved options. */
+const dwv_bake_options_t *dwvb_bake_options(const dwvb_bake *bake);
+
 /* Embree's memory for the scene's geometry, in bytes (for memory per triangle). */
 long long dwvb_scene_geometry_bytes(const dwvb_scene *scene);
 
