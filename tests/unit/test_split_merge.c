@@ -3,6 +3,7 @@
  * error), for 1, 2 and 3 unequal chunks in any order; missing, duplicate, overlapping, truncated,
  * corrupt and foreign chunks are refused with a message naming the file. */
 #define _POSIX_C_SOURCE 200809L
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -157,6 +158,15 @@ int main(void)
     o.sample_count = 3;
     dwv_image_t *none = NULL;
     CHECK(dwv_bake(scene, &o, &none) == DWV_ERROR_OUT_OF_RANGE, "range beyond the samples refused");
+    /* A caller of the older header (struct_size ending before sample_first) gets a whole bake. */
+    dwv_bake_options_t old = base;
+    old.struct_size = (uint32_t)offsetof(dwv_bake_options_t, sample_first);
+    old.sample_first = 99; /* beyond its struct_size: never read */
+    old.sample_count = 99;
+    dwv_image_t *old_image = NULL;
+    CHECK(dwv_bake(scene, &old, &old_image) == DWV_SUCCESS && same_image(old_image, whole),
+          "older struct_size: the whole bake (%s)", dwv_last_error_message());
+    dwv_image_release(old_image);
     dwv_image_release(whole);
     dwv_scene_release(scene);
     char command[400];
