@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "kernel/rng.h"
+#include "step.h"
 #include "util/clock.h"
 #include "util/parallel.h"
 
@@ -195,23 +196,18 @@ static inline dwvu_vec3 aligned_guided_direction(const fast_plan *plan, const dw
 /* dwvw_cosine(direction, plan->axis) for an aligned plan. */
 static inline double aligned_cosine(const fast_plan *plan, dwvu_vec3 direction)
 {
-    double mu = plan->axis_sign * component(direction, plan->axis_index);
-    return mu < -1.0 ? -1.0 : mu > 1.0 ? 1.0 : mu;
+    return dwvw_clamp_cosine(plan->axis_sign * component(direction, plan->axis_index));
 }
 
-/* The Russian roulette of dwvw_walk_complete on a weight exp(log_weight) after `events` events:
- * 0 if the walk ends (absorbed), 1 if it goes on unchanged, 2 if it goes on with its weight raised
- * to the threshold (*log_weight = its log). */
-#define DWVW_LOG_ROULETTE_THRESHOLD -0.69314718055994531 /* log(DWVW_ROULETTE_THRESHOLD) */
-static int roulette(uint64_t key, uint32_t events, double *log_weight)
+/* The Russian roulette of dwvw_walk_complete (dwvw_roulette_survives) on a weight
+ * exp(log_weight) after `events` events: 0 if the walk ends (absorbed), 1 if it goes on
+ * unchanged, 2 if it goes on with its weight raised to the threshold (*log_weight = its log). */
+static int guided_roulette(uint64_t key, uint32_t events, double *log_weight)
 {
-    const double log_threshold = DWVW_LOG_ROULETTE_THRESHOLD;
-    if (!(*log_weight < log_threshold)) return 1;
-    double weight = exp(*log_weight);
-    if (!(weight > 0.0)) return 0;
-    double survive = weight / DWVW_ROULETTE_THRESHOLD;
-    if (dwvk_rng_uniform_d(key, dwvw_event_dim(events - 1u) + DWVW_DIM_ROULETTE) >= survive) return 0;
-    *log_weight = log_threshold; /* weight / survive */
+    if (!(*log_weight < DWVW_LOG_ROULETTE_THRESHOLD)) return 1;
+    double weight = exp(*log_weight), survive;
+    if (!(weight > 0.0) || !dwvw_roulette_survives(key, events, weight, &survive)) return 0;
+    *log_weight = DWVW_LOG_ROULETTE_THRESHOLD; /* log(weight / survive) */
     return 2;
 }
 
@@ -231,29 +227,14 @@ static inline void classical_walk_in(const dwvw_estimate_setup *setup, dwvw_shap
             direction = dwvw_classical_direction(direction, g, dwvk_rng_uniform_pair_f(key, dim + DWVW_DIM_DIRECTION));
         double t = dwvw_flight(sigma, dwvk_rng_uniform_f(key, dim + DWVW_DIM_DISTANCE));
         double hit = dwvw_shape_exit_inline(&setup->shape, kind, position, direction, &normal);
-        if (hit <= t) {
+        if (dwvw_leaves(hit, t)) {
             end->status = DWVW_EXITED;
             break;
         }
         add_flight(&position, direction, t);
         ++events;
         weight *= albedo;
-        if (!(weight > 0.0)) {
-            end->status = DWVW_ABSORBED;
-            break;
-        }
-        if (weight < DWVW_ROULETTE_THRESHOLD) {
-            double survive = weight / DWVW_ROULETTE_THRESHOLD;
-            if (dwvk_rng_uniform_d(key, dwvw_event_dim(events - 1u) + DWVW_DIM_ROULETTE) >= survive) {
-                end->status = DWVW_ABSORBED;
-                break;
-            }
-            weight /= survive;
-        }
-        if (events >= setup->max_events) {
-            end->status = DWVW_TRUNCATED;
-            break;
-        }
+        if (!dwvw_grey_goes_on(key, events, setup->max_events, &weight, &end->status)) break;
     }
     end->events = events;
     end->weight[0] = end->status == DWVW_ABSORBED ? 0.0 : weight;
@@ -310,21 +291,20 @@ static inline void guided_walk_in(const dwvw_estimate_setup *setup, const fast_p
     /* log weight = log_constants - sigma x exponent, exponent = sum over steps of (1 - s) t. */
     double log_constants = 0.0, exponent = 0.0, log_weight = 0.0, last_factor = 1.0;
     /* The RNG counter of this event's direction dimension, stepped by additions (dwvk_rng_counter). */
-    const uint64_t event_step = (uint64_t)DWVW_DIMS_PER_EVENT * DWVK_GOLDEN_GAMMA;
-    const uint64_t to_distance = (uint64_t)(DWVW_DIM_DISTANCE - DWVW_DIM_DIRECTION) * DWVK_GOLDEN_GAMMA;
+    const uint64_t to_distance = DWVW_DIM_COUNTER_OFFSET(DWVW_DIM_DIRECTION, DWVW_DIM_DISTANCE);
     uint64_t counter = dwvk_rng_counter(key, dwvw_event_dim(0) + DWVW_DIM_DIRECTION);
-    for (;; counter += event_step) {
+    for (;; counter += DWVW_EVENT_COUNTER_STEP) {
         /* The first step (events = 0) keeps the entry direction: its constant is log(alpha / s0). */
         if (events > 0) {
-            dwvk_uniform_pair_f u = dwvk_uniform_pair_f_from_bits(dwvk_mix64(counter));
+            dwvk_uniform_pair_f u = dwvw_counter_uniform_pair_f(counter);
             direction = plan->aligned ? aligned_guided_direction(plan, &m->dwivedi_event, u)
                                       : dwvw_guided_direction_turned(plan->turned, &m->dwivedi_event, u);
         }
         double mu = plan->aligned ? aligned_cosine(plan, direction) : dwvw_cosine(direction, plan->axis);
         double stretch = dwvk_dwivedi_stretch_d(&m->dwivedi, mu);
-        double t = dwvw_flight(sigma * stretch, dwvk_uniform_f_from_bits(dwvk_mix64(counter + to_distance)));
+        double t = dwvw_flight(sigma * stretch, dwvw_counter_uniform_f(counter + to_distance));
         double hit = dwvw_shape_exit_inline(&setup->shape, kind, position, direction, &normal);
-        if (hit <= t) {
+        if (dwvw_leaves(hit, t)) {
             add_flight(&position, direction, hit);
             exponent += (1.0 - stretch) * hit;
             log_weight = log_constants - sigma * exponent;
@@ -339,7 +319,7 @@ static inline void guided_walk_in(const dwvw_estimate_setup *setup, const fast_p
         ++events;
         log_weight = log_constants - sigma * exponent;
         if (log_weight < DWVW_LOG_ROULETTE_THRESHOLD) {
-            int fate = roulette(key, events, &log_weight);
+            int fate = guided_roulette(key, events, &log_weight);
             if (fate == 0) {
                 end->status = DWVW_ABSORBED;
                 break;
@@ -393,46 +373,28 @@ static inline void mixture_walk_in(const dwvw_estimate_setup *setup, const fast_
             direction = !guided       ? dwvw_classical_direction(previous, g, u)
                         : plan->aligned ? aligned_guided_direction(plan, &m->dwivedi_event, u)
                                         : dwvw_guided_direction_turned(plan->turned, &m->dwivedi_event, u);
-            phase = g == 0.0f ? DWVK_INV_FOUR_PI : dwvk_hg_pdf_f(g, (float)dwvw_cosine(previous, direction));
+            phase = dwvw_phase_value(g, previous, direction);
         }
         double stretch = dwvk_dwivedi_stretch_d(&m->dwivedi, plan->aligned ? aligned_cosine(plan, direction)
                                                                            : dwvw_cosine(direction, plan->axis));
         if (events > 0) pdf_guided = m->guided_pdf_scale / stretch;
         double t = dwvw_flight(sigma * (guided ? stretch : 1.0), dwvk_rng_uniform_f(key, dim + DWVW_DIM_DISTANCE));
         double hit = dwvw_shape_exit_inline(&setup->shape, kind, position, direction, &normal);
-        int exited = hit <= t;
-        if (exited) t = hit;
-        /* dwvw_walk_complete's grey branch, term by term. */
+        int exited;
+        t = dwvw_step_length(hit, t, &exited);
+        /* dwvw_walk_complete's grey branch, term by term (the classical term's stretch and decay
+         * are 1). */
         double qp0 = q0 * phase, qp1 = q1 * pdf_guided, denominator = 0.0;
-        if (qp0 > 0.0) denominator += qp0 * 1.0 * 1.0;
-        if (qp1 > 0.0) {
-            double decay = stretch == 1.0 ? 1.0 : dwvk_exp_fast(sigma * (1.0 - stretch) * t);
-            denominator += qp1 * (exited ? 1.0 : stretch) * decay;
-        }
-        double ratio = phase * (exited ? 1.0 : albedo) / denominator;
-        weight *= isfinite(ratio) ? ratio : 0.0;
+        if (qp0 > 0.0) denominator += dwvw_grey_term(qp0, 1.0, 1.0, exited);
+        if (qp1 > 0.0) denominator += dwvw_grey_term(qp1, stretch, dwvw_grey_decay(sigma, stretch, t), exited);
+        weight *= dwvw_grey_ratio(phase, albedo, denominator, exited);
         add_flight(&position, direction, t);
         if (exited) {
             end->status = DWVW_EXITED;
             break;
         }
         ++events;
-        if (!(weight > 0.0)) {
-            end->status = DWVW_ABSORBED;
-            break;
-        }
-        if (weight < DWVW_ROULETTE_THRESHOLD) {
-            double survive = weight / DWVW_ROULETTE_THRESHOLD;
-            if (dwvk_rng_uniform_d(key, dwvw_event_dim(events - 1u) + DWVW_DIM_ROULETTE) >= survive) {
-                end->status = DWVW_ABSORBED;
-                break;
-            }
-            weight /= survive;
-        }
-        if (events >= setup->max_events) {
-            end->status = DWVW_TRUNCATED;
-            break;
-        }
+        if (!dwvw_grey_goes_on(key, events, setup->max_events, &weight, &end->status)) break;
     }
     end->events = events;
     end->weight[0] = end->status == DWVW_ABSORBED ? 0.0 : weight;
@@ -602,13 +564,13 @@ static void lane_begin(guided_lanes *L, int l, const dwvw_estimate_setup *setup,
  * are discarded). */
 static inline double lane_halfspace_exit(double pz, double wz)
 {
-    double toward_front = dwvw_positive_part(pz) / -wz;
+    double toward_front = dwvw_front_plane_distance(pz, wz);
     return wz < 0.0 ? toward_front : INFINITY;
 }
 
 static inline double lane_slab_exit(double thickness, double pz, double wz)
 {
-    double toward_front = dwvw_positive_part(pz) / -wz, toward_back = dwvw_positive_part(thickness - pz) / wz;
+    double toward_front = dwvw_front_plane_distance(pz, wz), toward_back = dwvw_back_plane_distance(thickness, pz, wz);
     return wz < 0.0 ? toward_front : wz > 0.0 ? toward_back : INFINITY;
 }
 
@@ -620,11 +582,6 @@ static inline double lane_slab_exit(double thickness, double pz, double wz)
  * turns (the same products as aligned_guided_direction's turned frame, signs exact). */
 /* Each shape's step gets its own copy of the loops, with its exit test (GCC and Clang otherwise
  * judge the function too large to inline three times). */
-#if defined(__GNUC__)
-#define DWVW_ALWAYS_INLINE inline __attribute__((always_inline))
-#else
-#define DWVW_ALWAYS_INLINE inline
-#endif
 
 static DWVW_ALWAYS_INLINE int lanes_step_in(guided_lanes *L, const dwvw_estimate_setup *setup, const fast_plan *plan,
                                 dwvw_shape_kind kind)
@@ -633,18 +590,17 @@ static DWVW_ALWAYS_INLINE int lanes_step_in(guided_lanes *L, const dwvw_estimate
     const dwvk_dwivedi_event_f *d = &m->dwivedi_event;
     const double sigma = m->sigma_t[0], log_per_event = plan->log_per_event, thickness = setup->shape.thickness;
     const uint32_t max_events = setup->max_events;
-    const uint64_t to_distance = (uint64_t)(DWVW_DIM_DISTANCE - DWVW_DIM_DIRECTION) * DWVK_GOLDEN_GAMMA;
-    const uint64_t event_step = (uint64_t)DWVW_DIMS_PER_EVENT * DWVK_GOLDEN_GAMMA;
+    const uint64_t to_distance = DWVW_DIM_COUNTER_OFFSET(DWVW_DIM_DIRECTION, DWVW_DIM_DISTANCE);
     const double sy = plan->sign[0][1], sz = plan->sign[0][2], axis_sign = plan->axis_sign;
     const double kappa = m->dwivedi.kappa, one_minus_kappa = m->dwivedi.one_minus_kappa;
     float ua[DWVW_LANES], ub[DWVW_LANES], udist[DWVW_LANES];
     float cos_theta[DWVW_LANES], sin_theta[DWVW_LANES], azimuth_c[DWVW_LANES], azimuth_s[DWVW_LANES];
     for (int l = 0; l < DWVW_LANES; ++l) {
-        uint64_t bits = dwvk_mix64(L->counter[l]);
-        ua[l] = dwvk_uniform_f_from_bits(bits);
-        ub[l] = (float)(int32_t)((bits >> 16) & 0xffffffu) * 0x1.0p-24f; /* dwvk_uniform_pair_f_from_bits */
-        udist[l] = dwvk_uniform_f_from_bits(dwvk_mix64(L->counter[l] + to_distance));
-        L->counter[l] += event_step;
+        dwvk_uniform_pair_f u = dwvw_counter_uniform_pair_f(L->counter[l]);
+        ua[l] = u.a;
+        ub[l] = u.b;
+        udist[l] = dwvw_counter_uniform_f(L->counter[l] + to_distance);
+        L->counter[l] += DWVW_EVENT_COUNTER_STEP;
     }
     for (int l = 0; l < DWVW_LANES; ++l) {
         dwvk_dwivedi_event_cosine_f s = dwvk_dwivedi_event_sample_select_f(d, ua[l]);
@@ -668,8 +624,7 @@ static DWVW_ALWAYS_INLINE int lanes_step_in(guided_lanes *L, const dwvw_estimate
     int any = 0;
     for (int l = 0; l < DWVW_LANES; ++l) {
         double px = L->px[l], py = L->py[l], pz = L->pz[l], wx = L->dx[l], wy = L->dy[l], wz = L->dz[l];
-        double mu = axis_sign * wz;
-        mu = mu < -1.0 ? -1.0 : mu > 1.0 ? 1.0 : mu;
+        double mu = dwvw_clamp_cosine(axis_sign * wz);
         /* dwvk_dwivedi_stretch_d, its constants loaded before the loop and both sides formed. */
         double stretch_above = one_minus_kappa + kappa * (1.0 - mu), stretch_below = 1.0 - kappa * mu;
         double stretch = mu >= 0.0 ? stretch_above : stretch_below;
@@ -681,8 +636,8 @@ static DWVW_ALWAYS_INLINE int lanes_step_in(guided_lanes *L, const dwvw_estimate
             dwvu_vec3 normal;
             hit = dwvw_shape_exit_inline(&setup->shape, kind, dwvu_v(px, py, pz), dwvu_v(wx, wy, wz), &normal);
         }
-        int exited = hit <= t;
-        double step = exited ? hit : t;
+        int exited;
+        double step = dwvw_step_length(hit, t, &exited);
         double exponent = L->exponent[l] + (1.0 - stretch) * step;
         double before = L->log_constants[l], first = L->first_constant[l]; /* loaded unconditionally */
         double later = before + log_per_event;
@@ -742,7 +697,7 @@ static int lane_end(guided_lanes *L, int l, const dwvw_estimate_setup *setup, co
     } else {
         if (L->log_weight[l] < DWVW_LOG_ROULETTE_THRESHOLD) {
             double log_weight = L->log_weight[l];
-            int fate = roulette(L->key[l], events, &log_weight);
+            int fate = guided_roulette(L->key[l], events, &log_weight);
             if (fate == 0) {
                 end->status = DWVW_ABSORBED;
                 goto done;
@@ -850,7 +805,9 @@ static DWVW_ALWAYS_INLINE int mixture_lanes_step_in(guided_lanes *L, const dwvw_
     const double q0 = setup->guide.q_classical, q1 = plan->q_guided, total = q0 + q1;
     const double phase = DWVK_INV_FOUR_PI, pdf_scale = m->guided_pdf_scale;
     const uint32_t max_events = setup->max_events;
-    const uint64_t gamma = DWVK_GOLDEN_GAMMA, event_step = (uint64_t)DWVW_DIMS_PER_EVENT * DWVK_GOLDEN_GAMMA;
+    const uint64_t to_component = DWVW_DIM_COUNTER_OFFSET(DWVW_DIM_CHANNEL, DWVW_DIM_COMPONENT);
+    const uint64_t to_direction = DWVW_DIM_COUNTER_OFFSET(DWVW_DIM_CHANNEL, DWVW_DIM_DIRECTION);
+    const uint64_t to_distance = DWVW_DIM_COUNTER_OFFSET(DWVW_DIM_CHANNEL, DWVW_DIM_DISTANCE);
     const double sy = plan->sign[0][1], sz = plan->sign[0][2], axis_sign = plan->axis_sign;
     const double kappa = m->dwivedi.kappa, one_minus_kappa = m->dwivedi.one_minus_kappa;
     float ua[DWVW_LANES], ub[DWVW_LANES], udist[DWVW_LANES];
@@ -859,13 +816,12 @@ static DWVW_ALWAYS_INLINE int mixture_lanes_step_in(guided_lanes *L, const dwvw_
      * distance +4. */
     for (int l = 0; l < DWVW_LANES; ++l) {
         uint64_t c = L->counter[l];
-        double u_component = (double)(dwvk_mix64(c + gamma * DWVW_DIM_COMPONENT) >> 11) * 0x1.0p-53;
-        guided[l] = !(u_component * total < q0);
-        uint64_t bits = dwvk_mix64(c + gamma * DWVW_DIM_DIRECTION);
-        ua[l] = dwvk_uniform_f_from_bits(bits);
-        ub[l] = (float)(int32_t)((bits >> 16) & 0xffffffu) * 0x1.0p-24f;
-        udist[l] = dwvk_uniform_f_from_bits(dwvk_mix64(c + gamma * DWVW_DIM_DISTANCE));
-        L->counter[l] = c + event_step;
+        guided[l] = !(dwvw_counter_uniform_d(c + to_component) * total < q0);
+        dwvk_uniform_pair_f u = dwvw_counter_uniform_pair_f(c + to_direction);
+        ua[l] = u.a;
+        ub[l] = u.b;
+        udist[l] = dwvw_counter_uniform_f(c + to_distance);
+        L->counter[l] = c + DWVW_EVENT_COUNTER_STEP;
     }
     double wx[DWVW_LANES], wy[DWVW_LANES], wz[DWVW_LANES];
     for (int l = 0; l < DWVW_LANES; ++l) {
@@ -897,8 +853,7 @@ static DWVW_ALWAYS_INLINE int mixture_lanes_step_in(guided_lanes *L, const dwvw_
     int exited_of[DWVW_LANES];
     for (int l = 0; l < DWVW_LANES; ++l) {
         double pz = L->pz[l], z = wz[l];
-        double mu = axis_sign * z;
-        mu = mu < -1.0 ? -1.0 : mu > 1.0 ? 1.0 : mu;
+        double mu = dwvw_clamp_cosine(axis_sign * z);
         double stretch_above = one_minus_kappa + kappa * (1.0 - mu), stretch_below = 1.0 - kappa * mu;
         double stretch = mu >= 0.0 ? stretch_above : stretch_below;
         double t = dwvw_flight(sigma * (guided[l] ? stretch : 1.0), udist[l]);
@@ -910,13 +865,13 @@ static DWVW_ALWAYS_INLINE int mixture_lanes_step_in(guided_lanes *L, const dwvw_
             hit = dwvw_shape_exit_inline(&setup->shape, kind, dwvu_v(L->px[l], L->py[l], pz), dwvu_v(wx[l], wy[l], z),
                                          &normal);
         }
-        int exited = hit <= t;
+        int exited;
+        t_of[l] = dwvw_step_length(hit, t, &exited);
         stretch_of[l] = stretch;
-        t_of[l] = exited ? hit : t;
         exited_of[l] = exited;
     }
     for (int l = 0; l < DWVW_LANES; ++l)
-        decay_of[l] = stretch_of[l] == 1.0 ? 1.0 : dwvk_exp_fast(sigma * (1.0 - stretch_of[l]) * t_of[l]);
+        decay_of[l] = dwvw_grey_decay(sigma, stretch_of[l], t_of[l]);
     int any = 0;
     for (int l = 0; l < DWVW_LANES; ++l) {
         double px = L->px[l], py = L->py[l], pz = L->pz[l], x = wx[l], y = wy[l], z = wz[l];
@@ -925,10 +880,9 @@ static DWVW_ALWAYS_INLINE int mixture_lanes_step_in(guided_lanes *L, const dwvw_
         double step_phase = first ? 1.0 : phase, pdf_guided = first ? 1.0 : pdf_scale / stretch;
         /* mixture_walk_in's denominator, term by term. */
         double qp0 = q0 * step_phase, qp1 = q1 * pdf_guided, denominator = 0.0;
-        if (qp0 > 0.0) denominator += qp0 * 1.0 * 1.0;
-        if (qp1 > 0.0) denominator += qp1 * (exited ? 1.0 : stretch) * decay_of[l];
-        double ratio = step_phase * (exited ? 1.0 : albedo) / denominator;
-        double weight = L->weight[l] * (isfinite(ratio) ? ratio : 0.0);
+        if (qp0 > 0.0) denominator += dwvw_grey_term(qp0, 1.0, 1.0, exited);
+        if (qp1 > 0.0) denominator += dwvw_grey_term(qp1, stretch, decay_of[l], exited);
+        double weight = L->weight[l] * dwvw_grey_ratio(step_phase, albedo, denominator, exited);
         uint32_t events = L->events[l] + (uint32_t)!exited;
         double flight = exited ? 0.0 : t; /* an exited lane keeps its position (lane_end) */
         L->px[l] = px + x * flight;
@@ -975,21 +929,12 @@ static int mixture_lane_end(guided_lanes *L, int l, const dwvw_estimate_setup *s
                                      dwvu_v(L->dx[l], L->dy[l], L->dz[l]), &normal);
         end->status = DWVW_EXITED;
         end->exit_normal = normal;
-    } else if (!(weight > 0.0)) {
-        end->status = DWVW_ABSORBED;
     } else {
-        if (weight < DWVW_ROULETTE_THRESHOLD) {
-            double survive = weight / DWVW_ROULETTE_THRESHOLD;
-            if (dwvk_rng_uniform_d(L->key[l], dwvw_event_dim(events - 1u) + DWVW_DIM_ROULETTE) >= survive) {
-                end->status = DWVW_ABSORBED;
-                goto done;
-            }
-            L->weight[l] = weight /= survive;
+        if (dwvw_grey_goes_on(L->key[l], events, setup->max_events, &weight, &end->status)) {
+            L->weight[l] = weight; /* perhaps raised by the roulette */
+            return 0;
         }
-        if (events < setup->max_events) return 0;
-        end->status = DWVW_TRUNCATED;
     }
-done:
     end->events = events;
     end->weight[0] = end->status == DWVW_ABSORBED ? 0.0 : weight;
     end->weight[1] = end->weight[2] = 0.0;
