@@ -42,9 +42,12 @@ static inline dwvu_vec3 aligned_guided_direction(const dwvw_fast_plan *plan, con
     return dwvu_scale(w, 1.5 - 0.5 * dwvu_dot(w, w));
 }
 
-/* Inline with a constant `kind`: each shape gets its own loop with its exit test inlined. */
-static inline void classical_walk_in(const dwvw_estimate_setup *setup, dwvw_shape_kind kind, uint64_t key,
-                                     dwvw_walk_end *end)
+/* The walkers below are inlined with a constant `kind`, so that each shape gets its own loop with
+ * its exit test written out. Plain `inline` left GCC 12 one copy per walker that tests the kind at
+ * every event, and the sphere's registers in the half-space's loop (a position spilled to the
+ * stack): forced, the classical walker takes 2-4% fewer instructions per walk (callgrind). */
+static DWVW_ALWAYS_INLINE void classical_walk_in(const dwvw_estimate_setup *setup, dwvw_shape_kind kind,
+                                                 uint64_t key, dwvw_walk_end *end)
 {
     const dwvw_medium *m = &setup->medium;
     const double sigma = m->sigma_t[0], albedo = m->albedo[0];
@@ -80,8 +83,8 @@ static void classical_walk(const dwvw_estimate_setup *setup, uint64_t key, dwvw_
     }
 }
 
-static inline void guided_walk_in(const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan, dwvw_shape_kind kind,
-                                  uint64_t key, dwvw_walk_end *end)
+static DWVW_ALWAYS_INLINE void guided_walk_in(const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan,
+                                              dwvw_shape_kind kind, uint64_t key, dwvw_walk_end *end)
 {
     const dwvw_medium *m = &setup->medium;
     const double sigma = m->sigma_t[0], log_per_event = plan->log_per_event;
@@ -149,8 +152,8 @@ static void guided_walk(const dwvw_estimate_setup *setup, const dwvw_fast_plan *
  * weight is the general path's f / (q0 p_classical + q1 p_guided), formed with the same
  * arithmetic as dwvw_walk_complete (one exponential per step), for any anisotropy; what the fast
  * path saves is the per-event mixture bookkeeping. */
-static inline void mixture_walk_in(const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan, dwvw_shape_kind kind,
-                                   uint64_t key, dwvw_walk_end *end)
+static DWVW_ALWAYS_INLINE void mixture_walk_in(const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan,
+                                               dwvw_shape_kind kind, uint64_t key, dwvw_walk_end *end)
 {
     const dwvw_medium *m = &setup->medium;
     const double sigma = m->sigma_t[0], albedo = m->albedo[0];
