@@ -215,9 +215,13 @@ static void chunk_free(chunk *c)
     free(c->points);
     free(c->counts);
     free(c->sums);
+    c->points = NULL;
+    c->counts = NULL;
+    c->sums = NULL;
 }
 
-static dwv_result_t read_chunk(const char *fn, const char *path, chunk *c)
+/* Reads and checks chunk `path`: its header only (header_only), or all of it with the checksum. */
+static dwv_result_t read_chunk(const char *fn, const char *path, chunk *c, int header_only)
 {
     memset(c, 0, sizeof *c);
     c->path = path;
@@ -259,6 +263,7 @@ static dwv_result_t read_chunk(const char *fn, const char *path, chunk *c)
                      (unsigned long long)expected);
         goto done;
     }
+    if (header_only) goto done;
     c->points = malloc((h->point_count ? h->point_count : 1u) * sizeof *c->points);
     c->counts = malloc(pixels * sizeof *c->counts);
     c->sums = malloc(pixels * sizeof *c->sums);
@@ -337,8 +342,10 @@ dwv_result_t dwv_merge_partials(const char *const *paths, uint32_t count, dwv_im
     dwvb_image *img = NULL;
     dwvb_pixel_sums *sums = NULL;
     uint32_t *counts = NULL;
+    /* First the headers of all (the ranges and the bake they come from), then each chunk in turn,
+     * whole and checksummed, added and freed: memory for one chunk and the sums, not for all. */
     for (; read < count; ++read) {
-        if ((r = read_chunk(fn, paths[read], &chunks[read])) != DWV_SUCCESS) goto done;
+        if ((r = read_chunk(fn, paths[read], &chunks[read], 1)) != DWV_SUCCESS) goto done;
         if (read > 0 && (r = same_bake(fn, &chunks[0], &chunks[read])) != DWV_SUCCESS) {
             chunk_free(&chunks[read]);
             goto done;
@@ -384,7 +391,13 @@ dwv_result_t dwv_merge_partials(const char *const *paths, uint32_t count, dwv_im
     double seconds = 0.0, truncated[3] = {0.0, 0.0, 0.0};
     dwv_bake_stats_t *st = &img->stats;
     for (uint32_t k = 0; k < count; ++k) {
-        const chunk *c = &chunks[k];
+        chunk *c = &chunks[k];
+        header expected = c->h;
+        if ((r = read_chunk(fn, c->path, c, 0)) != DWV_SUCCESS) goto done;
+        if (memcmp(&expected, &c->h, sizeof expected) != 0) {
+            r = dwv_fail(DWV_ERROR_IO, "%s: chunk '%s' changed while it was merged", fn, c->path);
+            goto done;
+        }
         for (size_t i = 0; i < pixels; ++i) {
             counts[i] += c->counts[i];
             dwvb_pixel_sums *p = &sums[i];
@@ -416,6 +429,7 @@ dwv_result_t dwv_merge_partials(const char *const *paths, uint32_t count, dwv_im
         st->features |= c->h.features;
         if (c->h.threads > st->threads) st->threads = c->h.threads;
         if (c->h.warnings > st->warnings) st->warnings = c->h.warnings;
+        chunk_free(c);
     }
     dwvb_sums_fill_image(&view, img);
     st->technique = (dwv_technique_t)h0->technique;
