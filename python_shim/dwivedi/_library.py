@@ -368,6 +368,9 @@ _BAKER_PROTOTYPES: Dict[str, Tuple[object, Sequence[object]]] = {
     "dwv_scene_create_default": (_result_t, (_handle_pp, _p(BakeOptions))),
 }
 
+# Every function the shim declares: a library that lacks one is older than this shim.
+LIBRARY_FUNCTIONS: Tuple[str, ...] = tuple(_PROTOTYPES) + tuple(_BAKER_PROTOTYPES)
+
 _lock = threading.Lock()
 _loaded: Optional[Tuple[ctypes.CDLL, str]] = None
 
