@@ -82,6 +82,7 @@ class LibraryStatus:
 
 
 _status = None        # LibraryStatus of the last check
+_status_key = None    # (path, identity of the file) it was made for
 _loaded_identity = {}  # path -> (device, inode, size, mtime) of the file when it was loaded
 
 
@@ -108,7 +109,8 @@ def _shim_on_path():
 def check_library():
     """Checks the library the add-on would use and loads it; returns (and keeps) a LibraryStatus.
     Never raises: every problem becomes the status' message (see libcheck)."""
-    global _status
+    global _status, _status_key
+    _status_key = _current_key()
     try:
         _status = _check_library()
     except Exception as error:  # a bug here must not take the panel down
@@ -149,9 +151,20 @@ def _check_library():
     return LibraryStatus(True, f"libdwivedi {version} ({path})", path, version)
 
 
+def _current_key():
+    try:
+        path = _wanted_library()[0]
+    except Exception:
+        return None
+    return path, libcheck.file_identity(path) if path else None
+
+
 def library_status():
-    """The last check's status (checking now if there was none)."""
-    return _status if _status is not None else check_library()
+    """The last check's status, checked again when there was none or when the file (or the
+    preferences' choice) changed since (one stat per call: cheap enough for every redraw)."""
+    if _status is None or _current_key() != _status_key:
+        return check_library()
+    return _status
 
 
 def shim():
@@ -601,7 +614,7 @@ def register():
 
 
 def unregister():
-    global _DWIVEDI_BAKE_REGISTERED, _status
+    global _DWIVEDI_BAKE_REGISTERED, _status, _status_key
     if not _DWIVEDI_BAKE_REGISTERED:
         return
     del bpy.types.Scene.dwivedi_bake
@@ -609,3 +622,4 @@ def unregister():
         bpy.utils.unregister_class(cls)
     _DWIVEDI_BAKE_REGISTERED = False
     _status = None
+    _status_key = None
