@@ -67,7 +67,9 @@ def _import_shim():
     try:
         from . import dwivedi  # bundled by tools/package_addon.py
     except ImportError:
-        import dwivedi  # a development checkout with python_shim on sys.path
+        if is_extension():  # an extension imports only what it carries
+            raise
+        import dwivedi  # a development checkout (legacy add-on) with python_shim on sys.path
     return dwivedi
 
 

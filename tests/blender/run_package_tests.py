@@ -112,6 +112,8 @@ def main(argv=None):
     parser.add_argument("--clang", default="clang-14" if shutil.which("clang-14") else "clang")
     parser.add_argument("--host-blender", default=shutil.which("blender") or "blender")
     parser.add_argument("--timeout", type=float, default=900.0)
+    parser.add_argument("--keep-going", action="store_true",
+                        help="run every step even after one failed (diagnosis; later steps build on earlier ones)")
     args = parser.parse_args(argv)
     build = args.build_dir.resolve()
     legacy, extension, library = build / "dwivedi_bake.zip", extension_zip(build), build / "libdwivedi.so.1"
@@ -176,6 +178,8 @@ def main(argv=None):
               "never in a package")
     if root:
         env["DWIVEDI_PRIVATE_MOUNTS"] = "1"
+    if args.keep_going:
+        env["DWIVEDI_TEST_KEEP_GOING"] = "1"
     blender = "/usr/bin/blender" if chroot is not None else args.host_blender
     command = [blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python",
                inside(stage / "scripts" / "test_package.py")]
