@@ -10,11 +10,12 @@ each through Blender's own operators; then, in this order (the process keeps wha
    warning where this Blender's subsurface model is not mapped yet;
 3. a bake cancelled (a KeyboardInterrupt in the main thread during the bake, as Python's Ctrl-C;
    Esc belongs to the UI's modal path, which headless Blender has not), then a bake;
-4. a bad file named in the preferences (a different path: the loader's message), then none;
+4. a bad file named in the preferences (a different path: the loader's message), then none; the
+   loaded file replaced under Blender ("restart Blender");
 5. a read-only add-on folder (a read-only bind mount in the private mount namespace the runner
    gives us as root; chmod otherwise): it enables and bakes, and nothing in it changes;
 6. a second copy enabled at once (the legacy add-on beside the extension on 4.2+; a second
-   folder on 3.x): it refuses with a message, the first keeps baking;
+   folder on 3.x): it refuses with a message, the first keeps baking; on 4.2+ the other order too;
 7. disable and enable again, and bake.
 
     blender -b --factory-startup --python-exit-code 1 --python tests/blender/test_package.py
@@ -312,6 +313,15 @@ class PackageTest(unittest.TestCase):
         prefs.library_path = ""
         result, error = operator()
         self.assertEqual(result, {'FINISHED'}, error)
+        # The loaded file replaced under Blender (an update while it runs): restart, it says.
+        library = bundled_library()
+        keep = WORK / "loaded-libdwivedi.so.1"
+        os.link(library, keep)  # the loaded file itself, to put back
+        put(WORK / "good-libdwivedi.so.1", library)
+        self.assertRefused("was replaced since Blender loaded it: restart Blender")
+        os.replace(keep, library)
+        result, error = operator()
+        self.assertEqual(result, {'FINISHED'}, error)
 
     @timed("read-only folder")
     def test_07_read_only_folder(self):
@@ -362,6 +372,18 @@ class PackageTest(unittest.TestCase):
             slab()
             result, error = operator()
             self.assertEqual(result, {'FINISHED'}, error)
+            if EXTENSIONS:
+                # The other order: the legacy add-on enabled first, then the extension refused.
+                self.assertEqual(bpy.ops.preferences.addon_disable(module=MODULE), {'FINISHED'})
+                self.assertEqual(bpy.ops.preferences.addon_enable(module=other), {'FINISHED'})
+                with self.assertRaises(RuntimeError) as caught:
+                    bpy.ops.preferences.addon_enable(module=MODULE)
+                self.assertIn(f"Dwivedi Subsurface Bake is already enabled as '{other}'", str(caught.exception))
+                self.assertTrue(addon_utils.check(other)[1])
+                self.assertEqual(bpy.ops.preferences.addon_disable(module=other), {'FINISHED'})
+                self.assertEqual(bpy.ops.preferences.addon_enable(module=MODULE), {'FINISHED'})
+                result, error = operator()
+                self.assertEqual(result, {'FINISHED'}, error)
         finally:
             # (Not addon_remove: in background mode it fails in Blender's own code, on context.area.)
             folder = next((Path(m.__file__).parent for m in addon_utils.modules(refresh=True) if m.__name__ == other),
