@@ -8,7 +8,7 @@ Steps, each timed (printed at the end and written to WORK/times.json):
 1. the bad library files (tests/blender/fixtures.py) with the C compiler and clang + ld.lld;
 2. for a chroot: the chroot (made once and reused: scripts/blender-chroots.sh), and a scratch
    folder inside it, CHROOT/tmp/dwivedi-test-..., with copies of the two packages, the test
-   scripts and the fixtures. If the bundled library still links libraries other than glibc,
+   scripts and the fixtures. If the packaged library still links libraries other than glibc,
    libstdc++ and libgcc (a library that is not yet self-contained), copies of the host's
    (Debian 12's) are put in that scratch folder's deps/ and loaded by the test before the bake:
    a scratch test set-up only, never in a package, said on stdout;
@@ -155,7 +155,14 @@ def main(argv=None):
                         "--cc", args.cc, "--clang", args.clang], check=False)
         if not (fixtures / "needs" / "libdwivedi.so.1").is_file():
             fail("tests/blender/fixtures.py could not build the fixtures (see above)")
-        return scratch_dependencies(library, stage / "deps") if chroot is not None else []
+        # The library the package carries (the self-contained build once there is one), not
+        # necessarily build/libdwivedi.so.1: its dependencies decide the scratch set-up.
+        import zipfile
+        packaged = stage / "packaged-libdwivedi.so.1"
+        with zipfile.ZipFile(extension) as zf:
+            packaged.write_bytes(zf.read("dwivedi/libdwivedi.so.1"))
+        packaged.chmod(0o755)
+        return scratch_dependencies(packaged, stage / "deps") if chroot is not None else []
 
     copied = step("stage", stage_files)
     home = stage / "home"
