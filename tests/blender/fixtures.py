@@ -5,6 +5,8 @@
 
 DIR/<case>/libdwivedi.so.1 for each case, all real files a user could end up with:
   aarch64     a shared library built for aarch64 (clang --target=aarch64-linux-gnu, ld.lld)
+  i386        one built for 32-bit x86 (clang --target=i386-linux-gnu, ld.lld): same CPU family,
+              another word size
   truncated   the first third of the real library (an interrupted copy or download)
   garbage     a text file named libdwivedi.so.1
   abi0        a shared library with SONAME libdwivedi.so.0 (an older ABI generation)
@@ -23,7 +25,7 @@ import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
-CASES = ("aarch64", "truncated", "garbage", "abi0", "abi2", "old", "needs")
+CASES = ("aarch64", "i386", "truncated", "garbage", "abi0", "abi2", "old", "needs")
 
 
 def shim_functions():
@@ -71,6 +73,8 @@ def build(library: Path, out: Path, cc: str, clang: str) -> None:
         # A real aarch64 shared object (no libc needed: nothing is ever run).
         run([clang, "--target=aarch64-linux-gnu", "-fPIC", "-nostdlib", "-shared", "-fuse-ld=lld",
              "-Wl,-soname,libdwivedi.so.1", "-o", str(out / "aarch64" / "libdwivedi.so.1"), str(version)])
+        run([clang, "--target=i386-linux-gnu", "-fPIC", "-nostdlib", "-shared", "-fuse-ld=lld",
+             "-Wl,-soname,libdwivedi.so.1", "-o", str(out / "i386" / "libdwivedi.so.1"), str(version)])
     data = library.resolve().read_bytes()
     (out / "truncated" / "libdwivedi.so.1").write_bytes(data[:len(data) // 3])
     (out / "garbage" / "libdwivedi.so.1").write_text("this is not a library\n")

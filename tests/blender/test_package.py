@@ -227,6 +227,7 @@ class PackageTest(unittest.TestCase):
         library = bundled_library()
         cases = [
             ("aarch64", "is built for aarch64, this Blender runs on x86_64"),
+            ("i386", "is built for x86 (i386) (32-bit), this Blender runs on x86_64"),
             ("truncated", "is damaged: truncated"),
             ("garbage", "is damaged or not a library: it is not an ELF file"),
             ("abi0", "is too old: libdwivedi ABI 0"),

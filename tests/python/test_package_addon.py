@@ -121,6 +121,7 @@ class LibraryCheckTest(unittest.TestCase):
     def test_each_bad_file(self) -> None:
         expected = {
             "aarch64": ("architecture", "is built for aarch64, this Blender runs on x86_64"),
+            "i386": ("architecture", "is built for x86 (i386) (32-bit), this Blender runs on x86_64"),
             "truncated": ("damaged", "is damaged: truncated"),
             "garbage": ("damaged", "it is not an ELF file"),
             "abi0": ("too_old", "is too old: libdwivedi ABI 0 (libdwivedi.so.0), this add-on needs ABI 1"),
