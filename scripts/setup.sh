@@ -9,6 +9,9 @@ packages=(build-essential cmake pkg-config binutils python3 python3-mpmath pytho
           abigail-tools valgrind clang-14 libclang-rt-14-dev)
 # Blender 3.4 for the add-on's headless tests (tests/blender, registered only where it is found).
 packages+=(blender)
+# The add-on's packages in Blender 4.3 and 5.2: clean Debian chroots (scripts/blender-chroots.sh);
+# lld-14 links the aarch64 library the load checks are tested with (tests/blender/fixtures.py).
+packages+=(mmdebstrap lld-14)
 
 missing=()
 for p in "${packages[@]}"; do

@@ -12,7 +12,8 @@
 # Every part runs even when an earlier one failed (CI then shows every finding at once); the exit
 # status is non-zero if any failed. Each part's wall time and CPU time (user + system of its
 # processes; on a shared machine the better measure of what it costs) are printed at the end.
-#   DWV_TEST_QUICK=1     part 1 only (while iterating)
+#   DWV_TEST_QUICK=1     part 1 only, without the tests in other Blenders' chroots (ctest label
+#                        "chroot": they need root and make two Debian chroots once)
 #   DWV_TEST_VALGRIND=1  part 4 too
 #   DWV_TEST_PARTS       the parts by name, e.g. "ctest fuzz" (names: ctest asan fuzz valgrind)
 set -uo pipefail
@@ -48,7 +49,9 @@ start=$SECONDS
 if ! scripts/setup.sh -DDWV_WARNINGS_AS_ERRORS=ON; then echo "test.sh: setup or build failed" >&2; exit 1; fi
 cpu
 timings+=("setup and build: $((SECONDS - start)) s wall, $CPU s CPU")
-part ctest ctest --test-dir build --output-on-failure -j "$(nproc)"
+ctest_args=()
+[ "${DWV_TEST_QUICK:-0}" = 1 ] && ctest_args=(-LE chroot)
+part ctest ctest --test-dir build --output-on-failure -j "$(nproc)" "${ctest_args[@]}"
 part asan scripts/test-sanitizers.sh
 part fuzz scripts/fuzz.sh "${DWV_FUZZ_SECONDS:-60}"
 part valgrind scripts/test-valgrind.sh build

@@ -24,10 +24,10 @@ Costs, by --measure:
                 instructions, 2 cores shared by four jobs)
 
 Scenes: the report's sphere (thick, front-lit), slab (thin, back-lit), the leaf-like sheet of
-the report's Cycles section (dwivedi.report's geometry, written as scene files) and the built-in
+the report's Cycles section (cycles_report's geometry, written as scene files) and the built-in
 default scene. Prints the counts per sample, the fit with its residuals, and the #define lines.
 Only the coefficients' ratios matter to the pilot. Standard library only (the report's meshes
-come from python_shim/dwivedi/report.py, which needs no library to import).
+come from tools/cycles_report.py, which needs no library to import).
 
 usage: tools/fit_pilot_cost.py [--build build] [--measure instructions|time] [--repeats 5]
                                [--size 32] [--spp 16] [--scenes sphere,slab,leaf,default]
@@ -50,7 +50,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "python_shim"))
-from dwivedi import report  # noqa: E402  (geometry only: loads no library)
+sys.path.insert(0, str(ROOT / "tools"))
+import cycles_report as report  # noqa: E402  (geometry only: loads no library)
 
 COUNTS = ("samples", "walks", "events", "guided_events", "rays", "point_queries", "mixture_terms")
 NAMES = ("SAMPLE", "WALK", "EVENT", "GUIDED_EVENT", "RAY", "QUERY", "TERM")

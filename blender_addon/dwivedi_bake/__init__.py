@@ -24,9 +24,7 @@ import traceback
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 
-from . import export
-
-ADDON_NAME = __name__
+from . import export, libcheck
 
 TECHNIQUES = [
     ('AUTO', "Auto", "Chosen per scene: incident-illumination guiding with a classical share"),
@@ -49,33 +47,167 @@ CHANNEL_WALKS = [
 ]
 
 
-_custom_library = False  # the preferences' library is in use (not the bundled one)
+# The module name differs by how the add-on is installed: "dwivedi_bake" as a legacy add-on
+# (Blender 3.x, or 4.x's Install legacy add-on), "bl_ext.<repository>.dwivedi_bake" as an
+# extension (4.2+). Preferences are looked up by it, never by a hard-coded name.
+ADDON_NAME = __package__ or __name__
+PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__))
+# The library the packages bundle (tools/package_addon.py), beside the bundled shim.
+BUNDLED_LIBRARY = os.path.join(PACKAGE_DIR, "dwivedi", "libdwivedi.so.1")
+# Set on every copy of this add-on that is registered: a second copy (the legacy add-on and the
+# extension, or two folders) finds the first by it and refuses to register.
+_DWIVEDI_BAKE_REGISTERED = False
 
 
-def shim():
-    """The dwivedi Python shim: the copy bundled in the add-on, else one on sys.path; with the
-    library from the add-on preferences when one is set."""
+def is_extension():
+    return ADDON_NAME.startswith("bl_ext.")
+
+
+def _import_shim():
     try:
         from . import dwivedi  # bundled by tools/package_addon.py
     except ImportError:
-        import dwivedi  # a development checkout with python_shim on sys.path
+        if is_extension():  # an extension imports only what it carries
+            raise
+        import dwivedi  # a development checkout (legacy add-on) with python_shim on sys.path
+    return dwivedi
+
+
+class LibraryStatus:
+    """The outcome of the last library check: ok with the path and version in use, or the problem."""
+
+    def __init__(self, ok, message, path=None, version=None):
+        self.ok = ok
+        self.message = message
+        self.path = path
+        self.version = version
+
+
+_status = None        # LibraryStatus of the last check
+_status_key = None    # (path, identity of the file) it was made for
+_loaded_identity = {}  # path -> (device, inode, size, mtime) of the file when it was loaded
+
+
+def _wanted_library():
+    """(path, where from) of the library to use: the preferences' file, else the bundled one,
+    else (a development checkout without one) None for the shim's own search."""
     prefs = preferences()
     wanted = prefs.library_path.strip() if prefs is not None else ""
-    global _custom_library
     if wanted:
-        wanted = os.path.abspath(bpy.path.abspath(wanted))
-        if dwivedi._library.loaded_path() != wanted:
-            dwivedi.use_library(wanted)
-            _custom_library = True
-    elif _custom_library:
-        dwivedi.use_library(None)  # back to the bundled library
-        _custom_library = False
-    return dwivedi
+        return os.path.abspath(bpy.path.abspath(wanted)), "the library named in the add-on preferences"
+    if os.path.isdir(os.path.join(PACKAGE_DIR, "dwivedi")) or not _shim_on_path():
+        return BUNDLED_LIBRARY, "the add-on's bundled library"
+    return None, "the shim's search"
+
+
+def _shim_on_path():
+    try:
+        import importlib.util
+        return importlib.util.find_spec("dwivedi") is not None
+    except (ImportError, ValueError):
+        return False
+
+
+def check_library():
+    """Checks the library the add-on would use and loads it; returns (and keeps) a LibraryStatus.
+    Never raises: every problem becomes the status' message (see libcheck)."""
+    global _status, _status_key
+    _status_key = _current_key()
+    try:
+        _status = _check_library()
+    except Exception as error:  # a bug here must not take the panel down
+        traceback.print_exc()
+        _status = LibraryStatus(False, f"the library check failed: {error}")
+    return _status
+
+
+def _check_library():
+    dwivedi = _import_shim()
+    path, origin = _wanted_library()
+    if path is None:
+        try:
+            found = dwivedi.library_path()
+            return LibraryStatus(True, f"libdwivedi {dwivedi.version()} ({found})", found, dwivedi.version())
+        except Exception as error:
+            return LibraryStatus(False, str(error).splitlines()[0])
+    problem = libcheck.check_file(path, dwivedi.ABI_VERSION, dwivedi.LIBRARY_FUNCTIONS)
+    if problem is not None:
+        if problem.kind == "missing" and path == BUNDLED_LIBRARY:
+            problem.message += " (the add-on package is incomplete: install it again)"
+        return LibraryStatus(False, f"{origin}: {problem.message}", path)
+    identity = libcheck.file_identity(path)
+    if dwivedi.loaded_library_path() == path:
+        if path in _loaded_identity and _loaded_identity[path] != identity:
+            return LibraryStatus(False, f"{origin}: {path} was replaced since Blender loaded it: restart Blender "
+                                        "to use the new file", path)
+    else:
+        try:
+            dwivedi.use_library(path)
+        except dwivedi.Error as error:  # the loader's own message, e.g. a missing dependency
+            return LibraryStatus(False, f"{origin}: {str(error).splitlines()[0]}", path)
+        _loaded_identity[path] = identity
+    try:
+        version = dwivedi.version()
+    except Exception as error:
+        return LibraryStatus(False, f"{origin}: {path} loads but does not answer: {error}", path)
+    return LibraryStatus(True, f"libdwivedi {version} ({path})", path, version)
+
+
+def _current_key():
+    try:
+        path = _wanted_library()[0]
+    except Exception:
+        return None
+    return path, libcheck.file_identity(path) if path else None
+
+
+def library_status():
+    """The last check's status, checked again when there was none or when the file (or the
+    preferences' choice) changed since (one stat per call: cheap enough for every redraw)."""
+    if _status is None or _current_key() != _status_key:
+        return check_library()
+    return _status
+
+
+def shim():
+    """The dwivedi Python shim with the checked library loaded; ExportError saying what is wrong
+    with the library otherwise (the bake operator reports it)."""
+    status = check_library()
+    if not status.ok:
+        raise export.ExportError(f"the dwivedi library cannot be used: {status.message}")
+    return _import_shim()
 
 
 def preferences():
     addon = bpy.context.preferences.addons.get(ADDON_NAME)
     return addon.preferences if addon is not None else None
+
+
+def draw_status(layout):
+    """The library's state in a panel: its version, or the problem with an ERROR icon."""
+    status = library_status()
+    if status.ok:
+        layout.label(text=status.message, icon='CHECKMARK')
+        return
+    box = layout.box()
+    box.label(text="dwivedi library not usable:", icon='ERROR')
+    for line in _wrap(status.message, 70):
+        box.label(text=line)
+
+
+def _wrap(text, width):
+    words, lines, line = text.split(), [], ""
+    for word in words:
+        if line and len(line) + 1 + len(word) > width:
+            lines.append(line)
+            line = word
+        else:
+            line = f"{line} {word}" if line else word
+    return lines + ([line] if line else [])
+
+
+def _library_path_changed(self, context):
+    check_library()
 
 
 class DwivediBakePreferences(bpy.types.AddonPreferences):
@@ -84,16 +216,12 @@ class DwivediBakePreferences(bpy.types.AddonPreferences):
     library_path: StringProperty(
         name="Library",
         description="libdwivedi.so.1 to use; empty: the one bundled with the add-on (or found on the system)",
-        subtype='FILE_PATH', default="")
+        subtype='FILE_PATH', default="", update=_library_path_changed)
 
     def draw(self, context):
         layout = self.layout
         layout.prop(self, "library_path")
-        try:
-            path = shim().library_path()
-            layout.label(text=f"In use: {path}", icon='CHECKMARK')
-        except Exception as error:  # the library may be missing: show why, never fail drawing
-            layout.label(text=f"Library not usable: {str(error).splitlines()[0]}", icon='ERROR')
+        draw_status(layout)
 
 
 def _poll_mesh(self, obj):
@@ -130,6 +258,9 @@ class DwivediBakeSettings(bpy.types.PropertyGroup):
     progress: FloatProperty(name="Progress", default=0.0, min=0.0, max=100.0, subtype='PERCENTAGE',
                             options={'SKIP_SAVE'})
     last_result: StringProperty(default="", options={'SKIP_SAVE'})
+    # The last bake's warnings, one a line (what was not modelled, such as this Blender's own
+    # subsurface model); also reported to the Info log.
+    last_warnings: StringProperty(default="", options={'SKIP_SAVE'})
 
 
 def output_folder(settings):
@@ -137,8 +268,19 @@ def output_folder(settings):
     temporary folder for an unsaved file."""
     raw = settings.output_dir.strip() or "//dwivedi_bake/"
     if raw.startswith("//") and not bpy.data.filepath:
-        return os.path.join(bpy.app.tempdir or os.path.realpath("/tmp"), raw[2:])
+        return os.path.join(unsaved_file_folder(), raw[2:])
     return os.path.abspath(bpy.path.abspath(raw))
+
+
+def unsaved_file_folder():
+    """Where "//" points for an unsaved file: the extension's own user folder on Blender 4.2+
+    (bpy.utils.extension_path_user, never the package folder), else Blender's temporary folder."""
+    if is_extension() and hasattr(bpy.utils, "extension_path_user"):
+        try:
+            return bpy.utils.extension_path_user(ADDON_NAME, path="bakes", create=True)
+        except (ValueError, OSError):
+            pass
+    return bpy.app.tempdir or os.path.realpath("/tmp")
 
 
 def _check_folder(folder):
@@ -275,7 +417,9 @@ class DWIVEDI_OT_bake(bpy.types.Operator):
         settings = context.scene.dwivedi_bake
         job = None
         try:
+            settings.last_warnings = ""
             job = _Job(context, settings)
+            settings.last_warnings = "\n".join(job.exported.warnings)
             for warning in job.exported.warnings:
                 self.report({'WARNING'}, warning)
             image = job.dwivedi.bake(job.exported.scene, job.bake_settings)
@@ -302,7 +446,9 @@ class DWIVEDI_OT_bake(bpy.types.Operator):
             self.report({'ERROR'}, "a Dwivedi bake is already running")
             return {'CANCELLED'}
         try:
+            settings.last_warnings = ""
             self._job = _Job(context, settings)
+            settings.last_warnings = "\n".join(self._job.exported.warnings)
             for warning in self._job.exported.warnings:
                 self.report({'WARNING'}, warning)
             self._job.start()
@@ -401,6 +547,9 @@ class DWIVEDI_PT_bake(bpy.types.Panel):
         layout.use_property_split = True
         layout.use_property_decorate = False
         settings = context.scene.dwivedi_bake
+        status = library_status()
+        if not status.ok:
+            draw_status(layout)
         layout.prop(settings, "target", expand=True)
         if settings.target == 'UV':
             layout.prop(settings, "uv_object")
@@ -426,18 +575,53 @@ class DWIVEDI_PT_bake(bpy.types.Panel):
             layout.operator(DWIVEDI_OT_bake.bl_idname, icon='RENDER_STILL')
         if settings.last_result:
             layout.label(text=settings.last_result)
+        for warning in settings.last_warnings.splitlines()[:4]:
+            layout.label(text=warning, icon='ERROR' if warning.startswith("Blender ") else 'INFO')
 
 
 CLASSES = (DwivediBakePreferences, DwivediBakeSettings, DWIVEDI_OT_bake, DWIVEDI_PT_bake)
 
 
+def _other_copy():
+    """(module name, folder) of another copy of this add-on that is registered, else None."""
+    import sys
+    for name, module in list(sys.modules.items()):
+        if name != __name__ and getattr(module, "_DWIVEDI_BAKE_REGISTERED", False) is True:
+            return name, os.path.dirname(getattr(module, "__file__", "") or "?")
+    if hasattr(bpy.types.Scene, "dwivedi_bake") or hasattr(bpy.types, "DWIVEDI_OT_bake"):
+        return "an unknown module", "?"
+    return None
+
+
+class AlreadyEnabled(RuntimeError):
+    pass
+
+
 def register():
+    global _DWIVEDI_BAKE_REGISTERED
+    other = _other_copy()
+    if other is not None:
+        # Two copies would register the same classes and Scene.dwivedi_bake: refuse before
+        # registering anything, so the copy already enabled keeps working.
+        raise AlreadyEnabled(f"Dwivedi Subsurface Bake is already enabled as '{other[0]}' ({other[1]}): disable "
+                             f"that copy before enabling this one ('{ADDON_NAME}', {PACKAGE_DIR})")
     for cls in CLASSES:
         bpy.utils.register_class(cls)
     bpy.types.Scene.dwivedi_bake = PointerProperty(type=DwivediBakeSettings)
+    _DWIVEDI_BAKE_REGISTERED = True
+    status = check_library()
+    if not status.ok:
+        # The panel shows it with an ERROR icon; the console says it once at enable.
+        print(f"Dwivedi Subsurface Bake: the dwivedi library cannot be used: {status.message}")
 
 
 def unregister():
+    global _DWIVEDI_BAKE_REGISTERED, _status, _status_key
+    if not _DWIVEDI_BAKE_REGISTERED:
+        return
     del bpy.types.Scene.dwivedi_bake
     for cls in reversed(CLASSES):
         bpy.utils.unregister_class(cls)
+    _DWIVEDI_BAKE_REGISTERED = False
+    _status = None
+    _status_key = None

@@ -16,6 +16,12 @@ looked for on the first call, in this order (see ``library_path()``):
    most recently built first;
 4. the system's library search (ctypes.util.find_library("dwivedi"), then "libdwivedi.so.1").
 
+``loaded_library_path()`` says which library is in use without loading one: the file it was
+loaded from (or, when the system's search found it, the name it was found by), or None before the
+first load. ``use_library(path)`` picks a file instead of the search. ``ABI_VERSION`` is the ABI
+generation the shim's declarations are written for (DWV_ABI_VERSION of capi/dwivedi.h, the N of
+the library's SONAME libdwivedi.so.N); ``LIBRARY_FUNCTIONS`` names every function it declares.
+
 Errors: arguments of the wrong type (a str, bool or None where a number is wanted, a non-str
 method) raise TypeError; every value the library rejects (NaN, infinity, out of range, an unknown
 method name) and a library that cannot be found raise ``dwivedi.Error``, a ValueError carrying the
@@ -34,7 +40,7 @@ from dataclasses import dataclass
 from typing import NamedTuple, Tuple
 
 from . import _library
-from ._library import Error, library_path, use_library
+from ._library import ABI_VERSION, LIBRARY_FUNCTIONS, Error, library_path, loaded_library_path, use_library
 from .baker import (AreaLight, Bake, BakeSettings, BakeStats, Camera, Cancelled, DisplaySettings, ErrorPoint, Image, merge_partials,
                     Material, PointLight, Progress, Scene, SunLight, bake, feature_names, start_bake, techniques)
 
@@ -42,7 +48,10 @@ __all__ = [
     "merge_partials",
     "Error",
     "Cancelled",
+    "ABI_VERSION",
+    "LIBRARY_FUNCTIONS",
     "library_path",
+    "loaded_library_path",
     "use_library",
     "Scene",
     "Material",

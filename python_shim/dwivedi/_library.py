@@ -15,6 +15,9 @@ from typing import Callable, Dict, Iterator, List, Optional, Sequence, Tuple
 
 # The environment variable naming the library file to load, bypassing the search.
 ENV_VARIABLE = "DWIVEDI_LIBRARY"
+# DWV_ABI_VERSION of capi/dwivedi.h: the ABI generation these declarations are written for (the
+# library's SONAME is libdwivedi.so.<ABI_VERSION>).
+ABI_VERSION = 1
 # The file names of the library, the SONAME (libdwivedi.so.<DWV_ABI_VERSION>) first.
 LIBRARY_FILE_NAMES = ("libdwivedi.so.1", "libdwivedi.so")
 # A file only dwivedi's source tree has: the directory holding it is the repository root.
@@ -369,6 +372,9 @@ _BAKER_PROTOTYPES: Dict[str, Tuple[object, Sequence[object]]] = {
     "dwv_scene_create_default": (_result_t, (_handle_pp, _p(BakeOptions))),
 }
 
+# Every function the shim declares: a library that lacks one is older than this shim.
+LIBRARY_FUNCTIONS: Tuple[str, ...] = tuple(_PROTOTYPES) + tuple(_BAKER_PROTOTYPES)
+
 _lock = threading.Lock()
 _loaded: Optional[Tuple[ctypes.CDLL, str]] = None
 
@@ -485,10 +491,16 @@ def library() -> ctypes.CDLL:
     return _loaded_library()[0]
 
 
-def loaded_path() -> Optional[str]:
-    """Where the library in use came from, or None if none was loaded yet (never loads one)."""
+def loaded_library_path() -> Optional[str]:
+    """Where the library in use came from: the file it was loaded from, or for a library found by
+    the system's search the name it was found by; None if none was loaded yet. Never loads one
+    (``library_path()`` does). Public as ``dwivedi.loaded_library_path()``."""
     with _lock:
         return None if _loaded is None else _loaded[1]
+
+
+# The earlier, private name (kept for scripts that used it).
+loaded_path = loaded_library_path
 
 
 def use_library(path: Optional[str]) -> Optional[str]:

@@ -58,7 +58,10 @@ def principled_material(name, color, radius, scale=1.0, weight=1.0, anisotropy=0
     material = bpy.data.materials.new(name)
     material.use_nodes = True
     bsdf = material.node_tree.nodes["Principled BSDF"]
-    bsdf.subsurface_method = 'RANDOM_WALK_FIXED_RADIUS'
+    # 3.x's Fixed Radius walk where it exists; 4.0 renamed it Random Walk (5.2 changed it again:
+    # the add-on warns that those models are not mapped yet).
+    methods = [item.identifier for item in bsdf.bl_rna.properties["subsurface_method"].enum_items]
+    bsdf.subsurface_method = 'RANDOM_WALK_FIXED_RADIUS' if 'RANDOM_WALK_FIXED_RADIUS' in methods else 'RANDOM_WALK'
     inputs = bsdf.inputs
     rgba = (color[0], color[1], color[2], 1.0)
     if "Subsurface Weight" in inputs:  # Blender 4.x

@@ -22,9 +22,11 @@ from pathlib import Path
 
 SOURCE_DIR = Path(os.environ.get("DWIVEDI_SOURCE_DIR", Path(__file__).resolve().parents[2]))
 sys.path.append(str(SOURCE_DIR / "python_shim"))
+sys.path.append(str(SOURCE_DIR / "tools"))
 
 import dwivedi  # noqa: E402
-from dwivedi import _buffers, _library, report  # noqa: E402
+from dwivedi import _buffers, _library  # noqa: E402
+import cycles_report as report  # noqa: E402  (its geometry: the report tool is not part of the shim)
 
 try:
     import numpy

@@ -1,4 +1,5 @@
-"""The error-against-time report tool, `python3 -m dwivedi.report`, in its quick form without
+"""The error-against-time report tool, `python3 tools/cycles_report.py` (moved out of the shim: a tool, not part of
+`import dwivedi`, and not in the add-on packages), in its quick form without
 Cycles: it runs, writes report.md and report.json with every technique on every benchmark scene,
 RMSE falls with samples, and plots appear where matplotlib is installed."""
 import importlib.util
@@ -15,12 +16,15 @@ sys.path.append(str(SOURCE_DIR / "python_shim"))
 
 import dwivedi  # noqa: E402
 
+REPORT = SOURCE_DIR / "tools" / "cycles_report.py"
+sys.path.append(str(SOURCE_DIR / "tools"))
+
 
 class ReportTest(unittest.TestCase):
     def test_quick_report(self):
         with tempfile.TemporaryDirectory() as tmp:
             env = {**os.environ, "PYTHONPATH": str(SOURCE_DIR / "python_shim")}
-            result = subprocess.run([sys.executable, "-m", "dwivedi.report", "--quick", "--no-cycles", "--size", "8",
+            result = subprocess.run([sys.executable, str(REPORT), "--quick", "--no-cycles", "--size", "8",
                                      "--out", tmp], capture_output=True, text=True, env=env, timeout=300)
             self.assertEqual(result.returncode, 0, result.stderr[-2000:])
             text = (Path(tmp) / "report.md").read_text()
@@ -39,7 +43,7 @@ class ReportTest(unittest.TestCase):
 
     def test_reference_noise_is_taken_out(self):
         # Points measured against a reference of R spp: RMSE^2 = s^2 (1 / spp + 1 / R).
-        from dwivedi import report
+        import cycles_report as report
         s2, reference = 0.4, 4096
         points = [{"samples": n, "seconds": 0.001 * n, "rmse": (s2 * (1.0 / n + 1.0 / reference)) ** 0.5}
                   for n in (64, 256, 1024)]
@@ -53,7 +57,7 @@ class ReportTest(unittest.TestCase):
     def test_sections_alone_and_bad_choices(self):
         env = {**os.environ, "PYTHONPATH": str(SOURCE_DIR / "python_shim")}
         with tempfile.TemporaryDirectory() as tmp:
-            result = subprocess.run([sys.executable, "-m", "dwivedi.report", "--quick", "--sections", "v0",
+            result = subprocess.run([sys.executable, str(REPORT), "--quick", "--sections", "v0",
                                      "--out", tmp], capture_output=True, text=True, env=env, timeout=120)
             self.assertEqual(result.returncode, 0, result.stderr[-2000:])
             data = json.loads((Path(tmp) / "report.json").read_text())
@@ -64,7 +68,7 @@ class ReportTest(unittest.TestCase):
                                  (["--cycles-scenes", "cube"], "unknown section or scene 'cube'"),
                                  (["--sections", ","], "no section or scene given"),
                                  (["--repeats", "0"], "--repeats 0 is outside 1 to 100")):
-                result = subprocess.run([sys.executable, "-m", "dwivedi.report", "--out", tmp] + bad,
+                result = subprocess.run([sys.executable, str(REPORT), "--out", tmp] + bad,
                                         capture_output=True, text=True, env=env, timeout=60)
                 self.assertEqual(result.returncode, 1, bad)
                 self.assertIn(message, result.stderr)
@@ -74,11 +78,11 @@ class ReportTest(unittest.TestCase):
             blocker = Path(tmp) / "file"
             blocker.write_text("x")
             env = {**os.environ, "PYTHONPATH": str(SOURCE_DIR / "python_shim")}
-            result = subprocess.run([sys.executable, "-m", "dwivedi.report", "--quick", "--no-cycles",
+            result = subprocess.run([sys.executable, str(REPORT), "--quick", "--no-cycles",
                                      "--out", str(blocker / "sub")], capture_output=True, text=True, env=env,
                                     timeout=60)
             self.assertEqual(result.returncode, 1)
-            self.assertIn("dwivedi.report:", result.stderr)
+            self.assertIn("cycles_report:", result.stderr)
 
 
 if __name__ == "__main__":

@@ -395,6 +395,34 @@ def child_env(python_path: Path, library: Optional[str]) -> Dict[str, str]:
     return env
 
 
+class LoadedLibraryPathTest(unittest.TestCase):
+    """dwivedi.loaded_library_path(): None before the first load (and it never loads one), the
+    file in use after; dwivedi.ABI_VERSION is the header's DWV_ABI_VERSION."""
+
+    def test_none_before_a_load_then_the_file(self) -> None:
+        code = ("import json, dwivedi\n"
+                "before = dwivedi.loaded_library_path()\n"
+                "again = dwivedi.loaded_library_path()\n"
+                "version = dwivedi.version()\n"
+                "print(json.dumps([before, again, dwivedi.loaded_library_path(), dwivedi.library_path()]))\n")
+        env = child_env(Path(dwivedi.__file__).parent.parent, os.environ["DWIVEDI_LIBRARY"])
+        done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=60)
+        self.assertEqual(done.returncode, 0, done.stderr)
+        before, again, after, path = json.loads(done.stdout)
+        self.assertIsNone(before)
+        self.assertIsNone(again, "asking does not load the library")
+        self.assertEqual(after, path)
+        self.assertEqual(Path(after).resolve(), Path(os.environ["DWIVEDI_LIBRARY"]).resolve())
+
+    def test_abi_version_is_the_headers(self) -> None:
+        header = (SOURCE_DIR / "capi" / "dwivedi.h").read_text()
+        found = re.search(r"#define DWV_ABI_VERSION (\d+)", header)
+        self.assertIsNotNone(found)
+        self.assertEqual(dwivedi.ABI_VERSION, int(found.group(1)))
+        self.assertIn("loaded_library_path", dwivedi.__all__)
+        self.assertIn("loaded_library_path", dwivedi.__doc__)
+
+
 class DiscoveryTest(unittest.TestCase):
     def setUp(self) -> None:
         self.work = Path(tempfile.mkdtemp(prefix="dwivedi-shim-test-"))

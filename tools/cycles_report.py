@@ -1,4 +1,4 @@
-"""The error-against-run-time report: python3 -m dwivedi.report --out DIR [--quick] [--no-cycles]
+"""The error-against-run-time report: python3 tools/cycles_report.py --out DIR [--quick] [--no-cycles]
 [--sections v0,techniques,cycles] [--cycles-scenes slab,leaf,sphere] [--repeats N]
 
 Runs benchmark scenes through the shim and writes DIR/report.md, DIR/report.json and plots
@@ -42,10 +42,14 @@ import tempfile
 from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
-import dwivedi
+SOURCE_DIR = Path(__file__).resolve().parent.parent  # tools/ -> the source tree
+SHIM_DIR = SOURCE_DIR / "python_shim"
+# A tool of the source tree, not part of `import dwivedi` (nor of the add-on's packages): it uses
+# the shim of its own tree unless PYTHONPATH already names one.
+if str(SHIM_DIR) not in sys.path:
+    sys.path.append(str(SHIM_DIR))
 
-PACKAGE_DIR = Path(__file__).resolve().parent
-SOURCE_DIR = PACKAGE_DIR.parent.parent  # python_shim/dwivedi -> the source tree (when run from it)
+import dwivedi  # noqa: E402
 
 
 # ---------------------------------------------------------------------------------------------
@@ -284,7 +288,7 @@ def cycles_section(quick: bool, blender: str, size: int, scenes: Sequence[str], 
         raise RuntimeError(f"the Cycles comparison needs the source tree (tests/blender, blender_addon) at {SOURCE_DIR}")
     with tempfile.TemporaryDirectory() as work:
         result_path = Path(work) / "result.json"
-        args = {"shim": str(PACKAGE_DIR.parent), "addon": str(addon_dir), "scenes": str(scenes_dir), "work": work,
+        args = {"shim": str(Path(dwivedi.__file__).resolve().parent.parent), "addon": str(addon_dir), "scenes": str(scenes_dir), "work": work,
                 "result": str(result_path), "size": size, "scenes_list": list(scenes), "repeats": repeats,
                 # Counts large enough that Cycles' render time, not its per-render overhead, is
                 # what is measured.
@@ -387,7 +391,7 @@ def plots(out: Path, data: Dict[str, Any]) -> List[str]:
 
 def markdown(data: Dict[str, Any], made: List[str]) -> str:
     lines = ["# dwivedi: error against run time", "",
-             f"Made by `python3 -m dwivedi.report` on {data['date']} ({data['machine']}), library "
+             f"Made by `python3 tools/cycles_report.py` on {data['date']} ({data['machine']}), library "
              f"{data['version']} ({data['library']}). Timings are ratios within this run; other load on the "
              "machine moves the absolute seconds.", ""]
     if "v0" in data:
@@ -465,7 +469,7 @@ def markdown(data: Dict[str, Any], made: List[str]) -> str:
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
-    parser = argparse.ArgumentParser(prog="python3 -m dwivedi.report", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="tools/cycles_report.py", description=__doc__.splitlines()[0])
     parser.add_argument("--out", required=True, type=Path, help="folder for report.md, report.json and plots")
     parser.add_argument("--quick", action="store_true", help="fewer and smaller bakes (a smoke run)")
     parser.add_argument("--size", type=int, default=None,
@@ -487,7 +491,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     if unknown or not sections or not cycles_scenes or not 1 <= repeats <= 100:
         problem = (f"unknown section or scene {unknown[0]!r}" if unknown else "no section or scene given"
                    if not sections or not cycles_scenes else f"--repeats {repeats} is outside 1 to 100")
-        print(f"dwivedi.report: {problem} (sections: {', '.join(SECTIONS)}; scenes: {', '.join(CYCLES_SCENES)})",
+        print(f"cycles_report: {problem} (sections: {', '.join(SECTIONS)}; scenes: {', '.join(CYCLES_SCENES)})",
               file=sys.stderr)
         return 1
     try:
@@ -516,9 +520,9 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         (args.out / "report.md").write_text(text)
         (args.out / "report.json").write_text(json.dumps(data, indent=1))
     except (dwivedi.Error, RuntimeError, OSError) as error:
-        print(f"dwivedi.report: {error}", file=sys.stderr)
+        print(f"cycles_report: {error}", file=sys.stderr)
         return 1
-    print(f"dwivedi.report: wrote {args.out / 'report.md'} and {len(made)} plot(s)", file=sys.stderr)
+    print(f"cycles_report: wrote {args.out / 'report.md'} and {len(made)} plot(s)", file=sys.stderr)
     return 0
 
 
