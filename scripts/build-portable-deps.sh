@@ -242,6 +242,9 @@ b_openexr() {    # OpenEXRCore only: the C library that src/output/exr.c calls
   install -m 0644 cmake/OpenEXRConfig.h "$prefix/include/OpenEXR/"
 }
 b_ocio() {
+  # The orig tarball of 2.1.3 misses includes that GCC 12 no longer brings in (Debian's patches,
+  # not in the archive here, add them): force the standard headers it needs.
+  CXXFLAGS="$CXXFLAGS -include cstring -include cstdint -include limits" \
   cmake_build "$(unpacked ocio)" -DOCIO_BUILD_APPS=OFF -DOCIO_BUILD_TESTS=OFF -DOCIO_BUILD_GPU_TESTS=OFF \
     -DOCIO_BUILD_PYTHON=OFF -DOCIO_BUILD_DOCS=OFF -DOCIO_BUILD_OPENFX=OFF -DOCIO_BUILD_NUKE=OFF \
     -DOCIO_BUILD_JAVA=OFF -DOCIO_INSTALL_EXT_PACKAGES=NONE -DOCIO_USE_SSE=ON \
@@ -260,7 +263,7 @@ b_assimp() {
     -DASSIMP_NO_EXPORT=ON -DASSIMP_BUILD_ZLIB=OFF -DASSIMP_BUILD_DRACO=OFF -DASSIMP_INSTALL_PDB=OFF \
     -DASSIMP_WARNINGS_AS_ERRORS=OFF -DASSIMP_INJECT_DEBUG_POSTFIX=OFF -DASSIMP_BUILD_MINIZIP=OFF \
     -DZLIB_ROOT="$prefix" -DZLIB_INCLUDE_DIR="$prefix/include" -DZLIB_LIBRARY="$prefix/lib/libz.a" \
-    "-DCMAKE_CXX_FLAGS=-I/usr/include/utf8cpp"
+    "-DCMAKE_CXX_FLAGS=$CXXFLAGS -I/usr/include/utf8cpp -I$prefix/include/minizip"
 }
 b_embree() {
   cmake_build "$(unpacked embree)" -DEMBREE_STATIC_LIB=ON -DEMBREE_TASKING_SYSTEM=INTERNAL \
