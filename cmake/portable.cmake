@@ -40,8 +40,7 @@ set(dwv_pd ${DWV_PORTABLE_DEPS})
 set(dwv_portable_archive_names
   libOpenColorIO.a libyaml-cpp.a libpystring.a libexpat.a libImath-3_1.a libOpenEXRCore-3_1.a
   libassimp.a libminizip.a libcjson.a libpng16.a libz.a
-  libembree3.a libembree_sse42.a libembree_avx2.a libembree_avx512.a libsimd.a liblexers.a libsys.a
-  libmath.a libtasking.a)
+  libembree3.a libsimd.a liblexers.a libsys.a libmath.a libtasking.a)
 set(dwv_portable_archives)
 foreach(name IN LISTS dwv_portable_archive_names)
   if(NOT EXISTS "${dwv_pd}/lib/${name}")
@@ -49,9 +48,10 @@ foreach(name IN LISTS dwv_portable_archive_names)
   endif()
   list(APPEND dwv_portable_archives "${dwv_pd}/lib/${name}")
 endforeach()
-# OpenColorIO's static build may leave helper archives of its own (sampleicc, utils) beside it.
-file(GLOB dwv_portable_extra_archives "${dwv_pd}/lib/libOpenColorIO*.a" "${dwv_pd}/lib/libsampleicc*.a"
-     "${dwv_pd}/lib/libutils*.a")
+# Embree's kernels of each ISA it was built for (libembree_avx2.a...), and any helper archives
+# OpenColorIO's static build leaves beside it.
+file(GLOB dwv_portable_extra_archives "${dwv_pd}/lib/libembree_*.a" "${dwv_pd}/lib/libOpenColorIO*.a"
+     "${dwv_pd}/lib/libsampleicc*.a" "${dwv_pd}/lib/libutils*.a")
 list(REMOVE_ITEM dwv_portable_extra_archives ${dwv_portable_archives})
 list(APPEND dwv_portable_archives ${dwv_portable_extra_archives})
 set(dwv_portable_includes ${dwv_pd}/include ${dwv_pd}/include/OpenEXR ${dwv_pd}/include/cjson)

@@ -18,8 +18,8 @@
 #   zlib 1.2.13 (+ its contrib/minizip, for Assimp's unzip), libpng 1.6.39, expat 2.5.0,
 #   yaml-cpp 0.7.0, pystring 1.1.4, Imath 3.1.6, OpenEXRCore 3.1.5 (the C core library only),
 #   OpenColorIO 2.1.3 (no apps, python, docs, tests), cJSON 1.7.15, Assimp 5.2.5 (OBJ and PLY
-#   importers only, no exporters), Embree 3.13.5 (static, internal tasking: no TBB; SSE2, SSE4.2,
-#   AVX2 and AVX-512 kernels; triangles and instances only; filter functions and ray masks on).
+#   importers only, no exporters), Embree 3.13.5 (static, internal tasking: no TBB; SSE2,
+#   AVX, AVX2 and AVX-512 kernels; triangles and instances only; filter functions and ray masks on).
 # Sources: `apt-get source` from bookworm's deb-src (added below when missing), unpacked with
 # dpkg-source so that Debian's patches apply. Where the archive this machine uses lacks a file of a
 # bookworm source package (Embree's and pystring's debian.tar.xz, both files of OpenColorIO
@@ -266,15 +266,25 @@ b_assimp() {
     "-DCMAKE_CXX_FLAGS=$CXXFLAGS -I/usr/include/utf8cpp -I$prefix/include/minizip"
 }
 b_embree() {
-  cmake_build "$(unpacked embree)" -DEMBREE_STATIC_LIB=ON -DEMBREE_TASKING_SYSTEM=INTERNAL \
+  # Embree 3's BVH8 code is compiled only for its AVX target, which AVX2 and AVX-512 need too:
+  # SSE2 (the base), AVX, AVX2, AVX-512 (Debian's build also has SSE4.2). Results differ in the last
+  # bits between Embree's ISAs, so the portable library matches the Debian build bit for bit where
+  # both pick the same kernels: every CPU with AVX, AVX2 or AVX-512 (not SSE4.2-only ones).
+  cmake -S "$(unpacked embree)" -B . "${cm_common[@]}" -DEMBREE_STATIC_LIB=ON -DEMBREE_TASKING_SYSTEM=INTERNAL \
     -DEMBREE_ISPC_SUPPORT=OFF -DEMBREE_TUTORIALS=OFF -DEMBREE_TUTORIALS_GLFW=OFF \
-    -DEMBREE_MAX_ISA=NONE -DEMBREE_ISA_SSE2=ON -DEMBREE_ISA_SSE42=ON -DEMBREE_ISA_AVX=OFF \
+    -DEMBREE_MAX_ISA=NONE -DEMBREE_ISA_SSE2=ON -DEMBREE_ISA_SSE42=OFF -DEMBREE_ISA_AVX=ON \
     -DEMBREE_ISA_AVX2=ON -DEMBREE_ISA_AVX512=ON \
     -DEMBREE_GEOMETRY_TRIANGLE=ON -DEMBREE_GEOMETRY_INSTANCE=ON -DEMBREE_GEOMETRY_QUAD=OFF \
     -DEMBREE_GEOMETRY_CURVE=OFF -DEMBREE_GEOMETRY_SUBDIVISION=OFF -DEMBREE_GEOMETRY_USER=OFF \
     -DEMBREE_GEOMETRY_POINT=OFF -DEMBREE_GEOMETRY_GRID=OFF -DEMBREE_FILTER_FUNCTION=ON -DEMBREE_RAY_MASK=ON \
     -DEMBREE_RAY_PACKETS=OFF -DEMBREE_BACKFACE_CULLING=OFF -DEMBREE_IGNORE_INVALID_RAYS=OFF \
     -DEMBREE_STAT_COUNTERS=OFF -DEMBREE_ZIP_MODE=OFF "-DCMAKE_C_FLAGS_RELEASE=" "-DCMAKE_CXX_FLAGS_RELEASE="
+  nice cmake --build . -j "$jobs"
+  # Not `cmake --install`: it also installs readme.pdf, which the +dfsg tarball does not have.
+  install -m 0644 ./*.a "$prefix/lib/"
+  mkdir -p "$prefix/include/embree3"
+  install -m 0644 "$(unpacked embree)"/include/embree3/*.h "$prefix/include/embree3/"
+  ls "$prefix/lib/libembree_avx.a" "$prefix/lib/libembree_avx2.a" "$prefix/lib/libembree_avx512.a" >/dev/null
 }
 
 fetch_sources
