@@ -15,6 +15,7 @@
 #   DWV_TEST_QUICK=1     part 1 only, without the tests in other Blenders' chroots (ctest label
 #                        "chroot": they need root and make two Debian chroots once)
 #   DWV_TEST_VALGRIND=1  part 4 too
+#   DWV_TEST_PORTABLE=0  skip the portable library (its static dependencies and its test)
 #   DWV_TEST_PARTS       the parts by name, e.g. "ctest fuzz" (names: ctest asan fuzz valgrind)
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -46,9 +47,21 @@ part() { # name command...
 }
 
 start=$SECONDS
-if ! scripts/setup.sh -DDWV_WARNINGS_AS_ERRORS=ON; then echo "test.sh: setup or build failed" >&2; exit 1; fi
+# The portable library the Blender packages carry (issue 16): its static dependencies, built once
+# into a cache outside the clone (scripts/build-portable-deps.sh; DWV_TEST_PORTABLE=0 skips it).
+portable_args=()
+if [ "${DWV_TEST_PORTABLE:-1}" = 1 ]; then
+  if ! portable_prefix=$(scripts/build-portable-deps.sh | tail -n 1) || [ ! -f "$portable_prefix/.complete" ]; then
+    echo "test.sh: scripts/build-portable-deps.sh failed" >&2; exit 1
+  fi
+  portable_args=(-DDWV_PORTABLE_DEPS="$portable_prefix")
+  cpu
+  timings+=("portable dependencies: $((SECONDS - start)) s wall, $CPU s CPU")
+fi
+setup_start=$SECONDS setup_cpu0=${CPU:-0}
+if ! scripts/setup.sh -DDWV_WARNINGS_AS_ERRORS=ON "${portable_args[@]}"; then echo "test.sh: setup or build failed" >&2; exit 1; fi
 cpu
-timings+=("setup and build: $((SECONDS - start)) s wall, $CPU s CPU")
+timings+=("setup and build: $((SECONDS - setup_start)) s wall, $((CPU - setup_cpu0)) s CPU")
 ctest_args=()
 [ "${DWV_TEST_QUICK:-0}" = 1 ] && ctest_args=(-LE chroot)
 part ctest ctest --test-dir build --output-on-failure -j "$(nproc)" "${ctest_args[@]}"
