@@ -131,6 +131,30 @@ static double principled_diffuse_factor(const void *context, dwvu_vec3 light)
                                           lobe->roughness);
 }
 
+/* The whole surface BRDF at the entry point where a specular layer is there (material.h): the
+ * layered diffuse (Lambertian, or 3.x Principled's with its Fresnel terms), 3.x's retro-reflection
+ * lobe and the specular layer, per channel. */
+typedef struct surface_lobes {
+    const dwvb_material *material;
+    retro_lobe lobe;
+    double diffuse[3]; /* the diffuse lobe's weight per channel (layered) */
+} surface_lobes;
+
+static void surface_factor(const void *context, dwvu_vec3 light, double f[3])
+{
+    const surface_lobes *s = context;
+    const dwvb_material *m = s->material;
+    double cos_l = dwvu_dot(s->lobe.n, light), l_dot_v = dwvu_dot(light, s->lobe.to_view);
+    double diffuse = m->principled_diffuse
+                         ? dwvb_principled_diffuse_factor(cos_l, s->lobe.cos_view, l_dot_v, s->lobe.roughness)
+                         : 1.0;
+    double retro = m->principled_v1
+                       ? dwvb_principled_retro_factor(cos_l, s->lobe.cos_view, l_dot_v, s->lobe.roughness)
+                       : 0.0;
+    dwvb_specular_factor(m, s->lobe.n, light, s->lobe.to_view, f);
+    for (int c = 0; c < 3; ++c) f[c] += s->diffuse[c] * diffuse + m->retro_albedo[c] * retro;
+}
+
 /* The exit weight of Blender 3.x's Principled BSDF; the context is the exit's shading normal. */
 static double exit_factor(const void *context, dwvu_vec3 light)
 {
@@ -193,7 +217,17 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
     const dwvl_terminator *smooth = mesh->normals && cutoff > 0.0 ? &terminator : NULL;
     /* The world's top along ng is known for the outward side of the triangle only. */
     double top = ng_flipped ? INFINITY : dwvg_world_top(&scene->geometry, hit->mesh, hit->prim);
-    if (material->principled_v1) {
+    /* The layers under a 4.x+ specular keep 1 - its albedo toward the viewer (1 otherwise). */
+    double cos_view = -dwvu_dot(n, view);
+    double layer = material->specular ? dwvb_specular_layer_weight(material, cos_view) : 1.0;
+    if (material->specular) {
+        surface_lobes lobes = {material, {n, dwvu_scale(view, -1.0), cos_view, material->roughness}, {0.0, 0.0, 0.0}};
+        for (int c = 0; c < 3; ++c) lobes.diffuse[c] = layer * material->diffuse_albedo[c];
+        double surface[3];
+        dwvl_direct_rgb(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, surface_factor, &lobes,
+                        surface);
+        for (int c = 0; c < 3; ++c) rgb[c] += surface[c];
+    } else if (material->principled_v1) {
         /* The Lambertian lobe and the retro-reflection lobe from the same light samples. */
         retro_lobe lobe = {n, dwvu_scale(view, -1.0), -dwvu_dot(n, view), material->roughness};
         double direct[3], retro[3];
@@ -216,8 +250,20 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
      * go below the geometric surface. The pdf cos/pi cancels the diffuse transmission f = 1/pi. */
     double u[2];
     dwvk_sampler_pair(sampler, pair, u);
-    double mu = sqrt(u[0]);
-    dwvu_vec3 inward = dwvk_direction_about(dwvu_scale(n, -1.0), mu, 1.0 - mu, 1.0 + mu, u[1]);
+    dwvu_vec3 inward;
+    if (material->entry == DWVB_ENTRY_DIFFUSE) {
+        double mu = sqrt(u[0]);
+        inward = dwvk_direction_about(dwvu_scale(n, -1.0), mu, 1.0 - mu, 1.0 + mu, u[1]);
+    } else {
+        /* Cycles 4.x+: GGX refraction (Skin: half of it), a direction distribution of unit weight
+         * (subsurface_entry_bounce); none where the viewer is below the shading normal. */
+        dwvu_frame frame = dwvu_frame_about(n);
+        dwvu_vec3 to_view = dwvu_scale(view, -1.0);
+        dwvu_vec3 wi = dwvu_v(dwvu_dot(frame.t, to_view), dwvu_dot(frame.s, to_view), dwvu_dot(frame.n, to_view));
+        dwvu_vec3 wo;
+        if (!dwvb_entry_sample(material, wi, u[0], u[1], &wo)) return;
+        inward = dwvu_add(dwvu_add(dwvu_scale(frame.t, wo.x), dwvu_scale(frame.s, wo.y)), dwvu_scale(frame.n, wo.z));
+    }
     if (!(dwvu_dot(inward, ng) < 0.0)) return;
     /* The walk's first events take the pairs after the exit's lights (walk.h, DWVW_PAIR_*). */
     uint32_t walk_pair = pair + DWVB_SHADE_PAIRS + 2u * light_pairs;
@@ -246,7 +292,7 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
                                       &shader->channel_guides[3u * hit->mesh + (uint32_t)c], hit->prim, x, inward, n,
                                       dwvk_mix64(key_walk + (uint64_t)c + 3u * (uint64_t)j), sampler,
                                       pairs[j].first_pair, &pairs[j], &walk, &exit, tally);
-                double share = material->walk_scale[c] / (double)count;
+                double share = layer * material->walk_scale[c] / (double)count;
                 if (walk.status == DWVW_TRUNCATED) tally->truncated[c] += walk.weight[0] * share;
                 if (!exited) continue;
                 exit_light(shader, hit->mesh, material, &walk, &exit, sampler, exit_pair, direct);
@@ -265,5 +311,5 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
         for (int c = 0; c < 3; ++c) tally->truncated[c] += walk.weight[grey ? 0 : c] * material->walk_scale[c];
     if (!exited) return;
     exit_light(shader, hit->mesh, material, &walk, &exit, sampler, exit_pair, direct);
-    for (int c = 0; c < 3; ++c) rgb[c] += walk.weight[grey ? 0 : c] * material->walk_scale[c] * direct[c];
+    for (int c = 0; c < 3; ++c) rgb[c] += layer * walk.weight[grey ? 0 : c] * material->walk_scale[c] * direct[c];
 }
