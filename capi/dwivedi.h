@@ -526,11 +526,16 @@ typedef struct dwv_material_t {
     int32_t specular_multiscatter; /* 0: GGX; 1: Multiscatter GGX (4.x+: energy-compensated; refused with
                                      DWV_SPECULAR_PRINCIPLED_V1, whose multiscatter is a stochastic walk) */
     uint32_t reserved2;           /* 0 */
+    /* >= 0, finite: in camera bakes a channel whose radius x scale is below this many times the
+     * camera ray's footprint at the hit (Cycles' sd->dP: distance x the pixel's angular spread, or
+     * the pixel's width for an orthographic camera) is Lambertian there: Cycles 4.0-4.4's "fall back
+     * to diffuse if the radius is smaller than a quarter pixel" (0.25). 0: never (UV bakes: never). */
+    double subsurface_min_footprint;
 } dwv_material_t;
 #define DWV_MATERIAL_INIT                                                                           \
     {sizeof(dwv_material_t), DWV_MATERIAL_SUBSURFACE, {0.8, 0.8, 0.8}, 1.0, {0.8, 0.8, 0.8},         \
      {1.0, 0.2, 0.1}, 0.05, 0.0, 1.4, DWV_SUBSURFACE_EXIT_LAMBERT, 0u, 0.5,                          \
-     DWV_SUBSURFACE_MODEL_FIXED_RADIUS, DWV_SPECULAR_NONE, 1.5, 0.5, {1.0, 1.0, 1.0}, 0, 0u}
+     DWV_SUBSURFACE_MODEL_FIXED_RADIUS, DWV_SPECULAR_NONE, 1.5, 0.5, {1.0, 1.0, 1.0}, 0, 0u, 0.0}
 
 /* Adds a material; *material_id numbers them from 0 in order. */
 DWV_API dwv_result_t dwv_scene_add_material(dwv_scene_t *scene, const dwv_material_t *material,

@@ -165,6 +165,7 @@ def material_from_blender(material: Any, dwivedi: Any, warnings: List[str],
             warnings.append(f"material '{name}': {note}")
         node_roughness = min(max(_value(node, ("Roughness",), 1.0, name, warnings), 0.0), 1.0) if blender4 else 1.0
         return dwivedi.Material(base_color=color, subsurface_weight=1.0, subsurface_color=color,
+                                subsurface_min_footprint=footprint_rule(version),
                                 subsurface_radius=_value(node, ("Radius",), (1.0, 0.2, 0.1), name, warnings)[:3],
                                 subsurface_scale=_value(node, ("Scale",), 0.05, name, warnings),
                                 subsurface_anisotropy=max(-0.99, min(0.99, _value(node, ("Anisotropy",), 0.0, name,
@@ -231,7 +232,14 @@ def material_from_blender(material: Any, dwivedi: Any, warnings: List[str],
         if note:
             warnings.append(f"material '{name}': {note}")
     out.subsurface_anisotropy = max(-0.99, min(0.99, out.subsurface_anisotropy))  # the library clamps per model
+    out.subsurface_min_footprint = footprint_rule(version)
     return out
+
+
+def footprint_rule(version: Tuple[int, ...]) -> float:
+    """Cycles 4.0-4.4's bssrdf_setup turns a channel whose radius is below a quarter of the camera
+    ray's footprint into diffuse (removed in 4.5): 0.25 there, else 0."""
+    return 0.25 if (4, 0, 0) <= tuple(version) < (4, 5, 0) else 0.0
 
 
 # ---------------------------------------------------------------------------------------------

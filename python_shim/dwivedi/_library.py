@@ -142,6 +142,7 @@ class Material(_SizedStructure):
         ("specular_tint", _Vec3),
         ("specular_multiscatter", ctypes.c_int32),
         ("reserved2", ctypes.c_uint32),
+        ("subsurface_min_footprint", ctypes.c_double),
     ]
 
 

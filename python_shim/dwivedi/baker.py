@@ -161,7 +161,9 @@ class Material:
     (dwv_subsurface_model_t). specular_model: "none", "principled_v1" (3.x: Specular, Specular
     Tint as specular_tint[0], Roughness) or "principled_v2" (4.x+: ior, Specular IOR Level as
     `specular`, the Specular Tint colour, Roughness, specular_multiscatter for Multiscatter GGX).
-    Material.for_blender(version, ...) picks them from a Blender version and its node's inputs.
+    subsurface_min_footprint: Cycles 4.0-4.4 turn a channel whose radius is below a quarter of the
+    camera ray's footprint into diffuse (0.25; 0: never). The add-on sets all of these from
+    bpy.app.version and the node (blender_addon/dwivedi_bake/export.py).
     """
 
     base_color: Color = (0.8, 0.8, 0.8)
@@ -180,6 +182,7 @@ class Material:
     specular: float = 0.5
     specular_tint: Color = (1.0, 1.0, 1.0)
     specular_multiscatter: bool = False
+    subsurface_min_footprint: float = 0.0
 
     @classmethod
     def diffuse(cls, color: Color) -> "Material":
@@ -224,6 +227,7 @@ class Material:
         if not isinstance(self.specular_multiscatter, (bool, int)) or int(self.specular_multiscatter) not in (0, 1):
             raise ValueError(f"specular_multiscatter must be True or False, not {self.specular_multiscatter!r}")
         out.specular_multiscatter = int(self.specular_multiscatter)
+        out.subsurface_min_footprint = _real("subsurface_min_footprint", self.subsurface_min_footprint)
         return out
 
 

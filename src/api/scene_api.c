@@ -143,6 +143,7 @@ dwv_result_t dwv_scene_add_material(dwv_scene_t *scene, const dwv_material_t *ma
     if (material->specular_multiscatter != 0 && material->specular_multiscatter != 1)
         return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: specular_multiscatter = %d is neither 0 (GGX) nor 1", fn,
                         (int)material->specular_multiscatter);
+    DWV_TRY(dwv_check_range(fn, "subsurface_min_footprint", material->subsurface_min_footprint, 0.0, 1e6));
     if (material->specular_model == DWV_SPECULAR_PRINCIPLED_V1 && !(material->specular < 12.5))
         return dwv_fail(DWV_ERROR_OUT_OF_RANGE,
                         "%s: specular = %.17g: the 3.x Principled v1 specular needs Specular below 12.5 (its IOR "

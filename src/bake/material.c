@@ -357,6 +357,11 @@ void dwvb_material_init(dwvb_material *out, const dwv_material_t *in)
     out->entry = DWVB_ENTRY_DIFFUSE;
     out->entry_alpha = in->roughness * in->roughness;
     specular_init(out, in);
+    out->min_footprint = in->kind == DWV_MATERIAL_SUBSURFACE ? in->subsurface_min_footprint : 0.0;
+    for (int c = 0; c < 3; ++c) {
+        out->radius[c] = in->subsurface_radius[c] * in->subsurface_scale;
+        out->fallback_albedo[c] = (in->kind == DWV_MATERIAL_SUBSURFACE ? in->subsurface_weight : 0.0) * in->subsurface_color[c];
+    }
     /* The refraction entry's IOR is the specular layer's eta (4.x+ Principled: IOR adjusted by
      * Specular IOR Level), else `ior` (the Subsurface Scattering node's IOR); clamped as Cycles. */
     out->entry_ior = fmin(fmax(out->specular == DWV_SPECULAR_PRINCIPLED_V2 ? out->spec_eta : in->ior, 1.01), 3.8);

@@ -63,6 +63,12 @@ typedef struct dwvb_material {
     double spec_E[DWVB_SPEC_MU];  /* v2: GGX albedo (F = 1) toward mu_i = i / (DWVB_SPEC_MU - 1) */
     double spec_s[DWVB_SPEC_MU];  /* v2: the albedo's interpolation factor between f0 and 1 */
     double spec_Fms[3];        /* v2 multiscatter: Kulla-Conty's multiple-bounce Fresnel */
+    /* Cycles 4.0-4.4's footprint rule (dwv_material_t.subsurface_min_footprint): a walking channel
+     * c whose radius[c] (radius x scale) is below min_footprint x the camera ray's footprint turns
+     * into a Lambertian lobe of fallback_albedo[c] there. */
+    double min_footprint;
+    double radius[3];
+    double fallback_albedo[3];
 } dwvb_material;
 
 /* Entries into the medium. */

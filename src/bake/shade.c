@@ -183,6 +183,18 @@ static void exit_light(const dwvb_shader *shader, uint32_t mesh_id, const dwvb_m
         dwvl_direct(&shader->env, walk->position, exit_n, exit_ng, exit_smooth, exit_top, sampler, pair, direct);
 }
 
+double dwvb_footprint(const dwvb_shader *shader, dwvu_vec3 view, double t)
+{
+    if (shader->footprint == 2) return shader->pixel;
+    if (shader->footprint != 1) return 0.0;
+    double along = dwvu_dot(view, shader->forward);
+    if (!(along > 0.0)) return 0.0;
+    dwvu_vec3 d = dwvu_scale(view, 1.0 / along); /* on the plane at unit distance */
+    dwvu_vec3 dx = dwvu_sub(dwvu_normalize(dwvu_add(d, shader->pixel_right)), view);
+    dwvu_vec3 dy = dwvu_sub(dwvu_normalize(dwvu_add(d, shader->pixel_up)), view);
+    return t * 0.5 * (dwvu_length(dx) + dwvu_length(dy));
+}
+
 void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, const dwvk_sampler *sampler,
                 uint32_t pair, uint64_t key_walk, double rgb[3], dwvb_tally *tally)
 {
@@ -210,6 +222,22 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
     dwvu_vec3 x = dwvg_point(mesh, hit->prim, hit->u, hit->v);
     dwvu_vec3 n = dwvg_shading_normal(mesh, hit->prim, hit->u, hit->v, ng);
     uint32_t light_pairs = dwvl_direct_pairs(&shader->env);
+    /* Cycles 4.0-4.4: channels whose radius is below a quarter of the camera ray's footprint are
+     * Lambertian at this hit (bssrdf_setup); their walks' results are not used. */
+    double diffuse_albedo[3], keep[3] = {1.0, 1.0, 1.0};
+    int walks_left = material->subsurface;
+    for (int c = 0; c < 3; ++c) diffuse_albedo[c] = material->diffuse_albedo[c];
+    if (material->subsurface && material->min_footprint > 0.0 && shader->footprint) {
+        double limit = material->min_footprint * dwvb_footprint(shader, view, hit->t);
+        walks_left = 0;
+        for (int c = 0; c < 3; ++c) {
+            if (material->walk_scale[c] > 0.0 && material->radius[c] < limit) {
+                keep[c] = 0.0;
+                diffuse_albedo[c] += material->fallback_albedo[c];
+            }
+            if (material->walk_scale[c] > 0.0 && keep[c] > 0.0) walks_left = 1;
+        }
+    }
     /* Shadow rays of smooth-shaded triangles leave from the smooth surface near the terminator,
      * as in Cycles with the mesh's geometry offset (src/light/terminator.h). */
     double cutoff = scene->terminator_offsets[hit->mesh];
@@ -222,7 +250,7 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
     double layer = material->specular ? dwvb_specular_layer_weight(material, cos_view) : 1.0;
     if (material->specular) {
         surface_lobes lobes = {material, {n, dwvu_scale(view, -1.0), cos_view, material->roughness}, {0.0, 0.0, 0.0}};
-        for (int c = 0; c < 3; ++c) lobes.diffuse[c] = layer * material->diffuse_albedo[c];
+        for (int c = 0; c < 3; ++c) lobes.diffuse[c] = layer * diffuse_albedo[c];
         double surface[3];
         dwvl_direct_rgb(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, surface_factor, &lobes,
                         surface);
@@ -239,13 +267,12 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
         dwvl_direct_lobe(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, principled_diffuse_factor, &lobe,
                          NULL, diffuse);
         for (int c = 0; c < 3; ++c) rgb[c] += material->diffuse_albedo[c] * diffuse[c];
-    } else if (material->diffuse_albedo[0] > 0.0 || material->diffuse_albedo[1] > 0.0 ||
-               material->diffuse_albedo[2] > 0.0) {
+    } else if (diffuse_albedo[0] > 0.0 || diffuse_albedo[1] > 0.0 || diffuse_albedo[2] > 0.0) {
         double direct[3];
         dwvl_direct(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, direct);
-        for (int c = 0; c < 3; ++c) rgb[c] += material->diffuse_albedo[c] * direct[c];
+        for (int c = 0; c < 3; ++c) rgb[c] += layer * diffuse_albedo[c] * direct[c];
     }
-    if (!material->subsurface) return;
+    if (!walks_left) return;
     /* Entry: cosine-weighted about -n, rejected (no contribution, as Cycles) where it would not
      * go below the geometric surface. The pdf cos/pi cancels the diffuse transmission f = 1/pi. */
     double u[2];
@@ -282,7 +309,7 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
             pairs[j].have = pairs[j].stratified = 0u;
         }
         for (int c = 0; c < 3; ++c) {
-            if (!(material->walk_scale[c] > 0.0)) continue;
+            if (!(material->walk_scale[c] > 0.0) || !(keep[c] > 0.0)) continue;
             /* A channel of `count` walks averages them; walk j draws its own stratified pairs
              * (shared with the other channels' walk j) and counter-based numbers. */
             uint32_t count = shader->channel_counts ? shader->channel_counts[3u * hit->mesh + (uint32_t)c] : 1u;
@@ -311,5 +338,5 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
         for (int c = 0; c < 3; ++c) tally->truncated[c] += walk.weight[grey ? 0 : c] * material->walk_scale[c];
     if (!exited) return;
     exit_light(shader, hit->mesh, material, &walk, &exit, sampler, exit_pair, direct);
-    for (int c = 0; c < 3; ++c) rgb[c] += layer * walk.weight[grey ? 0 : c] * material->walk_scale[c] * direct[c];
+    for (int c = 0; c < 3; ++c) rgb[c] += keep[c] * layer * walk.weight[grey ? 0 : c] * material->walk_scale[c] * direct[c];
 }

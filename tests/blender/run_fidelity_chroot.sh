@@ -28,11 +28,31 @@ ldd "$build/libdwivedi.so.1" | awk '/=> \//{print $1, $3}' | while read -r name 
     if ! [[ $name =~ $base ]]; then cp -L "$path" "$stage/deps/$name"; fi
 done
 n=$(ls "$stage/deps" | wc -l)
-[ "$n" -gt 0 ] && echo "run_fidelity_chroot: $n host libraries preloaded for the test (the library is not self-contained)"
+if [ "$n" -gt 0 ]; then
+    # One dlopen with RTLD_DEEPBIND of a wrapper that needs Blender's own malloc (jemalloc, where this
+    # Blender links it) before the library: the library then binds to its own Embree 3 / OpenEXR but
+    # to the process's malloc (a separate glibc malloc aborts: free(): invalid pointer).
+    malloc_lib=$(chroot "$root" sh -c "ldd /usr/bin/blender" | awk '/jemalloc|tbbmalloc_proxy/{print $3; exit}')
+    mkdir -p "$stage/wrap"
+    echo 'int dwv_fidelity_wrapper(void) { return 1; }' > "$stage/wrap/wrap.c"
+    cc -shared -fPIC -o "$stage/wrap/libdwvwrap.so" "$stage/wrap/wrap.c" -Wl,--no-as-needed \
+        ${malloc_lib:+"$root$malloc_lib"} "$stage/lib/libdwivedi.so.1" -Wl,--disable-new-dtags \
+        -Wl,-rpath,'$ORIGIN/../lib:$ORIGIN/../deps'
+    echo "run_fidelity_chroot: scratch set-up: $n host libraries beside the library (not self-contained), loaded" \
+         "by a RTLD_DEEPBIND wrapper${malloc_lib:+ with $malloc_lib first}"
+fi
 env_vars=(BLENDER_USER_SCRIPTS=$stage_rel/home/scripts BLENDER_USER_CONFIG=$stage_rel/home/config
           BLENDER_USER_DATAFILES=$stage_rel/home/datafiles DWIVEDI_TEST_HOME=$stage_rel/home
-          DWIVEDI_ADDON_ZIP=$stage_rel/dwivedi_bake.zip DWIVEDI_PRELOAD_DIR=$stage_rel/deps DWIVEDI_LIBRARY=$stage_rel/lib/libdwivedi.so.1
+          DWIVEDI_ADDON_ZIP=$stage_rel/dwivedi_bake.zip DWIVEDI_PRELOAD=$stage_rel/wrap/libdwvwrap.so DWIVEDI_LIBRARY=$stage_rel/lib/libdwivedi.so.1
           PYTHONDONTWRITEBYTECODE=1 HOME=$stage_rel/home TMPDIR=$stage_rel/home)
+if [ "$n" -gt 0 ] && [ -n "${DWIVEDI_FIDELITY_OCIO_FROM:-}" ]; then
+    # The host library's OpenColorIO (2.1) cannot read a newer Blender's config (5.2: version 2.5):
+    # the display PNG (not compared here) then fails the bake. Scratch: Blender and the bake both use
+    # the config of another chroot's Blender (DWIVEDI_FIDELITY_OCIO_FROM=trixie: Blender 4.3's).
+    cp -r "/var/cache/dwivedi/chroots/$DWIVEDI_FIDELITY_OCIO_FROM/usr/share/blender/datafiles/colormanagement" "$stage/ocio"
+    env_vars+=(OCIO=$stage_rel/ocio/config.ocio)
+    echo "run_fidelity_chroot: scratch set-up: OCIO=$DWIVEDI_FIDELITY_OCIO_FROM's Blender config (the host OpenColorIO is older)"
+fi
 for v in DWIVEDI_FIDELITY_EVENT_CAP DWIVEDI_FIDELITY_ONLY DWIVEDI_FIDELITY_RESOLUTION DWIVEDI_FIDELITY_CYCLES_SPP DWIVEDI_FIDELITY_DWIVEDI_SPP; do
     [ -n "${!v:-}" ] && env_vars+=("$v=${!v}")
 done
@@ -42,5 +62,6 @@ unshare --mount --propagation private sh -c 'mount -t proc proc "$1/proc" && shi
 status=$?
 set -e
 cp "$stage/home/fidelity_figures.json" "$results/" 2>/dev/null || true
+rm -rf "$results/work" && cp -r "$stage/home/work" "$results/work" 2>/dev/null || true
 echo "run_fidelity_chroot: $suite: exit $status; figures in $results/fidelity_figures.json"
 exit $status

@@ -34,34 +34,19 @@ import scenes  # noqa: E402
 
 
 def preload_scratch_dependencies():
-    """run_fidelity_chroot.sh's scratch set-up for a library that is not self-contained: the host
-    libraries it needs, then the library itself (DWIVEDI_LIBRARY, which the add-on's shim then
-    opens: the same handle), all with RTLD_DEEPBIND so that the library binds to its own Embree 3
-    and OpenEXR, not to the Embree 4 / OpenEXR that this Blender has loaded under the same symbol
-    names (without it every ray misses). Branch native's self-contained library needs none of it."""
-    folder = os.environ.get("DWIVEDI_PRELOAD_DIR")
-    if not folder or not Path(folder).is_dir():
+    """run_fidelity_chroot.sh's scratch set-up for a library that is not self-contained
+    (DWIVEDI_PRELOAD: a wrapper needing this Blender's malloc, then the library; the host
+    dependencies beside it): one dlopen with RTLD_DEEPBIND, so that the library binds to its own
+    Embree 3 and OpenEXR rather than the Embree 4 / OpenEXR this Blender loaded under the same
+    symbol names (without it every ray misses). The add-on's shim then opens the same file
+    (DWIVEDI_LIBRARY): the same handle. Branch native's self-contained library needs none of it."""
+    wrapper = os.environ.get("DWIVEDI_PRELOAD")
+    if not wrapper or not Path(wrapper).is_file():
         return
     import ctypes
-    mode = ctypes.RTLD_LOCAL | getattr(os, "RTLD_DEEPBIND", 8)
-    left = sorted(str(p) for p in Path(folder).iterdir())
-    for _ in range(len(left) + 1):
-        failed = []
-        for path in left:
-            try:
-                ctypes.CDLL(path, mode=mode)
-            except OSError:
-                failed.append(path)
-        left = failed
-        if not left:
-            break
-    if left:
-        raise SystemExit(f"test_fidelity: cannot preload {left}")
-    library = os.environ.get("DWIVEDI_LIBRARY")
-    if library:
-        ctypes.CDLL(os.path.abspath(library), mode=mode)
-        print(f"test_fidelity: scratch set-up: {library} and its host dependencies preloaded with RTLD_DEEPBIND",
-              flush=True)
+    ctypes.CDLL(wrapper, mode=ctypes.RTLD_LOCAL | getattr(os, "RTLD_DEEPBIND", 8))
+    print(f"test_fidelity: scratch set-up: {wrapper} (the library and its host dependencies) loaded with "
+          "RTLD_DEEPBIND", flush=True)
 
 
 preload_scratch_dependencies()

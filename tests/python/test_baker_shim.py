@@ -80,7 +80,7 @@ class StructLayoutTest(unittest.TestCase):
     def test_sizes_on_lp64(self):
         if ctypes.sizeof(ctypes.c_void_p) != 8:
             self.skipTest("the sizes below are those of an LP64 ABI")
-        sizes = {"dwv_material_t": 184, "dwv_mesh_t": 152, "dwv_light_desc_t": 216, "dwv_camera_t": 128,
+        sizes = {"dwv_material_t": 192, "dwv_mesh_t": 152, "dwv_light_desc_t": 216, "dwv_camera_t": 128,
                  "dwv_bake_progress_t": 48, "dwv_bake_options_t": 96, "dwv_image_info_t": 40,
                  "dwv_bake_stats_t": 128, "dwv_error_point_t": 24, "dwv_display_options_t": 56}
         for name, size in sizes.items():
@@ -122,11 +122,12 @@ class StructLayoutTest(unittest.TestCase):
         material = dwivedi.Material()._to_c()
         self.assertEqual(tuple(material.subsurface_radius), (1.0, 0.2, 0.1))
         self.assertEqual((material.subsurface_scale, material.subsurface_ior), (0.05, 1.4))
-        self.assertEqual((material.struct_size, material.subsurface_exit, material.roughness), (184, 0, 0.5))
+        self.assertEqual((material.struct_size, material.subsurface_exit, material.roughness), (192, 0, 0.5))
         # Issue 17's fields: the same defaults as DWV_MATERIAL_INIT (fixed radius, no specular).
         self.assertEqual((material.subsurface_model, material.specular_model, material.ior, material.specular,
-                          tuple(material.specular_tint), material.specular_multiscatter),
-                         (0, 0, 1.5, 0.5, (1.0, 1.0, 1.0), 0))
+                          tuple(material.specular_tint), material.specular_multiscatter,
+                          material.subsurface_min_footprint),
+                         (0, 0, 1.5, 0.5, (1.0, 1.0, 1.0), 0, 0.0))
         self.assertEqual(_library.DisplayOptions().gamma, 1.0)
 
 
