@@ -1,5 +1,5 @@
 /* dwivedi_bake_counts: bakes a scene with one technique and prints what auto's pilot counts to
- * price a sample (src/bake/bake.c, PILOT_COST_*): samples, walk events, Embree rays, closest-point
+ * price a sample (src/bake/pilot.c, PILOT_COST_*): samples, walk events, Embree rays, closest-point
  * queries and mixture terms, with the bake's seconds. tools/fit_pilot_cost.py runs it over scenes
  * and techniques and fits the pilot's cost per count by least squares, to wall time or to
  * callgrind's instruction count in bake.c's `worker`. The counts are internal (the image object,

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Refits the cost model of auto's pilot (PILOT_COST_* in src/bake/bake.c).
+"""Refits the cost model of auto's pilot (PILOT_COST_* in src/bake/pilot.c).
 
 The pilot prices a sample as
     cost = c_sample + c_walk x walks + c_event x events + c_guided x guided events + c_ray x rays

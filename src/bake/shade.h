@@ -27,7 +27,7 @@ typedef struct dwvb_shader {
     const dwvw_guide *channel_guides;
     /* Per mesh x 3, where channels walk apart: walks per sample of each channel, 1 to
      * DWVB_MAX_CHANNEL_WALKS, each weighing 1 / count (NULL: one each). Auto's pilot sets them
-     * where a channel's variance is worth more walks than its cost (bake.c). */
+     * where a channel's variance is worth more walks than its cost (pilot.c). */
     const uint8_t *channel_counts;
     uint32_t max_events;
     /* Camera bakes: the camera ray's footprint at a hit (Cycles' sd->dP, for

@@ -133,7 +133,7 @@ static inline dwvk_dwivedi_event_cosine_f dwvk_dwivedi_event_sample_f(const dwvk
 
 /* dwvk_dwivedi_event_sample_f with the branch's constants picked by selects instead of an index:
  * the same arithmetic and the same values, bit for bit, in a form a compiler can vectorise over a
- * loop of independent samples (the estimator's lock-step lanes, src/walk/estimate.c). */
+ * loop of independent samples (the estimator's lock-step lanes, src/walk/estimate_lanes.c). */
 static inline dwvk_dwivedi_event_cosine_f dwvk_dwivedi_event_sample_select_f(const dwvk_dwivedi_event_f *d, float u)
 {
     /* Both branches' constants loaded unconditionally, then selected (a conditional load would

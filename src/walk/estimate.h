@@ -51,7 +51,7 @@ typedef struct dwvw_walk_end {
  * opposite interface exists): GUIDED for that component alone in an isotropic medium, MIXTURE for
  * it with a classical share (auto, cycles), CLASSICAL for classical alone. They make the same walks
  * as the general path from the same random numbers; GUIDED and CLASSICAL cancel the weight's
- * terms (see estimate.c), MIXTURE forms it as the general path does. */
+ * terms (see estimate_fast.c), MIXTURE forms it as the general path does. */
 typedef enum dwvw_walker {
     DWVW_WALKER_GENERAL = 0,
     DWVW_WALKER_CLASSICAL = 1,
@@ -63,7 +63,7 @@ dwvw_walker dwvw_estimate_walker(const dwvw_estimate_setup *setup);
  * the general one). */
 void dwvw_estimate_walk(const dwvw_estimate_setup *setup, dwvw_walker walker, uint64_t index, dwvw_walk_end *end);
 
-/* How many walks the guided and mixture walkers advance in lock-step (estimate.c, "lock-step"). */
+/* How many walks the guided and mixture walkers advance in lock-step (estimate_lanes.c). */
 #define DWVW_LANES 8
 /* Walks first .. first + count - 1 of a setup in lock-step lanes, their ends into ends[0 ..
  * count - 1], as dwvw_estimate_run takes them; returns 1, or 0 (nothing written) where the run

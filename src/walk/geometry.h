@@ -33,6 +33,18 @@ static inline double dwvw_positive_part(double x)
     return x > 0.0 ? x : 0.0;
 }
 
+/* The distance along a direction of z component wz < 0 from height pz to the front plane z = 0,
+ * and along wz > 0 to the back plane z = thickness (0 from a point already past it). */
+static inline double dwvw_front_plane_distance(double pz, double wz)
+{
+    return dwvw_positive_part(pz) / -wz;
+}
+
+static inline double dwvw_back_plane_distance(double thickness, double pz, double wz)
+{
+    return dwvw_positive_part(thickness - pz) / wz;
+}
+
 /* dwvw_shape_exit inline, with the kind given apart so that a caller that knows it at compile
  * time gets one case (the estimator's fast path, per event). */
 static inline double dwvw_shape_exit_inline(const dwvw_shape *shape, dwvw_shape_kind kind, dwvu_vec3 p, dwvu_vec3 d,
@@ -41,14 +53,14 @@ static inline double dwvw_shape_exit_inline(const dwvw_shape *shape, dwvw_shape_
     switch (kind) {
     case DWVW_HALFSPACE:
         *normal = DWVW_FRONT_NORMAL;
-        return d.z < 0.0 ? dwvw_positive_part(p.z) / -d.z : INFINITY;
+        return d.z < 0.0 ? dwvw_front_plane_distance(p.z, d.z) : INFINITY;
     case DWVW_SLAB:
         if (d.z < 0.0) {
             *normal = DWVW_FRONT_NORMAL;
-            return dwvw_positive_part(p.z) / -d.z;
+            return dwvw_front_plane_distance(p.z, d.z);
         }
         *normal = DWVW_BACK_NORMAL;
-        return d.z > 0.0 ? dwvw_positive_part(shape->thickness - p.z) / d.z : INFINITY;
+        return d.z > 0.0 ? dwvw_back_plane_distance(shape->thickness, p.z, d.z) : INFINITY;
     case DWVW_SPHERE: {
         /* |q + t d|^2 = R^2 with q = p - centre: t = -b + sqrt(b^2 - c), c = |q|^2 - R^2 <= 0; for
          * b > 0 the equivalent -c / (b + sqrt(b^2 - c)) avoids cancellation. */

@@ -1,10 +1,10 @@
 #include "walk.h"
 
-#include <float.h>
 #include <math.h>
 #include <string.h>
 
 #include "kernel/sheet.h"
+#include "step.h"
 
 void dwvw_medium_init(dwvw_medium *medium, int channels, const double *sigma_t, const double *albedo, double g)
 {
@@ -340,7 +340,7 @@ static double sheet_sample(dwvw_walk *walk, int channel, const double *choice, f
             walk->direction = dwvk_frame_direction(frame_about_axis(walk, normal), mu, sqrt(sin2 > 0.0 ? sin2 : 0.0),
                                                    dwvk_azimuth_f(u.b));
         }
-        walk->phase = g == 0.0f ? DWVK_INV_FOUR_PI : dwvk_hg_pdf_f(g, (float)dwvw_cosine(previous, walk->direction));
+        walk->phase = dwvw_phase_value(g, previous, walk->direction);
     } else {
         walk->phase = 1.0; /* the entry's direction: not sampled, pdf 1 for every component */
     }
@@ -415,8 +415,7 @@ double dwvw_walk_sample(dwvw_walk *walk)
         } else {
             walk->direction = dwvw_guided_direction(frame_about_axis(walk, walk->component_axis[chosen]), &m->dwivedi_event, u);
         }
-        /* HG at g = 0 is the isotropic 1/(4 pi): skip its square root and division. */
-        walk->phase = g == 0.0f ? DWVK_INV_FOUR_PI : dwvk_hg_pdf_f(g, (float)dwvw_cosine(previous, walk->direction));
+        walk->phase = dwvw_phase_value(g, previous, walk->direction);
     } else {
         walk->phase = 1.0;
     }
@@ -441,53 +440,21 @@ static inline double exp_shared(double x, int zero, int same, double earlier)
     return zero ? 1.0 : same ? earlier : dwvk_exp_fast(x);
 }
 
-/* rgb_weight_update (below) for one component (Q p = qp, stretch s), written out: the same
- * operations in the same order, without the loops over components. Through add_component_terms
- * and arrays, as the general form, it took ~35 instructions more per event (callgrind, slab). */
-static void rgb_weight_update_single(dwvw_walk *walk, double qp, double stretch, double t, int exited)
+/* The channel factors f_c = exp((r - sigma_c) t) of rgb_weight_update (below), for rate r. */
+static DWVW_ALWAYS_INLINE void channel_factors(const double sigma_t[3], double rate, double t, double f[3])
 {
-    const dwvw_medium *m = walk->medium;
-    const double s0 = m->sigma_t[0], s1 = m->sigma_t[1], s2 = m->sigma_t[2];
-    const double p0 = walk->channel_p[0], p1 = walk->channel_p[1], p2 = walk->channel_p[2];
-    const int on0 = p0 > 0.0, on1 = p1 > 0.0, on2 = p2 > 0.0;
-    const double x0 = s0 * stretch, x1 = s1 * stretch, x2 = s2 * stretch;
-    double rate = INFINITY;
-    if (qp > 0.0) {
-        if (on0 && x0 < rate) rate = x0;
-        if (on1 && x1 < rate) rate = x1;
-        if (on2 && x2 < rate) rate = x2;
-    }
-    const double f0 = exp_shared((rate - s0) * t, s0 == rate, 0, 0.0);
-    const double f1 = exp_shared((rate - s1) * t, s1 == rate, s1 == s0, f0);
-    const double f2 = exp_shared((rate - s2) * t, s2 == rate, s2 == s1, f1);
-    double denominator = 0.0;
-    if (rate < INFINITY) {
-        double d0 = f0, d1 = f1, d2 = f2;
-        if (stretch != 1.0) {
-            /* only the active channels' (an inactive one's argument may be positive) */
-            d0 = on0 ? exp_shared((rate - x0) * t, x0 == rate, 0, 0.0) : 0.0;
-            d1 = on1 ? exp_shared((rate - x1) * t, x1 == rate, on0 && x1 == x0, d0) : 0.0;
-            d2 = on2 ? exp_shared((rate - x2) * t, x2 == rate, on1 && x2 == x1, d1) : 0.0;
-        }
-        if (on0) denominator += qp * p0 * (exited ? 1.0 : x0) * d0;
-        if (on1) denominator += qp * p1 * (exited ? 1.0 : x1) * d1;
-        if (on2) denominator += qp * p2 * (exited ? 1.0 : x2) * d2;
-    }
-    /* The ratio is >= 0 or NaN (every factor is >= 0): `ratio <= DBL_MAX` is isfinite(ratio). A
-     * weight of 0 stays 0 either way (0 x a finite ratio, or 0 x 0), so it needs no test. */
-    const double phase = walk->phase, factor[3] = {f0, f1, f2};
-    for (int c = 0; c < 3; ++c) {
-        double f = phase * (exited ? 1.0 : m->sigma_t[c] * m->albedo[c]);
-        double ratio = f * factor[c] / denominator;
-        walk->weight[c] *= ratio <= DBL_MAX ? ratio : 0.0;
-    }
+    f[0] = exp_shared((rate - sigma_t[0]) * t, sigma_t[0] == rate, 0, 0.0);
+    f[1] = exp_shared((rate - sigma_t[1]) * t, sigma_t[1] == rate, sigma_t[1] == sigma_t[0], f[0]);
+    f[2] = exp_shared((rate - sigma_t[2]) * t, sigma_t[2] == rate, sigma_t[2] == sigma_t[1], f[1]);
 }
 
 /* One component's terms of the shared sum D (rgb_weight_update), added to `denominator` in
  * channel order: Q p = qp, stretch s, the rate r and the channel factors f_c = exp((r - sigma_c) t)
- * (the classical component's decays). */
-static double add_component_terms(double denominator, const double sigma_t[3], const double p[3], double qp,
-                                  double stretch, double rate, const double f[3], double t, int exited)
+ * (the classical component's decays). Only the active channels' exponentials are taken (an
+ * inactive one's argument may be positive). */
+static DWVW_ALWAYS_INLINE double add_component_terms(double denominator, const double sigma_t[3], const double p[3],
+                                                     double qp, double stretch, double rate, const double f[3],
+                                                     double t, int exited)
 {
     const int on0 = p[0] > 0.0, on1 = p[1] > 0.0, on2 = p[2] > 0.0;
     const double x0 = sigma_t[0] * stretch, x1 = sigma_t[1] * stretch, x2 = sigma_t[2] * stretch;
@@ -501,6 +468,32 @@ static double add_component_terms(double denominator, const double sigma_t[3], c
     if (on1) denominator += qp * p[1] * (exited ? 1.0 : x1) * d1;
     if (on2) denominator += qp * p[2] * (exited ? 1.0 : x2) * d2;
     return denominator;
+}
+
+/* rgb_weight_update (below) for one component (Q p = qp, stretch s): the same operations in the
+ * same order, without the loops over components and their arrays (which took ~35 instructions
+ * more per event, callgrind, slab). */
+static void rgb_weight_update_single(dwvw_walk *walk, double qp, double stretch, double t, int exited)
+{
+    const dwvw_medium *m = walk->medium;
+    const double sigma_t[3] = {m->sigma_t[0], m->sigma_t[1], m->sigma_t[2]};
+    const double p[3] = {walk->channel_p[0], walk->channel_p[1], walk->channel_p[2]};
+    double rate = INFINITY;
+    if (qp > 0.0) {
+        for (int c = 0; c < 3; ++c) {
+            double sigma = sigma_t[c] * stretch;
+            if (p[c] > 0.0 && sigma < rate) rate = sigma;
+        }
+    }
+    double f[3];
+    channel_factors(sigma_t, rate, t, f);
+    double denominator = 0.0;
+    if (rate < INFINITY) denominator = add_component_terms(denominator, sigma_t, p, qp, stretch, rate, f, t, exited);
+    /* A weight of 0 stays 0 whatever the ratio (0 x a finite ratio, or 0 x 0): it needs no test. */
+    for (int c = 0; c < 3; ++c) {
+        double numerator = walk->phase * (exited ? 1.0 : sigma_t[c] * m->albedo[c]);
+        walk->weight[c] *= dwvw_weight_ratio(numerator * f[c], denominator);
+    }
 }
 
 /* The weight update of an RGB walk (a medium has 1 or 3 channels) over components first .. end - 1,
@@ -532,20 +525,17 @@ static void rgb_weight_update(dwvw_walk *walk, const double *qp, int first, int 
         }
     }
     double f[3];
-    f[0] = exp_shared((rate - sigma_t[0]) * t, sigma_t[0] == rate, 0, 0.0);
-    f[1] = exp_shared((rate - sigma_t[1]) * t, sigma_t[1] == rate, sigma_t[1] == sigma_t[0], f[0]);
-    f[2] = exp_shared((rate - sigma_t[2]) * t, sigma_t[2] == rate, sigma_t[2] == sigma_t[1], f[1]);
+    channel_factors(sigma_t, rate, t, f);
     double denominator = 0.0;
     if (rate < INFINITY)
         for (int k = first; k < end; ++k)
             if (qp[k] > 0.0)
                 denominator = add_component_terms(denominator, sigma_t, p, qp[k], walk->component_stretch[k], rate, f, t,
                                                   exited);
-    /* as in rgb_weight_update_single: the ratio is >= 0 or NaN, and a weight of 0 stays 0 */
+    /* as in rgb_weight_update_single: a weight of 0 stays 0 */
     for (int c = 0; c < 3; ++c) {
         double numerator = walk->phase * (exited ? 1.0 : sigma_t[c] * m->albedo[c]);
-        double ratio = numerator * f[c] / denominator;
-        walk->weight[c] *= ratio <= DBL_MAX ? ratio : 0.0;
+        walk->weight[c] *= dwvw_weight_ratio(numerator * f[c], denominator);
     }
 }
 
@@ -579,8 +569,7 @@ static void sheet_weight_update(dwvw_walk *walk, double t, int exited)
     }
     for (int c = 0; c < m->channels; ++c) {
         double numerator = walk->phase * (exited ? 1.0 : m->sigma_t[c] * m->albedo[c]) * decay[c];
-        double ratio = numerator / denominator; /* >= 0 or NaN, as in rgb_weight_update */
-        walk->weight[c] *= ratio <= DBL_MAX ? ratio : 0.0;
+        walk->weight[c] *= dwvw_weight_ratio(numerator, denominator);
     }
 }
 
@@ -606,12 +595,9 @@ static void mixture_weight_update(dwvw_walk *walk, double t, int exited)
         for (int k = first; k < end; ++k) {
             if (!(qp[k] > 0.0)) continue;
             double stretch = walk->component_stretch[k];
-            /* The classical component (stretch 1) has exp(0) = 1: skip the call. */
-            double decay = stretch == 1.0 ? 1.0 : dwvk_exp_fast(sigma_t * (1.0 - stretch) * t);
-            denominator += qp[k] * (exited ? 1.0 : stretch) * decay;
+            denominator += dwvw_grey_term(qp[k], stretch, dwvw_grey_decay(sigma_t, stretch, t), exited);
         }
-        double ratio = walk->phase * (exited ? 1.0 : m->albedo[0]) / denominator; /* >= 0 or NaN */
-        walk->weight[0] *= ratio <= DBL_MAX ? ratio : 0.0;
+        walk->weight[0] *= dwvw_grey_ratio(walk->phase, m->albedo[0], denominator, exited);
     } else if (walk->single_component >= 0) {
         rgb_weight_update_single(walk, qp[first], walk->component_stretch[first], t, exited);
     } else {
@@ -641,8 +627,8 @@ dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvu_vec3 h
             walk->opposite_depth = -hit_distance * dwvu_dot(walk->direction, walk->entry_normal);
         }
     }
-    int exited = hit_distance <= walk->step_distance;
-    double t = exited ? hit_distance : walk->step_distance;
+    int exited;
+    double t = dwvw_step_length(hit_distance, walk->step_distance, &exited);
 
     if (walk->guide->q_sheet > 0.0) sheet_weight_update(walk, t, exited);
     else mixture_weight_update(walk, t, exited);
@@ -665,15 +651,9 @@ dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvu_vec3 h
         sheet_importance(walk, a);
         largest *= a[m->guide_channel] / DWVK_SHEET_EXTRAPOLATION;
     }
-    if (largest < DWVW_ROULETTE_THRESHOLD) {
-        /* Russian roulette below the threshold: survive with probability largest/threshold.
-         * Guided walks carry weights near alpha exp(sigma kappa z)/(1 + kappa), just below 1 near
-         * the surface; a threshold of 1 would kill them there for nothing but variance. At 0.5
-         * (was 0.05) the report's thick sphere takes 10% fewer events per walk for +0.5% variance
-         * (classical and poe alike), thin slabs and leaves are unchanged (docs/speed.md). */
-        double survive = largest / DWVW_ROULETTE_THRESHOLD;
-        double u = dwvk_rng_uniform_d(walk->key, dwvw_event_dim(walk->events - 1u) + DWVW_DIM_ROULETTE);
-        if (u >= survive) {
+    if (largest < DWVW_ROULETTE_THRESHOLD) { /* Russian roulette (step.h) */
+        double survive;
+        if (!dwvw_roulette_survives(walk->key, walk->events, largest, &survive)) {
             for (int c = 0; c < m->channels; ++c) walk->weight[c] = 0.0;
             return walk->status = DWVW_ABSORBED;
         }

@@ -221,56 +221,6 @@ dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvu_vec3 h
  * beyond it as none leaves the walk the same. */
 double dwvw_walk_probe_reach(const dwvw_walk *walk);
 
-/* ---- the per-event pieces, shared by dwvw_walk_sample and the estimator's fast path ----------- */
-
-static inline uint32_t dwvw_event_dim(uint32_t events)
-{
-    return 2u + DWVW_DIMS_PER_EVENT * events;
-}
-
-/* A classical direction: the cosine to `previous` from the phase function (isotropic at g = 0),
- * the azimuth uniform. u.a drives the cosine, u.b the azimuth. */
-static inline dwvu_vec3 dwvw_classical_direction(dwvu_vec3 previous, float g, dwvk_uniform_pair_f u)
-{
-    float mu = g == 0.0f ? dwvk_isotropic_sample_f(u.a) : dwvk_hg_sample_f(g, u.a);
-    float sin2 = (1.0f - mu) * (1.0f + mu);
-    dwvu_frame frame = dwvu_frame_about(previous);
-    return dwvk_frame_direction(&frame, mu, sqrtf(sin2 > 0.0f ? sin2 : 0.0f), dwvk_azimuth_f(u.b));
-}
-
-/* A guided direction about frame->n (Dwivedi's cosine distribution). */
-static inline dwvu_vec3 dwvw_guided_direction(const dwvu_frame *frame, const dwvk_dwivedi_event_f *d,
-                                              dwvk_uniform_pair_f u)
-{
-    dwvk_dwivedi_event_cosine_f s = dwvk_dwivedi_event_sample_f(d, u.a);
-    return dwvk_frame_direction(frame, s.cos_theta, s.sin_theta, dwvk_azimuth_f(u.b));
-}
-
-/* The same about a fixed axis, with its frame's four quarter turns made in advance
- * (turned[q] = dwvu_frame_turned(frame, q)): bit for bit dwvw_guided_direction, without turning
- * the azimuth per event. */
-static inline dwvu_vec3 dwvw_guided_direction_turned(const dwvu_frame turned[4], const dwvk_dwivedi_event_f *d,
-                                                     dwvk_uniform_pair_f u)
-{
-    dwvk_dwivedi_event_cosine_f s = dwvk_dwivedi_event_sample_f(d, u.a);
-    int32_t q;
-    dwvk_unit2_f azimuth = dwvk_azimuth_quadrant_f(u.b, &q);
-    return dwvk_frame_direction(&turned[q], s.cos_theta, s.sin_theta, azimuth);
-}
-
-/* The cosine of unit `direction` to unit `axis`, held in [-1, 1]. */
-static inline double dwvw_cosine(dwvu_vec3 direction, dwvu_vec3 axis)
-{
-    double mu = dwvu_dot(direction, axis);
-    return mu < -1.0 ? -1.0 : mu > 1.0 ? 1.0 : mu;
-}
-
-/* A free flight of extinction sigma (> 0) from a 24-bit uniform. */
-static inline double dwvw_flight(double sigma, float u)
-{
-    return dwvk_free_flight(u) / sigma;
-}
-
 /* The mixture weights `auto` uses for a medium: see the definition for the heuristic. */
 void dwvw_auto_weights(const dwvw_medium *medium, int patch_count, double *q_classical, double *q_closest,
                        double *q_incident);

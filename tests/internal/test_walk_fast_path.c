@@ -1,4 +1,4 @@
-/* The estimator's fast paths (src/walk/estimate.c: classical alone, one guided component about a
+/* The estimator's fast paths (src/walk/estimate_fast.c: classical alone, one guided component about a
  * fixed axis, and that component mixed with classical) against the general walk (dwvw_walk_sample / dwvw_walk_complete) from the same random
  * numbers:
  *   - dwvw_estimate_walker picks the fast path exactly where it applies (grey medium; classical

@@ -53,6 +53,7 @@
 #include "stats.h"
 #include "walk/estimate.h"
 #include "walk/geometry.h"
+#include "walk/step.h"
 #include "walk/walk.h"
 
 #define SEED 0x5ee7a1cull

@@ -327,7 +327,7 @@ static void test_cancel_and_budgets(void)
  * covered pixels' luminance; the bound allows for the estimates' own noise at 64 spp. The
  * estimate comes from the spread between each pixel's two independent stratified replicates, so
  * stratification does not inflate it (with the samples' own variance it was 2.2x here, with the
- * channel walks auto picks; bake.c estimate_error). Seeds 11 and 12: 1.0x. */
+ * channel walks auto picks; src/bake/pixel_sums.c). Seeds 11 and 12: 1.0x. */
 static void test_error_estimate_is_the_rmse(void)
 {
     dwv_scene_t *scene = mixed_scene();

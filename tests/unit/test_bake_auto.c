@@ -1,4 +1,4 @@
-/* Auto's pilot (choose_auto in src/bake/bake.c) picks, per mesh, the candidate with the least
+/* Auto's pilot (dwvb_pilot_choose in src/bake/pilot.c) picks, per mesh, the candidate with the least
  * variance x cost among classical sampling, Dwivedi sampling about the entry normal (backward),
  * the guided part of auto's mixture (incident, or closest) and the sheet walk (where light
  * reaches the mesh). Where one candidate is clearly the most efficient, auto must take it, for

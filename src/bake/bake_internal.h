@@ -1,0 +1,119 @@
+/* The state of a bake, shared by the files of the bake engine (bake.c: passes, tiles and workers;
+ * guides.c: the guides per mesh; pilot.c: auto's pilot; pixel_sums.c: the error estimate and the
+ * image), and the helpers more than one of them calls. bake.h keeps it opaque to the API. */
+#ifndef DWV_BAKE_BAKE_INTERNAL_H
+#define DWV_BAKE_BAKE_INTERNAL_H
+
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdint.h>
+
+#include "bake/bake.h"
+#include "bake/shade.h"
+#include "bake/uv_raster.h"
+#include "util/clock.h"
+#include "util/parallel.h"
+
+/* The walk's random numbers come from a stream of their own: bit 63 of the stream marks it. The
+ * per-pixel scrambles of the stratified pairs (kernel/sampler.h) come from bit 62's stream. */
+#define WALK_STREAM 0x8000000000000000ull
+#define PIXEL_STREAM 0x4000000000000000ull
+/* The pilot that chooses auto's technique per mesh draws from bit 61's streams. */
+#define PILOT_STREAM 0x2000000000000000ull
+
+/* A pixel's samples form two independent replicates (dwvb_bake_sample): even samples and odd ones. */
+#define REPLICATES 2u
+
+typedef struct dwvb_pixel_sums {
+    double sum[3], sum_squares[3];
+    double sum_alpha, sum_luminance_squares;
+    double replicate_luminance[REPLICATES]; /* the sum of each replicate's luminances */
+} dwvb_pixel_sums;
+
+struct dwvb_bake {
+    const dwvb_scene *scene;
+    dwv_bake_options_t options;
+    uint32_t width, height, threads;
+    dwvb_shader shader;
+    dwvw_guide *guides;
+    dwvw_guide *channel_guides; /* per mesh x 3 (shade.h) */
+    int *channel_walks;         /* per mesh (shade.h) */
+    uint8_t *channel_counts;    /* per mesh x 3 (shade.h) */
+    int *needs_closest;
+    int *auto_choice; /* per mesh: auto's technique is chosen by the pilot (dwvb_pilot_choose) */
+    uint32_t features;
+    /* camera */
+    dwvu_vec3 eye, right, up, forward; /* right/up scaled to the image's half extents */
+    /* UV */
+    dwvb_uv_raster raster;
+    /* accumulation */
+    dwvb_pixel_sums *sums;
+    uint32_t *counts;
+    uint32_t tiles_x, tile_count;
+    dwvb_tally *tile_tallies;
+    /* Tiles are handed out longest first, by the seconds each took in the previous pass, so that
+     * no worker is left with one long tile at the end of a pass (longest-processing-time-first
+     * scheduling). The order changes only timing: each pixel's samples are keyed by its index. */
+    uint32_t *tile_order;
+    double *tile_seconds;
+    struct timed_tile *tile_ranking; /* scratch for the ordering */
+    uint64_t pass_first, pass_end; /* sample indices of the running pass */
+    atomic_uint next_tile;
+    atomic_uint tiles_done;
+    atomic_int time_up;
+    atomic_int cancelled;
+    atomic_uint_fast64_t events;
+    double start; /* dwvu_clock_seconds() when the bake began */
+    uint64_t spp_done;
+    double error;
+    /* control */
+    pthread_t control;
+    int control_started, joined;
+    pthread_mutex_t lock;
+    pthread_cond_t changed; /* workers finished, or the bake ended */
+    uint32_t workers_running;
+    dwvu_parallel workers; /* a pass's tile workers */
+    int done;
+    dwv_result_t result;
+    char message[256];
+    dwvb_image *image;
+    dwv_bake_progress_t progress;
+};
+
+static inline double dwvb_bake_elapsed(const dwvb_bake *bake)
+{
+    return dwvu_clock_seconds() - bake->start;
+}
+
+static inline double dwvb_luminance(const double rgb[3])
+{
+    return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
+}
+
+static inline int dwvb_bake_pixel_active(const dwvb_bake *bake, uint32_t index)
+{
+    return bake->options.target == DWV_BAKE_CAMERA || bake->raster.texels[index].triangle >= 0;
+}
+
+/* Whether a worker (a pass's or the pilot's) must stop: cancelled, or (with a time limit) out of time. The time limit
+ * cuts only once the first pass is done (spp_done is written between passes, while no worker
+ * runs), so that a budget shorter than auto's pilot and the first pass ends the bake right after
+ * them with that pass's samples (2 per pixel, 1 where 1 is asked), not with an empty image; as
+ * Cycles, which renders at least one sample. */
+static inline int dwvb_bake_must_stop(dwvb_bake *bake)
+{
+    if (atomic_load_explicit(&bake->cancelled, memory_order_relaxed)) return 1;
+    if (bake->options.time_limit > 0.0 && bake->spp_done > 0 && dwvb_bake_elapsed(bake) >= bake->options.time_limit) {
+        atomic_store(&bake->time_up, 1);
+        return 1;
+    }
+    return 0;
+}
+
+/* Sample s of pixel `index` shaded by `shader`, with the random streams `stream` (pixel
+ * position, entry, lights and the walk's first events) and `stream | WALK_STREAM` (the rest of
+ * the walk); the mesh it saw (or UINT32_MAX) in *mesh_seen. */
+void dwvb_bake_sample(const dwvb_bake *bake, const dwvb_shader *shader, uint64_t stream, uint32_t index, uint64_t s,
+                      double rgb[3], double *alpha, uint32_t *mesh_seen, dwvb_tally *tally);
+
+#endif

@@ -1,0 +1,381 @@
+/* Auto's pilot (pilot.h): the candidates, their counted cost, the pilot's run and the choice. */
+#include "bake/pilot.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+#include "bake/guides.h"
+#include "kernel/rng.h"
+
+/* ---- auto: the technique that pays, per mesh --------------------------------------------------
+ * Guiding lowers a walk's variance but costs work per event (a mixture of components, each with
+ * a pdf and an exponential per channel pair); where the image's variance hardly moves that work
+ * is wasted, and auto's small defensive classical share doubles the mixture's terms where guiding
+ * alone would do (thin back-lit sheets). Before the first pass, a pilot shades the same pixel
+ * samples with each candidate and keeps, per mesh, the one with the largest efficiency
+ * 1 / (variance x cost) (Veach 1997, Sec. 2.4: the efficiency of an estimator; Hammersley and
+ * Handscomb 1964). The candidates:
+ * - classical sampling;
+ * - Dwivedi sampling about the entry normal, toward the opposite interface where the first step
+ *   found one (the backward technique; with no opposite interface it is the entry-normal
+ *   technique, poe): on thick front-lit media its walks need 30% fewer events than classical ones
+ *   at equal or lower variance (report's sphere: 17.4 against 24.3 events per walk), and on thin
+ *   sheets it aims at the far face as well as the near one (slab: variance 0.61x poe's);
+ * - the guided part of auto's mixture alone: toward the lit patches (incident), or the closest
+ *   surface point where no light reaches the mesh;
+ * - the sheet walk (walk.h, src/kernel/sheet.h), where light reaches some deciding mesh: toward
+ *   the strongest lit patch with an importance linear in depth, the zero-variance walk of a thin
+ *   sheet of albedo near 1, where Dwivedi's exponential is flat (the report's leaf: 7.5x less
+ *   image variance than classical walks at equal samples, efficiency 3.3x-4.4x auto's earlier pick);
+ * - each of these four with one walk per colour channel (channel walks, shade.h), where the
+ *   medium's channels differ and the option leaves it to auto. A shared walk weighs every channel
+ *   by the spectral MIS of all three; over many events the channels' weights then carry each
+ *   other's pdfs and scatter widely. On the report's wax sphere (extinctions 2x and 5x apart) the
+ *   image's variance per sample was 10x lower with one backward walk per channel, for 1.6x the
+ *   time per sample (docs/speed.md); on the leaf (one extinction, albedos apart) it was not worth
+ *   its cost. The pilot's variance is the three channels' together, as the image's RMSE over RGB
+ *   counts it: the luminance hides the colour noise of shared walks. A channel-walk candidate
+ *   also gets the walks per sample of each channel that suit it (candidate_work).
+ * Auto's mixture itself (the guided part plus a classical share of 1% or less) is no candidate:
+ * its variance was that of the guided part alone within the pilot's noise and its cost above it,
+ * so it won none of the pilots on the report's sphere, slab, leaf and default scene (both meshes)
+ * and the example scenes (20 pilots, seeds 1-3 or 1-2); it stays the technique of meshes the pilot
+ * cannot decide (too few samples). Every candidate is unbiased, so the choice moves noise, never
+ * the mean.
+ * The cost is counted, not timed, so that the choice (and the image) depends on the seed only:
+ * instructions per sample (camera ray, shading), per walk (its probe, exit and exit lighting),
+ * per walk event (the event's
+ * sampling and weight), more per event of a walk with a guided component (every candidate but
+ * classical: a Dwivedi direction's frame, sampling and pdf; 1.5x a classical event in the fit;
+ * the sheet's events are priced so too, with its two components' mixture terms: 1.54x a
+ * classical event on the leaf in the model, 1.37x per event in callgrind, walks included),
+ * per Embree ray the walk casts (steps inside a ball clear of the mesh cast
+ * none: shade.c run_walk), per closest-point query and per mixture term (see dwvb_tally). They
+ * are a least-squares fit (relative residuals, coefficients >= 0) of callgrind's instruction
+ * counts in the bake's workers, one thread, 32 x 32 pixels, 16 spp, over the report's sphere,
+ * slab, leaf and default scene x classical, poe, backward, incident, closest and cycles, and
+ * classical, backward and incident with channel walks: tools/fit_pilot_cost.py, which refits
+ * them (rms residual 18.8%; the worst: closest, whose query's cost grows with the mesh, -40% and
+ * -53% on the sphere and the default scene, and incident on the sphere, whose lit patches are
+ * weighed per event, -28% shared and -46% with channel walks; docs/speed.md). Rays come out at
+ * 0: with the ray-free steps and the box's plane exits they are about 0.5-0.7 per event in every
+ * technique, so the event's cost holds theirs. One-thread bake times agreed where the machine was
+ * quiet enough to measure (report's sphere, 32 x 32 pixels, 16 spp, best of 6: backward and poe
+ * 1.3% and 5.4% faster than classical, instructions 5.0% and 7.1%, two refits ago); under load a
+ * timed fit (--measure time) is not usable (rms 32%). Only their ratios matter. */
+#define PILOT_COST_SAMPLE 4514.0
+#define PILOT_COST_WALK 545.5
+#define PILOT_COST_EVENT 754.1
+#define PILOT_COST_GUIDED_EVENT 306.1
+#define PILOT_COST_RAY 0.0
+#define PILOT_COST_QUERY 6028.0
+#define PILOT_COST_TERM 25.22
+/* Pilot samples per candidate: a sixteenth of the bake's samples, at most PILOT_MAX; below
+ * PILOT_MIN the estimate is too noisy to act on and auto keeps its mixture. A mesh needs
+ * PILOT_MESH_MIN of them to be decided. */
+#define PILOT_MAX 4096u
+#define PILOT_MIN 256u
+#define PILOT_MESH_MIN 64.0
+
+/* The candidates, in the order of the pilot (a tie keeps the earlier, cheaper one): the four
+ * techniques with the channels walked together, then the same with one walk per channel. */
+#define PILOT_TECHNIQUES 4
+#define PILOT_CANDIDATES (2 * PILOT_TECHNIQUES)
+enum { PILOT_CLASSICAL = 0, PILOT_ENTRY = 1, PILOT_GUIDED = 2, PILOT_SHEET = 3 };
+
+/* Auto's classical share at or below which the guided candidates drop it: the isotropic
+ * defensive share, min(0.01, 0.1 sqrt(1 - alpha)) (dwvw_auto_weights). Above it auto raised the
+ * share to |g| for an anisotropic medium, where the Dwivedi pdf misses the phase function's peak
+ * and a guided walk's weight per event, phase / pdf, grows without that share to bound it (it is
+ * at most 1 / share: Hesterberg's defensive mixture). Measured on a thin back-lit slab with
+ * g = 0.8, 2048 pilot samples: guided alone had sample variances of 0.003 to 380 over three seeds
+ * against classical's 0.23, so the pilot's estimate would pick it by chance. */
+#define PILOT_ISOTROPIC_SHARE 0.01
+
+/* Technique `technique` (PILOT_*) of the pilot for a mesh of `medium` whose guide auto made
+ * (`mixture`: auto's mixture, or classical where the albedo is too low to guide). */
+static void pilot_guide(const dwvb_bake *bake, uint32_t m, int technique, const dwvw_medium *medium,
+                        const dwvw_guide *mixture, dwvw_guide *guide)
+{
+    const dwvb_scene *scene = bake->scene;
+    if (technique == PILOT_CLASSICAL || mixture->q_classical >= 1.0) {
+        dwvw_guide_init(guide, DWVW_CLASSICAL, medium, NULL, 0);
+        return;
+    }
+    if (technique == PILOT_SHEET) { /* its own classical share, at least auto's (walk.h) */
+        dwvw_guide_init(guide, DWVW_SHEET, medium, scene->patches[m], scene->patch_count[m]);
+        return;
+    }
+    if (technique == PILOT_ENTRY) dwvw_guide_init(guide, DWVW_BACKWARD, medium, NULL, 0);
+    else if (mixture->q_incident > 0.0)
+        dwvw_guide_init(guide, DWVW_INCIDENT, medium, scene->patches[m], scene->patch_count[m]);
+    else dwvw_guide_init(guide, DWVW_CLOSEST, medium, NULL, 0);
+    if (mixture->q_classical > PILOT_ISOTROPIC_SHARE) { /* keep auto's defensive classical share */
+        double guided = 1.0 - mixture->q_classical;
+        guide->q_classical = mixture->q_classical;
+        guide->q_backward *= guided;
+        guide->q_incident *= guided;
+        guide->q_closest *= guided;
+    }
+}
+
+/* Candidate `candidate` for mesh m (auto's guides in bake): its guide, its channel guides and
+ * whether its channels walk apart (a grey medium's one-channel walks walk once either way). */
+static void pilot_candidate(const dwvb_bake *bake, uint32_t m, int candidate, dwvw_guide *guide,
+                            dwvw_guide channel_guides[3], int *channel_walks)
+{
+    const dwvb_material *material = &bake->scene->shading[bake->scene->meshes[m].material_id];
+    int technique = candidate % PILOT_TECHNIQUES;
+    pilot_guide(bake, m, technique, &material->medium, &bake->guides[m], guide);
+    *channel_walks = candidate >= PILOT_TECHNIQUES && !material->grey;
+    for (int c = 0; c < 3; ++c)
+        if (!material->grey && material->walk_scale[c] > 0.0)
+            pilot_guide(bake, m, technique, &material->channel_medium[c], &bake->channel_guides[3u * m + (uint32_t)c],
+                        &channel_guides[c]);
+}
+
+typedef struct pilot_sums {
+    double count, sum[3], sum_squares[3], cost;
+    double channel_cost[3]; /* of the cost, the channel walks' own, by channel */
+} pilot_sums;
+
+static uint64_t active_pixels(const dwvb_bake *bake)
+{
+    uint64_t pixels = (uint64_t)bake->width * bake->height, active = 0;
+    for (uint64_t i = 0; i < pixels; ++i) active += (uint64_t)dwvb_bake_pixel_active(bake, (uint32_t)i);
+    return active;
+}
+
+/* The pilot's samples are cut into PILOT_BLOCKS fixed blocks that the bake's threads share; each
+ * block sums its samples in order and the blocks are added in block order, so the sums, the choice
+ * and the image are the same for any thread count. On one thread the pilot would be serial work
+ * beside the passes (a few percent of a short bake: Amdahl's law on the 1 -> 2 thread speed-up). */
+#define PILOT_BLOCKS 64u
+
+typedef struct pilot_run {
+    dwvb_bake *bake;
+    const dwvb_shader *shaders; /* indexed by candidate */
+    const int *candidates;      /* the candidates run (PILOT_*), candidate_count of them */
+    int candidate_count;
+    pilot_sums *block_sums;     /* [block][candidate][mesh] */
+    uint32_t samples, meshes;
+    atomic_uint next_block;
+    atomic_int stopped;
+} pilot_run;
+
+static void *pilot_worker(void *arg)
+{
+    pilot_run *run = arg;
+    dwvb_bake *bake = run->bake;
+    uint64_t pixels = (uint64_t)bake->width * bake->height;
+    for (;;) {
+        uint32_t block = atomic_fetch_add(&run->next_block, 1u);
+        if (block >= PILOT_BLOCKS || atomic_load(&run->stopped)) break;
+        uint32_t first = (uint32_t)((uint64_t)run->samples * block / PILOT_BLOCKS);
+        uint32_t end = (uint32_t)((uint64_t)run->samples * (block + 1u) / PILOT_BLOCKS);
+        pilot_sums *sums = &run->block_sums[(size_t)block * PILOT_CANDIDATES * run->meshes];
+        /* The same pixel samples for every candidate. */
+        for (int k = 0; k < run->candidate_count; ++k) {
+            int candidate = run->candidates[k];
+            for (uint32_t i = first; i < end; ++i) {
+                if (dwvb_bake_must_stop(bake)) {
+                    atomic_store(&run->stopped, 1);
+                    return NULL;
+                }
+                uint32_t index = (uint32_t)(dwvk_rng_u64(dwvk_rng_key(bake->options.seed, PILOT_STREAM, i), 0u) % pixels);
+                if (!dwvb_bake_pixel_active(bake, index)) continue;
+                double rgb[3], alpha;
+                uint32_t mesh;
+                dwvb_tally tally = {0};
+                dwvb_bake_sample(bake, &run->shaders[candidate], PILOT_STREAM, index, i, rgb, &alpha, &mesh, &tally);
+                if (mesh == UINT32_MAX || !bake->auto_choice[mesh]) continue;
+                pilot_sums *p = &sums[(size_t)candidate * run->meshes + mesh];
+                p->count += 1.0;
+                for (int c = 0; c < 3; ++c) {
+                    p->sum[c] += rgb[c];
+                    p->sum_squares[c] += rgb[c] * rgb[c];
+                }
+                double event_cost = PILOT_COST_EVENT + (candidate % PILOT_TECHNIQUES == PILOT_CLASSICAL ? 0.0 : PILOT_COST_GUIDED_EVENT);
+                p->cost += PILOT_COST_SAMPLE + PILOT_COST_WALK * (double)tally.walks + event_cost * (double)tally.events +
+                           PILOT_COST_RAY * (double)tally.rays +
+                           PILOT_COST_QUERY * (double)tally.point_queries + PILOT_COST_TERM * (double)tally.mixture_terms;
+                for (int c = 0; c < 3; ++c)
+                    p->channel_cost[c] += PILOT_COST_WALK * (double)tally.channel_walks[c] +
+                                          event_cost * (double)tally.channel_events[c] +
+                                          PILOT_COST_TERM * (double)tally.channel_terms[c];
+            }
+        }
+    }
+    return NULL;
+}
+
+/* Runs the pilot on the bake's threads; sums gets [candidate][mesh] totals. 0 done, 1 stopped
+ * (cancel or time), -1 out of memory or no thread. */
+static int run_pilot(dwvb_bake *bake, const dwvb_shader *shaders, const int *candidates, int candidate_count,
+                     uint32_t samples, pilot_sums *sums)
+{
+    uint32_t meshes = bake->scene->mesh_count;
+    size_t per_block = PILOT_CANDIDATES * (size_t)meshes;
+    pilot_run run = {bake, shaders, candidates, candidate_count, calloc(PILOT_BLOCKS * per_block, sizeof(pilot_sums)),
+                     samples, meshes, 0u, 0};
+    if (!run.block_sums) return -1;
+    atomic_init(&run.next_block, 0u);
+    atomic_init(&run.stopped, 0);
+    dwvu_parallel_run(bake->threads < 64u ? bake->threads : 64u, pilot_worker, &run);
+    for (uint32_t block = 0; block < PILOT_BLOCKS; ++block)
+        for (size_t k = 0; k < per_block; ++k) {
+            const pilot_sums *b = &run.block_sums[block * per_block + k];
+            sums[k].count += b->count;
+            for (int c = 0; c < 3; ++c) {
+                sums[k].sum[c] += b->sum[c];
+                sums[k].sum_squares[c] += b->sum_squares[c];
+            }
+            sums[k].cost += b->cost;
+            for (int c = 0; c < 3; ++c) sums[k].channel_cost[c] += b->channel_cost[c];
+        }
+    free(run.block_sums);
+    return atomic_load(&run.stopped) ? 1 : 0;
+}
+
+/* A candidate's variance x cost per sample that saw the mesh; the variance is the three channels'
+ * together, as the image's RMSE over RGB counts it: the luminance would hide the colour noise of
+ * shared walks, whose channels' weights move against each other. With channel walks, also how many
+ * walks each walking channel takes per sample (counts, 1 to DWVB_MAX_CHANNEL_WALKS; else 1): the
+ * optimal allocation of stratified sampling with a cost per stratum (Cochran 1977, Sampling
+ * Techniques, ch. 5: n_c ~ sqrt(v_c / t_c)), searched exactly over the counts, some channel keeping
+ * one walk (below). n walks of a channel divide its variance v_c by n and multiply
+ * its walks' cost t_c by n; the rest of a sample's cost is shared. A channel whose walks are cheap
+ * and noisy gets more of them: the back-lit slab's red, 1.3 mean free paths thick, against its
+ * blue, 5 (docs/speed.md). Fewer than one walk per sample would cost the channel's squared mean
+ * on top of its variance, more than it saves. */
+static double candidate_work(const pilot_sums *p, const dwvb_material *material, int channel_walks, uint8_t counts[3])
+{
+    double variance[3], walk_cost[3], shared_cost = p->cost / p->count;
+    for (int c = 0; c < 3; ++c) {
+        double mean = p->sum[c] / p->count;
+        variance[c] = fmax(p->sum_squares[c] / p->count - mean * mean, 0.0) * p->count / (p->count - 1.0);
+        walk_cost[c] = p->channel_cost[c] / p->count;
+        shared_cost -= walk_cost[c];
+        counts[c] = 1u;
+    }
+    double best = INFINITY;
+    uint32_t most = channel_walks ? DWVB_MAX_CHANNEL_WALKS : 1u;
+    for (uint32_t n0 = 1; n0 <= most; ++n0)
+        for (uint32_t n1 = 1; n1 <= most; ++n1)
+            for (uint32_t n2 = 1; n2 <= most; ++n2) {
+                uint32_t n[3] = {n0, n1, n2};
+                double v = 0.0, t = shared_cost;
+                int useless = 0;
+                uint32_t fewest = UINT32_MAX; /* of the walking channels' counts */
+                for (int c = 0; c < 3; ++c) {
+                    int walks = material->walk_scale[c] > 0.0;
+                    useless |= n[c] > 1u && !walks; /* no walk to repeat */
+                    if (walks && n[c] < fewest) fewest = n[c];
+                    v += variance[c] / n[c];
+                    t += walk_cost[c] * n[c];
+                }
+                /* Some channel keeps one walk: more walks for every channel would only spread the
+                 * sample's shared cost, a gain the counted cost model cannot tell from its error
+                 * (measured: the leaf's 2 to 3 walks per channel cost 4.4x the instructions for
+                 * 4.3x less variance, where the model promised 1.4x). */
+                if (useless || (fewest != UINT32_MAX && fewest > 1u) || !(v * t < best)) continue; /* a tie keeps the fewer walks */
+                best = v * t;
+                for (int c = 0; c < 3; ++c) counts[c] = (uint8_t)n[c];
+            }
+    return best;
+}
+
+int dwvb_pilot_choose(dwvb_bake *bake)
+{
+    const dwvb_scene *scene = bake->scene;
+    uint32_t meshes = scene->mesh_count, deciding = 0;
+    int separable = 0, lit = 0;
+    for (uint32_t m = 0; m < meshes; ++m) {
+        deciding += (uint32_t)bake->auto_choice[m];
+        separable |= bake->auto_choice[m] && !scene->shading[scene->meshes[m].material_id].grey;
+        lit |= bake->auto_choice[m] && scene->patch_count[m] > 0;
+    }
+    if (deciding == 0) return 0;
+    uint64_t budget = active_pixels(bake) * bake->options.samples / 16u;
+    if (budget < PILOT_MIN) return 0;
+    uint32_t n = budget < PILOT_MAX ? (uint32_t)budget : PILOT_MAX;
+    /* Which forms run: the option's, or both where some deciding mesh has channels that differ. */
+    int candidates[PILOT_CANDIDATES], candidate_count = 0;
+    int shared = bake->options.channel_walks != DWV_CHANNEL_WALKS_SEPARATE || !separable;
+    int separate = separable && bake->options.channel_walks != DWV_CHANNEL_WALKS_SHARED;
+    /* The sheet walks only where some deciding mesh has a lit side to aim at (else they are
+     * classical ones). */
+    for (int c = 0; c < PILOT_CANDIDATES; ++c)
+        if ((c < PILOT_TECHNIQUES ? shared : separate) && (c % PILOT_TECHNIQUES != PILOT_SHEET || lit))
+            candidates[candidate_count++] = c;
+    size_t slots = PILOT_CANDIDATES * (size_t)meshes;
+    dwvw_guide *trial = malloc(slots * sizeof *trial);
+    dwvw_guide *trial_channels = malloc(3u * slots * sizeof *trial_channels);
+    int *trial_closest = malloc(slots * sizeof *trial_closest);
+    int *trial_walks = malloc(slots * sizeof *trial_walks);
+    pilot_sums *sums = calloc(slots, sizeof *sums); /* [candidate][mesh] */
+    int stopped = -1;
+    if (!trial || !trial_channels || !trial_closest || !trial_walks || !sums) goto done;
+    dwvb_shader shaders[PILOT_CANDIDATES];
+    for (int k = 0; k < candidate_count; ++k) {
+        int candidate = candidates[k];
+        size_t base = (size_t)candidate * meshes;
+        for (uint32_t m = 0; m < meshes; ++m) {
+            const dwvb_material *material = &scene->shading[scene->meshes[m].material_id];
+            if (bake->auto_choice[m]) {
+                pilot_candidate(bake, m, candidate, &trial[base + m], &trial_channels[3u * (base + m)],
+                                &trial_walks[base + m]);
+            } else {
+                trial[base + m] = bake->guides[m];
+                for (int c = 0; c < 3; ++c) trial_channels[3u * (base + m) + (size_t)c] = bake->channel_guides[3u * m + (uint32_t)c];
+                trial_walks[base + m] = bake->channel_walks[m];
+            }
+            trial_closest[base + m] = material->subsurface &&
+                                      dwvb_mesh_needs_closest(material, trial_walks[base + m], &trial[base + m],
+                                                              &trial_channels[3u * (base + m)]);
+        }
+        shaders[candidate] = bake->shader;
+        shaders[candidate].guides = &trial[base];
+        shaders[candidate].channel_guides = &trial_channels[3u * base];
+        shaders[candidate].channel_walks = &trial_walks[base];
+        shaders[candidate].needs_closest = &trial_closest[base];
+    }
+    stopped = run_pilot(bake, shaders, candidates, candidate_count, n, sums);
+    if (stopped == 0) {
+        for (uint32_t m = 0; m < meshes; ++m) {
+            /* Every candidate traced the same camera rays, so each saw the mesh equally often. */
+            if (!bake->auto_choice[m] || sums[(size_t)candidates[0] * meshes + m].count < PILOT_MESH_MIN) continue;
+            /* variance x cost, per sample that saw the mesh; the variance is the three channels'
+             * together, as the image's RMSE over RGB counts it: the luminance would hide the
+             * colour noise of shared walks, whose channels' weights move against each other. */
+            const dwvb_material *material = &scene->shading[scene->meshes[m].material_id];
+            int best = candidates[0];
+            double best_work = INFINITY;
+            uint8_t best_counts[3] = {1u, 1u, 1u};
+            for (int k = 0; k < candidate_count; ++k) {
+                const pilot_sums *p = &sums[(size_t)candidates[k] * meshes + m];
+                uint8_t counts[3];
+                double work = candidate_work(p, material, trial_walks[(size_t)candidates[k] * meshes + m], counts);
+                if (work < best_work) {
+                    best_work = work;
+                    best = candidates[k];
+                    for (int c = 0; c < 3; ++c) best_counts[c] = counts[c];
+                }
+            }
+            for (int c = 0; c < 3; ++c) bake->channel_counts[3u * m + (uint32_t)c] = best_counts[c];
+            size_t slot = (size_t)best * meshes + m;
+            bake->guides[m] = trial[slot];
+            for (int c = 0; c < 3; ++c) bake->channel_guides[3u * m + (uint32_t)c] = trial_channels[3u * slot + (size_t)c];
+            bake->channel_walks[m] = trial_walks[slot];
+            bake->needs_closest[m] = trial_closest[slot];
+        }
+        dwvb_bake_update_features(bake);
+    }
+done:
+    free(trial);
+    free(trial_channels);
+    free(trial_closest);
+    free(trial_walks);
+    free(sums);
+    return stopped;
+}

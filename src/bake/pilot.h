@@ -1,0 +1,13 @@
+/* Auto's pilot: before a bake's first pass, shades the same pixel samples with each candidate
+ * technique and keeps, per mesh that auto decides, the one with the largest efficiency (pilot.c
+ * says which candidates, and how their cost is counted). */
+#ifndef DWV_BAKE_PILOT_H
+#define DWV_BAKE_PILOT_H
+
+#include "bake/bake_internal.h"
+
+/* Runs the pilot and narrows bake->guides; 0 done (or nothing to decide), 1 cancelled or out of
+ * time, -1 out of memory. */
+int dwvb_pilot_choose(dwvb_bake *bake);
+
+#endif

@@ -1,0 +1,110 @@
+/* The scene file's bake settings, checked against the ranges of dwv_bake_options_t. */
+#include "scenefile/scene_json_internal.h"
+
+#include <string.h>
+
+#include "util/error.h"
+
+/* The ranges of dwv_bake_options_t as capi/dwivedi.h states them: checked here because the bake
+ * only checks them when it starts, and a file should fail where the value is written. */
+#define MAX_SIDE 16384u
+#define MAX_PIXELS (1u << 26)
+#define MAX_SAMPLES (1u << 24)
+#define MAX_THREADS 1024u
+#define MAX_MARGIN 64u
+
+static dwv_result_t read_seed(const cJSON *item, uint64_t *seed)
+{
+    static const char path[] = "bake.seed";
+    if (cJSON_IsString(item)) { /* all 64 bits, which a JSON number (a double) cannot carry */
+        const char *s = item->valuestring;
+        uint64_t v = 0;
+        if (!s[0]) return dwvs_fail_at(DWV_ERROR_FORMAT, path, "the string is empty");
+        for (; *s; ++s) {
+            char name[SHOWN_SIZE];
+            if (*s < '0' || *s > '9')
+                return dwvs_fail_at(DWV_ERROR_FORMAT, path, "'%s' is not a decimal number",
+                                    dwvs_shown(item->valuestring, name));
+            unsigned d = (unsigned)(*s - '0');
+            if (v > (UINT64_MAX - d) / 10u)
+                return dwvs_fail_at(DWV_ERROR_OUT_OF_RANGE, path, "'%s' is larger than 2^64 - 1",
+                                    dwvs_shown(item->valuestring, name));
+            v = 10u * v + d;
+        }
+        *seed = v;
+        return DWV_SUCCESS;
+    }
+    return dwvs_read_integer(item, path, 0.0, 9007199254740992.0, seed);
+}
+
+dwv_result_t dwvs_read_bake(dwvs_parser *ps, const cJSON *item)
+{
+    static const char *const keys[] = {"target",  "width",       "height",  "samples",   "technique",
+                                       "channel_walks", "time_limit", "target_error", "seed", "threads",
+                                       "max_events", "tile_size", "uv_mesh",     "uv_margin"};
+    static const char *const targets[] = {"camera", "uv"};
+    DWV_TRY(dwvs_check_keys(item, "bake", keys, sizeof keys / sizeof keys[0]));
+    dwv_bake_options_t *o = &ps->options;
+    const cJSON *target = dwvs_member(item, "target");
+    if (target) {
+        size_t t = 0;
+        DWV_TRY(dwvs_read_choice(target, "bake.target", targets, 2, &t));
+        o->target = t == 0 ? DWV_BAKE_CAMERA : DWV_BAKE_UV;
+    }
+    DWV_TRY(dwvs_opt_u32(item, "bake", "width", 1u, MAX_SIDE, &o->width));
+    DWV_TRY(dwvs_opt_u32(item, "bake", "height", 1u, MAX_SIDE, &o->height));
+    if ((uint64_t)o->width * o->height > MAX_PIXELS)
+        return dwvs_fail_at(DWV_ERROR_OUT_OF_RANGE, "bake", "%u x %u is more than %u pixels", o->width, o->height,
+                            MAX_PIXELS);
+    const cJSON *samples = dwvs_member(item, "samples");
+    if (samples) DWV_TRY(dwvs_read_integer(samples, "bake.samples", 1.0, (double)MAX_SAMPLES, &o->samples));
+    const cJSON *technique = dwvs_member(item, "technique");
+    if (technique) {
+        const char *name = NULL;
+        DWV_TRY(dwvs_read_string(technique, "bake.technique", &name));
+        dwv_result_t r = dwv_technique_from_name(name, &o->technique);
+        if (r != DWV_SUCCESS) return dwvs_prefix_capi(r, "bake.technique");
+    }
+    const cJSON *channel_walks = dwvs_member(item, "channel_walks");
+    if (channel_walks) {
+        const char *name = NULL;
+        DWV_TRY(dwvs_read_string(channel_walks, "bake.channel_walks", &name));
+        dwv_result_t r = dwv_channel_walks_from_name(name, &o->channel_walks);
+        if (r != DWV_SUCCESS) return dwvs_prefix_capi(r, "bake.channel_walks");
+    }
+    DWV_TRY(dwvs_opt_number(item, "bake", "time_limit", &o->time_limit));
+    if (o->time_limit < 0.0)
+        return dwvs_fail_at(DWV_ERROR_OUT_OF_RANGE, "bake.time_limit", "%.17g is negative (0 means no limit)",
+                            o->time_limit);
+    DWV_TRY(dwvs_opt_number(item, "bake", "target_error", &o->target_error));
+    if (o->target_error < 0.0)
+        return dwvs_fail_at(DWV_ERROR_OUT_OF_RANGE, "bake.target_error", "%.17g is negative (0 means none)",
+                            o->target_error);
+    const cJSON *seed = dwvs_member(item, "seed");
+    if (seed) DWV_TRY(read_seed(seed, &o->seed));
+    DWV_TRY(dwvs_opt_u32(item, "bake", "threads", 0u, MAX_THREADS, &o->threads));
+    DWV_TRY(dwvs_opt_u32(item, "bake", "max_events", 0u, UINT32_MAX, &o->max_events));
+    DWV_TRY(dwvs_opt_u32(item, "bake", "tile_size", 0u, MAX_SIDE, &o->tile_size));
+
+    const cJSON *uv_mesh = dwvs_member(item, "uv_mesh"), *uv_margin = dwvs_member(item, "uv_margin");
+    if (o->target != DWV_BAKE_UV) {
+        if (uv_mesh || uv_margin)
+            return dwvs_fail_at(DWV_ERROR_FORMAT, "bake", "'uv_mesh' and 'uv_margin' need \"target\": \"uv\"");
+        if (!ps->has_camera) return dwvs_fail_at(DWV_ERROR_FORMAT, "bake", "a camera bake needs a 'camera'");
+        return DWV_SUCCESS;
+    }
+    DWV_TRY(dwvs_opt_u32(item, "bake", "uv_margin", 0u, MAX_MARGIN, &o->uv_margin));
+    if (!uv_mesh) return dwvs_fail_at(DWV_ERROR_FORMAT, "bake", "a UV bake needs 'uv_mesh' (a mesh's name)");
+    const char *name = NULL;
+    char shown_name[SHOWN_SIZE];
+    DWV_TRY(dwvs_read_string(uv_mesh, "bake.uv_mesh", &name));
+    for (size_t i = 0; i < ps->mesh_count; ++i)
+        if (ps->meshes[i].name && strcmp(ps->meshes[i].name, name) == 0) {
+            if (!ps->meshes[i].has_uvs)
+                return dwvs_fail_at(DWV_ERROR_INVALID_ARGUMENT, "bake.uv_mesh", "the mesh '%s' has no UVs",
+                                    dwvs_shown(name, shown_name));
+            o->uv_mesh = ps->meshes[i].id;
+            return DWV_SUCCESS;
+        }
+    return dwvs_fail_at(DWV_ERROR_UNKNOWN_NAME, "bake.uv_mesh", "no mesh is named '%s'", dwvs_shown(name, shown_name));
+}

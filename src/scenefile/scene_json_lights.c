@@ -1,0 +1,102 @@
+/* The scene file's lights, world and camera. */
+#include "scenefile/scene_json_internal.h"
+
+#include "util/error.h"
+
+static dwv_result_t read_light(dwvs_parser *ps, const cJSON *item, const char *path)
+{
+    static const char *const kinds[] = {"sun", "point", "area"};
+    static const char *const shapes[] = {"rectangle", "disk"};
+    static const char *const sun_keys[] = {"kind", "color", "strength", "direction", "angle"};
+    static const char *const point_keys[] = {"kind", "color", "strength", "position", "radius"};
+    static const char *const area_keys[] = {"kind", "shape", "color", "strength", "transform", "size_x", "size_y"};
+    if (!cJSON_IsObject(item))
+        return dwvs_fail_at(DWV_ERROR_FORMAT, path, "expected an object, found %s", dwvs_type_name(item));
+    const cJSON *kind_item = dwvs_member(item, "kind");
+    if (!kind_item) return dwvs_fail_at(DWV_ERROR_FORMAT, path, "missing key 'kind' ('sun', 'point' or 'area')");
+    char p[PATH_SIZE];
+    size_t kind = 0;
+    dwvs_path_key(p, path, "kind");
+    DWV_TRY(dwvs_read_choice(kind_item, p, kinds, 3, &kind));
+    if (kind == 0)
+        DWV_TRY(dwvs_check_keys(item, path, sun_keys, sizeof sun_keys / sizeof sun_keys[0]));
+    else if (kind == 1)
+        DWV_TRY(dwvs_check_keys(item, path, point_keys, sizeof point_keys / sizeof point_keys[0]));
+    else
+        DWV_TRY(dwvs_check_keys(item, path, area_keys, sizeof area_keys / sizeof area_keys[0]));
+    dwv_light_desc_t light = DWV_LIGHT_DESC_INIT;
+    DWV_TRY(dwvs_opt_vector(item, path, "color", 3, light.color));
+    DWV_TRY(dwvs_opt_number(item, path, "strength", &light.strength));
+    if (kind == 0) {
+        light.kind = DWV_LIGHT_SUN;
+        DWV_TRY(dwvs_opt_vector(item, path, "direction", 3, light.direction));
+        double degrees = 0.0;
+        DWV_TRY(dwvs_opt_number(item, path, "angle", &degrees));
+        light.angle = degrees * (3.14159265358979323846 / 180.0);
+    } else if (kind == 1) {
+        light.kind = DWV_LIGHT_POINT;
+        DWV_TRY(dwvs_opt_vector(item, path, "position", 3, light.position));
+        DWV_TRY(dwvs_opt_number(item, path, "radius", &light.radius));
+    } else {
+        size_t shape = 0;
+        DWV_TRY(dwvs_opt_choice(item, path, "shape", shapes, 2, &shape));
+        light.kind = shape == 0 ? DWV_LIGHT_AREA_RECTANGLE : DWV_LIGHT_AREA_DISK;
+        DWV_TRY(dwvs_opt_transform(item, path, light.transform));
+        DWV_TRY(dwvs_opt_number(item, path, "size_x", &light.size_x));
+        light.size_y = light.size_x; /* a square or a circle unless size_y says otherwise */
+        DWV_TRY(dwvs_opt_number(item, path, "size_y", &light.size_y));
+    }
+    dwv_result_t r = dwv_scene_add_light(ps->scene, &light);
+    return r == DWV_SUCCESS ? r : dwvs_prefix_capi(r, path);
+}
+
+dwv_result_t dwvs_read_lights(dwvs_parser *ps, const cJSON *item)
+{
+    if (!cJSON_IsArray(item))
+        return dwvs_fail_at(DWV_ERROR_FORMAT, "lights", "expected an array of lights, found %s", dwvs_type_name(item));
+    size_t i = 0;
+    for (const cJSON *c = item->child; c; c = c->next, ++i) {
+        char p[PATH_SIZE];
+        dwvs_path_index(p, "lights", i);
+        DWV_TRY(read_light(ps, c, p));
+    }
+    return DWV_SUCCESS;
+}
+
+dwv_result_t dwvs_read_world(dwvs_parser *ps, const cJSON *item)
+{
+    static const char *const keys[] = {"color", "strength"};
+    DWV_TRY(dwvs_check_keys(item, "world", keys, 2));
+    double color[3] = {1.0, 1.0, 1.0}, strength = 1.0;
+    DWV_TRY(dwvs_opt_vector(item, "world", "color", 3, color));
+    DWV_TRY(dwvs_opt_number(item, "world", "strength", &strength));
+    dwv_result_t r = dwv_scene_set_world(ps->scene, color, strength);
+    return r == DWV_SUCCESS ? r : dwvs_prefix_capi(r, "world");
+}
+
+dwv_result_t dwvs_read_camera(dwvs_parser *ps, const cJSON *item)
+{
+    static const char *const kinds[] = {"perspective", "orthographic"};
+    static const char *const perspective_keys[] = {"kind", "transform", "focal_length", "sensor_width"};
+    static const char *const orthographic_keys[] = {"kind", "transform", "ortho_scale"};
+    if (!cJSON_IsObject(item))
+        return dwvs_fail_at(DWV_ERROR_FORMAT, "camera", "expected an object, found %s", dwvs_type_name(item));
+    size_t kind = 0;
+    DWV_TRY(dwvs_opt_choice(item, "camera", "kind", kinds, 2, &kind));
+    if (kind == 0)
+        DWV_TRY(dwvs_check_keys(item, "camera", perspective_keys, sizeof perspective_keys / sizeof perspective_keys[0]));
+    else
+        DWV_TRY(dwvs_check_keys(item, "camera", orthographic_keys, sizeof orthographic_keys / sizeof orthographic_keys[0]));
+    if (!dwvs_member(item, "transform"))
+        return dwvs_fail_at(DWV_ERROR_FORMAT, "camera", "missing key 'transform' (a 'matrix' or a 'look_at')");
+    dwv_camera_t camera = DWV_CAMERA_INIT;
+    camera.kind = kind == 0 ? DWV_CAMERA_PERSPECTIVE : DWV_CAMERA_ORTHOGRAPHIC;
+    DWV_TRY(dwvs_opt_transform(item, "camera", camera.transform));
+    DWV_TRY(dwvs_opt_number(item, "camera", "focal_length", &camera.focal_length));
+    DWV_TRY(dwvs_opt_number(item, "camera", "sensor_width", &camera.sensor_width));
+    DWV_TRY(dwvs_opt_number(item, "camera", "ortho_scale", &camera.ortho_scale));
+    dwv_result_t r = dwv_scene_set_camera(ps->scene, &camera);
+    if (r != DWV_SUCCESS) return dwvs_prefix_capi(r, "camera");
+    ps->has_camera = 1;
+    return DWV_SUCCESS;
+}

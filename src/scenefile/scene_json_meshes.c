@@ -1,0 +1,221 @@
+/* The scene file's meshes: OBJ or PLY files or inline arrays, transforms, unique names. */
+#include "scenefile/scene_json_internal.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "scenefile/mesh_file.h"
+#include "util/error.h"
+
+#define MAX_FILE_PATH 4096
+
+static const double identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+
+/* An array of numbers whose length is a multiple of `group`, as floats. */
+static dwv_result_t read_floats(const cJSON *item, const char *path, size_t group, size_t *count, float **out)
+{
+    if (!cJSON_IsArray(item))
+        return dwvs_fail_at(DWV_ERROR_FORMAT, path, "expected an array of numbers, found %s", dwvs_type_name(item));
+    size_t n = 0;
+    for (const cJSON *e = item->child; e; e = e->next) ++n;
+    if (n == 0 || n % group)
+        return dwvs_fail_at(DWV_ERROR_FORMAT, path, "%zu numbers: expected a non-zero multiple of %zu", n, group);
+    float *values = malloc(n * sizeof *values);
+    if (!values) return dwvs_fail_at(DWV_ERROR_OUT_OF_MEMORY, path, "no memory for %zu numbers", n);
+    size_t i = 0;
+    for (const cJSON *e = item->child; e; e = e->next, ++i) {
+        char p[PATH_SIZE];
+        double v = 0.0;
+        dwvs_path_index(p, path, i);
+        dwv_result_t r = dwvs_read_number(e, p, &v);
+        if (r == DWV_SUCCESS && fabs(v) > FLT_MAX)
+            r = dwvs_fail_at(DWV_ERROR_OUT_OF_RANGE, p, "%.17g does not fit a float", v);
+        if (r != DWV_SUCCESS) {
+            free(values);
+            return r;
+        }
+        values[i] = (float)v;
+    }
+    *count = n;
+    *out = values;
+    return DWV_SUCCESS;
+}
+
+static dwv_result_t read_indices(const cJSON *item, const char *path, size_t *count, uint32_t **out)
+{
+    if (!cJSON_IsArray(item))
+        return dwvs_fail_at(DWV_ERROR_FORMAT, path, "expected an array of whole numbers, found %s", dwvs_type_name(item));
+    size_t n = 0;
+    for (const cJSON *e = item->child; e; e = e->next) ++n;
+    if (n == 0 || n % 3u)
+        return dwvs_fail_at(DWV_ERROR_FORMAT, path, "%zu indices: expected a non-zero multiple of 3 (triangles)", n);
+    uint32_t *values = malloc(n * sizeof *values);
+    if (!values) return dwvs_fail_at(DWV_ERROR_OUT_OF_MEMORY, path, "no memory for %zu indices", n);
+    size_t i = 0;
+    for (const cJSON *e = item->child; e; e = e->next, ++i) {
+        char p[PATH_SIZE];
+        dwvs_path_index(p, path, i);
+        dwv_result_t r = dwvs_read_u32(e, p, 0u, UINT32_MAX, &values[i]);
+        if (r != DWV_SUCCESS) {
+            free(values);
+            return r;
+        }
+    }
+    *count = n;
+    *out = values;
+    return DWV_SUCCESS;
+}
+
+static dwv_result_t resolve_path(const char *base_dir, const char *file, const char *path, char out[MAX_FILE_PATH])
+{
+    int n;
+    if (file[0] == '/' || !base_dir || !base_dir[0])
+        n = snprintf(out, MAX_FILE_PATH, "%s", file);
+    else
+        n = snprintf(out, MAX_FILE_PATH, "%s/%s", base_dir, file);
+    if (n < 0 || n >= MAX_FILE_PATH)
+        return dwvs_fail_at(DWV_ERROR_OUT_OF_RANGE, path, "the path is longer than %d bytes", MAX_FILE_PATH - 1);
+    return DWV_SUCCESS;
+}
+
+static dwv_result_t read_mesh(dwvs_parser *ps, const cJSON *item, const char *path, dwvs_named *record)
+{
+    static const char *const keys[] = {"name",    "material", "transform", "file", "positions",
+                                       "indices", "normals",  "uvs",       "shadow_terminator_geometry_offset"};
+    DWV_TRY(dwvs_check_keys(item, path, keys, sizeof keys / sizeof keys[0]));
+    char p[PATH_SIZE], name[SHOWN_SIZE];
+    const cJSON *name_item = dwvs_member(item, "name");
+    record->name = NULL;
+    if (name_item) {
+        dwvs_path_key(p, path, "name");
+        DWV_TRY(dwvs_read_string(name_item, p, &record->name));
+    }
+
+    const cJSON *material_item = dwvs_member(item, "material");
+    if (!material_item) return dwvs_fail_at(DWV_ERROR_FORMAT, path, "missing key 'material'");
+    const char *material_name = NULL;
+    dwvs_path_key(p, path, "material");
+    DWV_TRY(dwvs_read_string(material_item, p, &material_name));
+    dwvs_named key = {material_name, 0u, 0u};
+    const dwvs_named *material = ps->material_count
+                                ? bsearch(&key, ps->materials, ps->material_count, sizeof key, dwvs_compare_named)
+                                : NULL;
+    if (!material) return dwvs_fail_at(DWV_ERROR_UNKNOWN_NAME, p, "unknown material '%s'", dwvs_shown(material_name, name));
+
+    dwv_mesh_t mesh = DWV_MESH_INIT;
+    mesh.material_id = material->id;
+    memcpy(mesh.transform, identity, sizeof identity);
+    DWV_TRY(dwvs_opt_transform(item, path, mesh.transform));
+    DWV_TRY(dwvs_opt_number(item, path, "shadow_terminator_geometry_offset", &mesh.shadow_terminator_geometry_offset));
+
+    const cJSON *file = dwvs_member(item, "file");
+    int inline_data = dwvs_member(item, "positions") || dwvs_member(item, "indices") || dwvs_member(item, "normals") ||
+                      dwvs_member(item, "uvs");
+    if (file && inline_data)
+        return dwvs_fail_at(DWV_ERROR_FORMAT, path, "give either 'file' or 'positions'/'indices'/'normals'/'uvs'");
+    if (!file && !(dwvs_member(item, "positions") && dwvs_member(item, "indices")))
+        return dwvs_fail_at(DWV_ERROR_FORMAT, path, "needs 'file', or 'positions' and 'indices'");
+
+    dwv_result_t r;
+    uint32_t mesh_id = 0;
+    if (file) {
+        const char *file_name = NULL;
+        char resolved[MAX_FILE_PATH];
+        dwvs_path_key(p, path, "file");
+        DWV_TRY(dwvs_read_string(file, p, &file_name));
+        DWV_TRY(resolve_path(ps->base_dir, file_name, p, resolved));
+        dwvs_mesh_data data;
+        r = dwvs_mesh_file_read(resolved, &data);
+        if (r != DWV_SUCCESS) return dwvs_prefix_capi(r, p);
+        mesh.vertex_count = data.vertex_count;
+        mesh.triangle_count = data.triangle_count;
+        mesh.positions = data.positions;
+        mesh.indices = data.indices;
+        mesh.normals = data.normals;
+        mesh.uvs = data.uvs;
+        r = dwv_scene_add_mesh(ps->scene, &mesh, &mesh_id);
+        if (r != DWV_SUCCESS) {
+            char where[PATH_SIZE + MAX_FILE_PATH / 16];
+            snprintf(where, sizeof where, "%s ('%s')", path, dwvs_shown(file_name, name));
+            r = dwvs_prefix_capi(r, where);
+        }
+        record->has_uvs = data.uvs != NULL;
+        dwvs_mesh_data_free(&data);
+    } else {
+        float *positions = NULL, *normals = NULL, *uvs = NULL;
+        uint32_t *indices = NULL;
+        size_t np = 0, ni = 0, nn = 0, nu = 0;
+        dwvs_path_key(p, path, "positions");
+        r = read_floats(dwvs_member(item, "positions"), p, 3, &np, &positions);
+        if (r == DWV_SUCCESS) {
+            dwvs_path_key(p, path, "indices");
+            r = read_indices(dwvs_member(item, "indices"), p, &ni, &indices);
+        }
+        if (r == DWV_SUCCESS && dwvs_member(item, "normals")) {
+            dwvs_path_key(p, path, "normals");
+            r = read_floats(dwvs_member(item, "normals"), p, 3, &nn, &normals);
+            if (r == DWV_SUCCESS && nn != np)
+                r = dwvs_fail_at(DWV_ERROR_FORMAT, p, "%zu numbers for %zu positions: one normal per vertex", nn,
+                                 np / 3u);
+        }
+        if (r == DWV_SUCCESS && dwvs_member(item, "uvs")) {
+            dwvs_path_key(p, path, "uvs");
+            r = read_floats(dwvs_member(item, "uvs"), p, 2, &nu, &uvs);
+            if (r == DWV_SUCCESS && nu != 2u * ni)
+                r = dwvs_fail_at(DWV_ERROR_FORMAT, p, "%zu numbers for %zu triangles: one (u, v) per triangle corner",
+                                 nu, ni / 3u);
+        }
+        if (r == DWV_SUCCESS) {
+            mesh.vertex_count = (uint32_t)(np / 3u);
+            mesh.triangle_count = (uint32_t)(ni / 3u);
+            mesh.positions = positions;
+            mesh.indices = indices;
+            mesh.normals = normals;
+            mesh.uvs = uvs;
+            r = dwv_scene_add_mesh(ps->scene, &mesh, &mesh_id);
+            if (r != DWV_SUCCESS) r = dwvs_prefix_capi(r, path);
+        }
+        record->has_uvs = uvs != NULL;
+        free(positions);
+        free(indices);
+        free(normals);
+        free(uvs);
+    }
+    record->id = mesh_id;
+    return r;
+}
+
+dwv_result_t dwvs_read_meshes(dwvs_parser *ps, const cJSON *item)
+{
+    if (!cJSON_IsArray(item))
+        return dwvs_fail_at(DWV_ERROR_FORMAT, "meshes", "expected an array of meshes, found %s", dwvs_type_name(item));
+    size_t n = 0;
+    for (const cJSON *c = item->child; c; c = c->next) ++n;
+    ps->meshes = calloc(n ? n : 1u, sizeof *ps->meshes);
+    if (!ps->meshes) return dwvs_fail_at(DWV_ERROR_OUT_OF_MEMORY, "meshes", "no memory for %zu meshes", n);
+    size_t i = 0;
+    for (const cJSON *c = item->child; c; c = c->next, ++i) {
+        char p[PATH_SIZE];
+        dwvs_path_index(p, "meshes", i);
+        DWV_TRY(read_mesh(ps, c, p, &ps->meshes[i]));
+        ps->mesh_count = i + 1;
+    }
+    /* Names must be unique (a UV bake picks a mesh by name). */
+    dwvs_named *sorted = malloc((n ? n : 1u) * sizeof *sorted);
+    if (!sorted) return dwvs_fail_at(DWV_ERROR_OUT_OF_MEMORY, "meshes", "no memory for %zu names", n);
+    size_t k = 0;
+    for (size_t j = 0; j < ps->mesh_count; ++j)
+        if (ps->meshes[j].name) sorted[k++] = ps->meshes[j];
+    qsort(sorted, k, sizeof *sorted, dwvs_compare_named);
+    dwv_result_t r = DWV_SUCCESS;
+    for (size_t j = 1; j < k && r == DWV_SUCCESS; ++j)
+        if (strcmp(sorted[j - 1].name, sorted[j].name) == 0) {
+            char name[SHOWN_SIZE];
+            r = dwvs_fail_at(DWV_ERROR_FORMAT, "meshes", "the name '%s' is given to two meshes", dwvs_shown(sorted[j].name, name));
+        }
+    free(sorted);
+    return r;
+}

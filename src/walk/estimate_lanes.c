@@ -1,0 +1,525 @@
+/* The estimator's guided and mixture walkers in lock-step lanes: the walks of guided_walk_in and
+ * mixture_walk_in (estimate_fast.c), eight at a time. Their step pieces are step.h's and
+ * estimate_walkers.h's, as there; what is written out here is the lanes' form of a step (a loop
+ * over the lanes per stage, selects for branches). */
+#include <math.h>
+#include <stdatomic.h>
+
+#include "estimate_walkers.h"
+#include "geometry.h"
+#include "step.h"
+
+/* ---- lock-step: several walks advanced together ---------------------------------------------
+ * One event of guided_walk_in is a long chain of dependent operations (hash, expm1, square root,
+ * direction, stretch, log, two divisions): a core that runs one walk waits on it. DWVW_LANES walks
+ * in lanes (structure of arrays) take their events together, one loop over the lanes per stage,
+ * so that the lanes' chains interleave (and a compiler may vectorise a stage). Each lane does
+ * exactly what guided_walk_in (or mixture_walk_in, for the mixture walker in an isotropic medium)
+ * does for its walk, with the same random numbers (the walk's key and dimensions), the same
+ * kernels and the same double arithmetic in the same order, so each walk ends as it does there,
+ * weight for weight to the last bit (tests/internal/test_walk_fast_path.c compares them walk by
+ * walk). What changes is only which walks run at the same time: the branches that end a walk
+ * (exit, Russian roulette, event cap) are taken for a lane after the step, and a lane whose walk
+ * ended takes the next walk of its thread's blocks. Results are added to their block in walk
+ * order (lane_feed), so the totals equal the one-walk-at-a-time path's. */
+
+/* The lanes' state. p: position; d: the direction of the step being taken (for a lane at
+ * events = 0, its entry direction). log_constants and exponent as in guided_walk_in, weight as in
+ * mixture_walk_in. */
+typedef struct lane_state {
+    double px[DWVW_LANES], py[DWVW_LANES], pz[DWVW_LANES];
+    double dx[DWVW_LANES], dy[DWVW_LANES], dz[DWVW_LANES];
+    double log_constants[DWVW_LANES], exponent[DWVW_LANES], log_weight[DWVW_LANES], stretch[DWVW_LANES];
+    double first_constant[DWVW_LANES]; /* the first step's log(alpha / s0) */
+    double entry_x[DWVW_LANES], entry_y[DWVW_LANES], entry_z[DWVW_LANES]; /* the entry direction */
+    uint64_t key[DWVW_LANES], counter[DWVW_LANES];
+    uint32_t events[DWVW_LANES];
+    int exited[DWVW_LANES], flagged[DWVW_LANES];
+    double weight[DWVW_LANES];         /* the mixture's throughput (mixture_lanes_step_in) */
+} lane_state;
+
+/* Puts walk `index` into lane l at its entry, as guided_walk_in starts it. */
+static void lane_begin(lane_state *L, int l, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan,
+                       uint64_t index)
+{
+    uint64_t key = dwvk_rng_key(setup->seed, index, 0);
+    dwvu_vec3 direction = dwvw_entry_direction(setup, key);
+    L->key[l] = key;
+    /* The guided walk steps the counter of an event's direction dimension, the mixture that of its
+     * first (channel) dimension. */
+    uint32_t dimension = plan->walker == DWVW_WALKER_MIXTURE ? DWVW_DIM_CHANNEL : DWVW_DIM_DIRECTION;
+    L->counter[l] = dwvk_rng_counter(key, dwvw_event_dim(0) + dimension);
+    L->px[l] = DWVW_ENTRY_POINT.x;
+    L->py[l] = DWVW_ENTRY_POINT.y;
+    L->pz[l] = DWVW_ENTRY_POINT.z;
+    L->dx[l] = L->entry_x[l] = direction.x;
+    L->dy[l] = L->entry_y[l] = direction.y;
+    L->dz[l] = L->entry_z[l] = direction.z;
+    L->events[l] = 0;
+    L->log_constants[l] = L->exponent[l] = L->log_weight[l] = 0.0;
+    L->weight[l] = 1.0;
+    if (plan->first_known) {
+        L->first_constant[l] = plan->log_first;
+    } else {
+        double stretch = dwvk_dwivedi_stretch_d(&setup->medium.dwivedi, dwvw_aligned_cosine(plan, direction));
+        L->first_constant[l] = log(setup->medium.albedo[0] / stretch);
+    }
+}
+
+/* The distance along w from p to a plane face, as dwvw_shape_exit_inline gives it, with every
+ * operation done whatever the sign (a lane's select, not a branch: the division's unused results
+ * are discarded). */
+static inline double lane_halfspace_exit(double pz, double wz)
+{
+    double toward_front = dwvw_front_plane_distance(pz, wz);
+    return wz < 0.0 ? toward_front : INFINITY;
+}
+
+static inline double lane_slab_exit(double thickness, double pz, double wz)
+{
+    double toward_front = dwvw_front_plane_distance(pz, wz), toward_back = dwvw_back_plane_distance(thickness, pz, wz);
+    return wz < 0.0 ? toward_front : wz > 0.0 ? toward_back : INFINITY;
+}
+
+/* One event of every lane (lanes whose walk ended compute on without effect until refilled).
+ * Sets flagged[l] where guided_walk_in would take a branch after the step: the walk exited, its
+ * weight fell below the roulette threshold, or it reached the event cap. Each stage is a loop
+ * over the lanes without branches, for the compiler to vectorise. The plan's frame is the one
+ * about a z axis (make_plan): direction (c, sz d, sz mu) for azimuth (c, d) turned by its quarter
+ * turns (the same products as aligned_guided_direction's turned frame, signs exact). */
+/* Each shape's step gets its own copy of the loops, with its exit test (GCC and Clang otherwise
+ * judge the function too large to inline three times). */
+
+static DWVW_ALWAYS_INLINE int guided_lanes_step_in(lane_state *L, const dwvw_estimate_setup *setup,
+                                                   const dwvw_fast_plan *plan, dwvw_shape_kind kind)
+{
+    const dwvw_medium *m = &setup->medium;
+    const dwvk_dwivedi_event_f *d = &m->dwivedi_event;
+    const double sigma = m->sigma_t[0], log_per_event = plan->log_per_event, thickness = setup->shape.thickness;
+    const uint32_t max_events = setup->max_events;
+    const uint64_t to_distance = DWVW_DIM_COUNTER_OFFSET(DWVW_DIM_DIRECTION, DWVW_DIM_DISTANCE);
+    const double sy = plan->sign[0][1], sz = plan->sign[0][2], axis_sign = plan->axis_sign;
+    const double kappa = m->dwivedi.kappa, one_minus_kappa = m->dwivedi.one_minus_kappa;
+    float ua[DWVW_LANES], ub[DWVW_LANES], udist[DWVW_LANES];
+    float cos_theta[DWVW_LANES], sin_theta[DWVW_LANES], azimuth_c[DWVW_LANES], azimuth_s[DWVW_LANES];
+    for (int l = 0; l < DWVW_LANES; ++l) {
+        dwvk_uniform_pair_f u = dwvw_counter_uniform_pair_f(L->counter[l]);
+        ua[l] = u.a;
+        ub[l] = u.b;
+        udist[l] = dwvw_counter_uniform_f(L->counter[l] + to_distance);
+        L->counter[l] += DWVW_EVENT_COUNTER_STEP;
+    }
+    for (int l = 0; l < DWVW_LANES; ++l) {
+        dwvk_dwivedi_event_cosine_f s = dwvk_dwivedi_event_sample_select_f(d, ua[l]);
+        dwvk_unit2_f azimuth = dwvk_azimuth_f(ub[l]); /* turned by its quarter turns */
+        cos_theta[l] = s.cos_theta;
+        sin_theta[l] = s.sin_theta;
+        azimuth_c[l] = azimuth.c;
+        azimuth_s[l] = azimuth.s;
+    }
+    for (int l = 0; l < DWVW_LANES; ++l) {
+        double wx = (double)azimuth_c[l] * (double)sin_theta[l];
+        double wy = sy * ((double)azimuth_s[l] * (double)sin_theta[l]);
+        double wz = sz * (double)cos_theta[l];
+        double scale = 1.5 - 0.5 * (wx * wx + wy * wy + wz * wz);
+        int fresh = L->events[l] == 0; /* the first step keeps the entry direction */
+        double ex = L->entry_x[l], ey = L->entry_y[l], ez = L->entry_z[l];
+        L->dx[l] = fresh ? ex : wx * scale;
+        L->dy[l] = fresh ? ey : wy * scale;
+        L->dz[l] = fresh ? ez : wz * scale;
+    }
+    int any = 0;
+    for (int l = 0; l < DWVW_LANES; ++l) {
+        double px = L->px[l], py = L->py[l], pz = L->pz[l], wx = L->dx[l], wy = L->dy[l], wz = L->dz[l];
+        double mu = dwvw_clamp_cosine(axis_sign * wz);
+        /* dwvk_dwivedi_stretch_d, its constants loaded before the loop and both sides formed. */
+        double stretch_above = one_minus_kappa + kappa * (1.0 - mu), stretch_below = 1.0 - kappa * mu;
+        double stretch = mu >= 0.0 ? stretch_above : stretch_below;
+        double t = dwvw_flight(sigma * stretch, udist[l]);
+        double hit;
+        if (kind == DWVW_HALFSPACE) hit = lane_halfspace_exit(pz, wz);
+        else if (kind == DWVW_SLAB) hit = lane_slab_exit(thickness, pz, wz);
+        else {
+            dwvu_vec3 normal;
+            hit = dwvw_shape_exit_inline(&setup->shape, kind, dwvu_v(px, py, pz), dwvu_v(wx, wy, wz), &normal);
+        }
+        int exited;
+        double step = dwvw_step_length(hit, t, &exited);
+        double exponent = dwvw_guided_exponent(L->exponent[l], stretch, step);
+        double before = L->log_constants[l], first = L->first_constant[l]; /* loaded unconditionally */
+        double later = before + log_per_event;
+        double log_constants = exited ? before : L->events[l] > 0 ? later : first;
+        uint32_t events = L->events[l] + (uint32_t)!exited;
+        double log_weight = dwvw_guided_log_weight(log_constants, sigma, exponent);
+        /* An exited lane keeps the position the step started from: the exit normal is found again
+         * from it (guided_lane_end). */
+        double flight = exited ? 0.0 : t; /* p + w 0 = p: a store in every lane, no conditional one */
+        L->px[l] = px + wx * flight;
+        L->py[l] = py + wy * flight;
+        L->pz[l] = pz + wz * flight;
+        L->exponent[l] = exponent;
+        L->log_constants[l] = log_constants;
+        L->log_weight[l] = log_weight;
+        L->stretch[l] = stretch;
+        L->events[l] = events;
+        L->exited[l] = exited;
+        int flagged = exited | (log_weight < DWVW_LOG_ROULETTE_THRESHOLD) | (events >= max_events);
+        L->flagged[l] = flagged;
+        any |= flagged;
+    }
+    return any;
+}
+
+/* guided_lanes_step_in for each shape, its exit test written out. */
+static int guided_lanes_step_halfspace(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
+{
+    return guided_lanes_step_in(L, setup, plan, DWVW_HALFSPACE);
+}
+
+static int guided_lanes_step_slab(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
+{
+    return guided_lanes_step_in(L, setup, plan, DWVW_SLAB);
+}
+
+static int guided_lanes_step_sphere(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
+{
+    return guided_lanes_step_in(L, setup, plan, DWVW_SPHERE);
+}
+
+/* The branches of guided_walk_in after a flagged step of lane l: 1 and *end filled if its walk
+ * ended, else 0 (the walk goes on, its weight perhaps raised by the roulette). */
+static int guided_lane_end(lane_state *L, int l, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan,
+                    dwvw_shape_kind kind, dwvw_walk_end *end)
+{
+    double last_factor = 1.0;
+    uint32_t events = L->events[l];
+    end->exit_normal = dwvu_v(0.0, 0.0, 0.0);
+    if (L->exited[l]) {
+        dwvu_vec3 normal;
+        (void)dwvw_shape_exit_inline(&setup->shape, kind, dwvu_v(L->px[l], L->py[l], L->pz[l]),
+                                     dwvu_v(L->dx[l], L->dy[l], L->dz[l]), &normal);
+        last_factor = dwvw_guided_exit_factor(plan, events, L->stretch[l]);
+        end->status = DWVW_EXITED;
+        end->exit_normal = normal;
+    } else {
+        if (L->log_weight[l] < DWVW_LOG_ROULETTE_THRESHOLD) {
+            double log_weight = L->log_weight[l];
+            int fate = dwvw_guided_roulette(L->key[l], events, &log_weight);
+            if (fate == 0) {
+                end->status = DWVW_ABSORBED;
+                goto done;
+            }
+            if (fate == 2) {
+                L->log_weight[l] = log_weight;
+                L->log_constants[l] = dwvw_guided_constants_for(log_weight, setup->medium.sigma_t[0], L->exponent[l]);
+            }
+        }
+        if (events < setup->max_events) return 0;
+        end->status = DWVW_TRUNCATED;
+    }
+done:
+    dwvw_guided_end(end, events, L->log_weight[l], last_factor);
+    return 1;
+}
+
+/* Where the lanes' walks come from and where their ends go: a thread's blocks of a run (walks are
+ * numbered in the order the thread starts them, and a ring of DWVW_LANE_RING ends adds them to
+ * their blocks in that order, so a block's totals are summed in walk order as in worker()), or a
+ * range of walks whose ends are all kept (dwvw_estimate_walks_lanes). */
+#define DWVW_LANE_RING 256u
+typedef struct lane_slot {
+    dwvw_walk_end end;
+    dwvw_block_totals *block;
+} lane_slot;
+
+typedef struct lane_feed {
+    dwvw_estimate_run_state *state;       /* a run's blocks, or NULL for a range */
+    uint64_t next, stop;           /* the next walk index and the end of the current block / range */
+    dwvw_block_totals *block;           /* the current block */
+    uint64_t started, committed;   /* walks started by this thread, and added to their blocks */
+    lane_slot *ring;
+    uint64_t first;                /* a range: its first walk, and where its ends go */
+    dwvw_walk_end *ends;
+    int exhausted;                 /* a run: no block left */
+} lane_feed;
+
+/* Moves a run's feed to the next unclaimed block; 0 when none is left. */
+static int claim_block(lane_feed *feed)
+{
+    dwvw_estimate_run_state *state = feed->state;
+    if (feed->exhausted) return 0;
+    unsigned block = atomic_fetch_add(&state->next_block, 1u);
+    if (block >= state->block_count) {
+        feed->exhausted = 1;
+        return 0;
+    }
+    feed->next = (uint64_t)block * state->block_size;
+    feed->stop = feed->next + state->block_size;
+    if (feed->stop > state->setup->walks) feed->stop = state->setup->walks;
+    feed->block = &state->blocks[block];
+    return 1;
+}
+
+/* The next walk for a lane: its index and sequence number; 0 if there is none (for now: in a run,
+ * the ring may be full until an earlier walk ends). */
+static int feed_next(lane_feed *feed, uint64_t *index, uint64_t *sequence)
+{
+    if (!feed->state) {
+        if (feed->next >= feed->stop) return 0;
+        *sequence = feed->next - feed->first;
+        *index = feed->next++;
+        return 1;
+    }
+    if (feed->started - feed->committed >= DWVW_LANE_RING) return 0;
+    if (feed->next >= feed->stop && !claim_block(feed)) return 0;
+    lane_slot *slot = &feed->ring[feed->started % DWVW_LANE_RING];
+    slot->end.status = DWVW_RUNNING;
+    slot->block = feed->block;
+    *sequence = feed->started++;
+    *index = feed->next++;
+    return 1;
+}
+
+static void feed_done(lane_feed *feed, const dwvw_estimate_setup *setup, uint64_t sequence, const dwvw_walk_end *end)
+{
+    if (!feed->state) {
+        feed->ends[sequence] = *end;
+        return;
+    }
+    feed->ring[sequence % DWVW_LANE_RING].end = *end;
+    for (; feed->committed < feed->started; ++feed->committed) {
+        lane_slot *slot = &feed->ring[feed->committed % DWVW_LANE_RING];
+        if (slot->end.status == DWVW_RUNNING) break;
+        dwvw_block_add_walk(setup, &slot->end, slot->block);
+    }
+}
+
+/* One event of every lane of mixture_walk_in (isotropic medium: phase 1/(4 pi) for both
+ * components), in the same arithmetic. The guided direction is formed in every lane; the lanes
+ * that picked the classical component (a share q0 of 0.01 or less for auto) have theirs replaced
+ * one by one. The weight is a product of ratios, as there: the mixture's denominator does not
+ * cancel, so each event keeps its exponential. */
+static DWVW_ALWAYS_INLINE int mixture_lanes_step_in(lane_state *L, const dwvw_estimate_setup *setup,
+                                                    const dwvw_fast_plan *plan, dwvw_shape_kind kind)
+{
+    const dwvw_medium *m = &setup->medium;
+    const dwvk_dwivedi_event_f *d = &m->dwivedi_event;
+    const double sigma = m->sigma_t[0], albedo = m->albedo[0], thickness = setup->shape.thickness;
+    const double q0 = setup->guide.q_classical, q1 = plan->q_guided, total = q0 + q1;
+    const double phase = DWVK_INV_FOUR_PI, pdf_scale = m->guided_pdf_scale;
+    const uint32_t max_events = setup->max_events;
+    const uint64_t to_component = DWVW_DIM_COUNTER_OFFSET(DWVW_DIM_CHANNEL, DWVW_DIM_COMPONENT);
+    const uint64_t to_direction = DWVW_DIM_COUNTER_OFFSET(DWVW_DIM_CHANNEL, DWVW_DIM_DIRECTION);
+    const uint64_t to_distance = DWVW_DIM_COUNTER_OFFSET(DWVW_DIM_CHANNEL, DWVW_DIM_DISTANCE);
+    const double sy = plan->sign[0][1], sz = plan->sign[0][2], axis_sign = plan->axis_sign;
+    const double kappa = m->dwivedi.kappa, one_minus_kappa = m->dwivedi.one_minus_kappa;
+    float ua[DWVW_LANES], ub[DWVW_LANES], udist[DWVW_LANES];
+    int guided[DWVW_LANES];
+    /* The counter is that of the event's channel dimension (+0); component +1, direction +2,
+     * distance +4. */
+    for (int l = 0; l < DWVW_LANES; ++l) {
+        uint64_t c = L->counter[l];
+        guided[l] = !(dwvw_counter_uniform_d(c + to_component) * total < q0);
+        dwvk_uniform_pair_f u = dwvw_counter_uniform_pair_f(c + to_direction);
+        ua[l] = u.a;
+        ub[l] = u.b;
+        udist[l] = dwvw_counter_uniform_f(c + to_distance);
+        L->counter[l] = c + DWVW_EVENT_COUNTER_STEP;
+    }
+    double wx[DWVW_LANES], wy[DWVW_LANES], wz[DWVW_LANES];
+    for (int l = 0; l < DWVW_LANES; ++l) {
+        dwvk_dwivedi_event_cosine_f s = dwvk_dwivedi_event_sample_select_f(d, ua[l]);
+        dwvk_unit2_f azimuth = dwvk_azimuth_f(ub[l]);
+        double x = (double)azimuth.c * (double)s.sin_theta, y = sy * ((double)azimuth.s * (double)s.sin_theta);
+        double z = sz * (double)s.cos_theta;
+        double scale = 1.5 - 0.5 * (x * x + y * y + z * z);
+        wx[l] = x * scale;
+        wy[l] = y * scale;
+        wz[l] = z * scale;
+    }
+    for (int l = 0; l < DWVW_LANES; ++l) {
+        if (L->events[l] == 0) { /* the first step keeps the entry direction */
+            wx[l] = L->dx[l];
+            wy[l] = L->dy[l];
+            wz[l] = L->dz[l];
+        } else if (!guided[l]) {
+            dwvk_uniform_pair_f u = {ua[l], ub[l]};
+            dwvu_vec3 w = dwvw_classical_direction(dwvu_v(L->dx[l], L->dy[l], L->dz[l]), 0.0f, u);
+            wx[l] = w.x;
+            wy[l] = w.y;
+            wz[l] = w.z;
+        }
+    }
+    /* Three loops, not one: each lane's chain from the flight's log through the exponential to
+     * the weight is long, and short loops let the core run the lanes' chains side by side. */
+    double stretch_of[DWVW_LANES], t_of[DWVW_LANES], decay_of[DWVW_LANES];
+    int exited_of[DWVW_LANES];
+    for (int l = 0; l < DWVW_LANES; ++l) {
+        double pz = L->pz[l], z = wz[l];
+        double mu = dwvw_clamp_cosine(axis_sign * z);
+        double stretch_above = one_minus_kappa + kappa * (1.0 - mu), stretch_below = 1.0 - kappa * mu;
+        double stretch = mu >= 0.0 ? stretch_above : stretch_below;
+        double t = dwvw_flight(sigma * (guided[l] ? stretch : 1.0), udist[l]);
+        double hit;
+        if (kind == DWVW_HALFSPACE) hit = lane_halfspace_exit(pz, z);
+        else if (kind == DWVW_SLAB) hit = lane_slab_exit(thickness, pz, z);
+        else {
+            dwvu_vec3 normal;
+            hit = dwvw_shape_exit_inline(&setup->shape, kind, dwvu_v(L->px[l], L->py[l], pz), dwvu_v(wx[l], wy[l], z),
+                                         &normal);
+        }
+        int exited;
+        t_of[l] = dwvw_step_length(hit, t, &exited);
+        stretch_of[l] = stretch;
+        exited_of[l] = exited;
+    }
+    for (int l = 0; l < DWVW_LANES; ++l)
+        decay_of[l] = dwvw_grey_decay(sigma, stretch_of[l], t_of[l]);
+    int any = 0;
+    for (int l = 0; l < DWVW_LANES; ++l) {
+        double px = L->px[l], py = L->py[l], pz = L->pz[l], x = wx[l], y = wy[l], z = wz[l];
+        int first = L->events[l] == 0, exited = exited_of[l];
+        double stretch = stretch_of[l], t = t_of[l];
+        double step_phase = first ? 1.0 : phase, pdf_guided = first ? 1.0 : pdf_scale / stretch;
+        /* mixture_walk_in's denominator, term by term. */
+        double qp0 = q0 * step_phase, qp1 = q1 * pdf_guided, denominator = 0.0;
+        if (qp0 > 0.0) denominator += dwvw_grey_term(qp0, 1.0, 1.0, exited);
+        if (qp1 > 0.0) denominator += dwvw_grey_term(qp1, stretch, decay_of[l], exited);
+        double weight = L->weight[l] * dwvw_grey_ratio(step_phase, albedo, denominator, exited);
+        uint32_t events = L->events[l] + (uint32_t)!exited;
+        double flight = exited ? 0.0 : t; /* an exited lane keeps its position (guided_lane_end) */
+        L->px[l] = px + x * flight;
+        L->py[l] = py + y * flight;
+        L->pz[l] = pz + z * flight;
+        L->dx[l] = x;
+        L->dy[l] = y;
+        L->dz[l] = z;
+        L->weight[l] = weight;
+        L->events[l] = events;
+        L->exited[l] = exited;
+        int flagged = exited | !(weight >= DWVW_ROULETTE_THRESHOLD) | (events >= max_events);
+        L->flagged[l] = flagged;
+        any |= flagged;
+    }
+    return any;
+}
+
+static int mixture_lanes_step_halfspace(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
+{
+    return mixture_lanes_step_in(L, setup, plan, DWVW_HALFSPACE);
+}
+
+static int mixture_lanes_step_slab(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
+{
+    return mixture_lanes_step_in(L, setup, plan, DWVW_SLAB);
+}
+
+static int mixture_lanes_step_sphere(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
+{
+    return mixture_lanes_step_in(L, setup, plan, DWVW_SPHERE);
+}
+
+/* The branches of mixture_walk_in after a flagged step of lane l, as guided_lane_end for the guided walk. */
+static int mixture_lane_end(lane_state *L, int l, const dwvw_estimate_setup *setup, dwvw_shape_kind kind,
+                            dwvw_walk_end *end)
+{
+    uint32_t events = L->events[l];
+    double weight = L->weight[l];
+    end->exit_normal = dwvu_v(0.0, 0.0, 0.0);
+    if (L->exited[l]) {
+        dwvu_vec3 normal;
+        (void)dwvw_shape_exit_inline(&setup->shape, kind, dwvu_v(L->px[l], L->py[l], L->pz[l]),
+                                     dwvu_v(L->dx[l], L->dy[l], L->dz[l]), &normal);
+        end->status = DWVW_EXITED;
+        end->exit_normal = normal;
+    } else {
+        if (dwvw_grey_goes_on(L->key[l], events, setup->max_events, &weight, &end->status)) {
+            L->weight[l] = weight; /* perhaps raised by the roulette */
+            return 0;
+        }
+    }
+    dwvw_grey_end(end, events, weight);
+    return 1;
+}
+
+static inline int lanes_step(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan,
+                             dwvw_shape_kind kind)
+{
+    if (plan->walker == DWVW_WALKER_MIXTURE) {
+        switch (kind) {
+        case DWVW_HALFSPACE: return mixture_lanes_step_halfspace(L, setup, plan);
+        case DWVW_SLAB: return mixture_lanes_step_slab(L, setup, plan);
+        case DWVW_SPHERE: return mixture_lanes_step_sphere(L, setup, plan);
+        }
+        return 0;
+    }
+    switch (kind) {
+    case DWVW_HALFSPACE: return guided_lanes_step_halfspace(L, setup, plan);
+    case DWVW_SLAB: return guided_lanes_step_slab(L, setup, plan);
+    case DWVW_SPHERE: return guided_lanes_step_sphere(L, setup, plan);
+    }
+    return 0;
+}
+
+static inline void lanes_run_in(const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan, dwvw_shape_kind kind,
+                                lane_feed *feed)
+{
+    lane_state L;
+    uint64_t sequence[DWVW_LANES];
+    int live[DWVW_LANES], live_count = 0;
+    for (int l = 0; l < DWVW_LANES; ++l) {
+        uint64_t index;
+        live[l] = feed_next(feed, &index, &sequence[l]);
+        if (live[l]) lane_begin(&L, l, setup, plan, index);
+        else lane_begin(&L, l, setup, plan, 0); /* an idle lane computes on a valid state */
+        live_count += live[l];
+    }
+    while (live_count > 0) {
+        if (!lanes_step(&L, setup, plan, kind)) continue;
+        int freed = 0;
+        for (int l = 0; l < DWVW_LANES; ++l) {
+            if (!L.flagged[l] || !live[l]) continue;
+            dwvw_walk_end end;
+            int ended = plan->walker == DWVW_WALKER_MIXTURE ? mixture_lane_end(&L, l, setup, kind, &end)
+                                                            : guided_lane_end(&L, l, setup, plan, kind, &end);
+            if (!ended) continue;
+            feed_done(feed, setup, sequence[l], &end);
+            live[l] = 0;
+            --live_count;
+            freed = 1;
+        }
+        if (!freed) continue;
+        /* Refill every idle lane: a lane left idle by a full ring may go on once the ring drained. */
+        for (int l = 0; l < DWVW_LANES; ++l) {
+            uint64_t index;
+            if (live[l] || !feed_next(feed, &index, &sequence[l])) continue;
+            lane_begin(&L, l, setup, plan, index);
+            live[l] = 1;
+            ++live_count;
+        }
+    }
+}
+
+/* Runs every walk of the feed in lanes. */
+static void lanes_run(const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan, lane_feed *feed)
+{
+    switch (setup->shape.kind) {
+    case DWVW_HALFSPACE: lanes_run_in(setup, plan, DWVW_HALFSPACE, feed); return;
+    case DWVW_SLAB: lanes_run_in(setup, plan, DWVW_SLAB, feed); return;
+    case DWVW_SPHERE: lanes_run_in(setup, plan, DWVW_SPHERE, feed); return;
+    }
+}
+
+void dwvw_lanes_run_blocks(dwvw_estimate_run_state *state)
+{
+    lane_slot ring[DWVW_LANE_RING];
+    lane_feed feed = {.state = state, .ring = ring};
+    lanes_run(state->setup, &state->plan, &feed);
+}
+
+void dwvw_lanes_run_range(const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan, uint64_t first,
+                          uint64_t count, dwvw_walk_end *ends)
+{
+    lane_feed feed = {.state = NULL, .next = first, .stop = first + count, .first = first, .ends = ends};
+    lanes_run(setup, plan, &feed);
+}
