@@ -15,7 +15,8 @@ build=$(cd "${2:?build dir}" && pwd)
 results=${3:-$build/tests/fidelity-$suite}
 root=/var/cache/dwivedi/chroots/$suite
 here=$(cd "$(dirname "$0")" && pwd)
-[ -x "$root/usr/bin/blender" ] || { echo "run_fidelity_chroot: no Blender in $root (make it with branch addon's scripts/blender-chroots.sh)" >&2; exit 1; }
+[ -x "$root/usr/bin/blender" ] || { echo "run_fidelity_chroot: no Blender in $root (make it with branch addon's scripts/blender-chroots.sh): skipped" >&2; exit 77; }
+[ "$(id -u)" = 0 ] || { echo "run_fidelity_chroot: needs root (chroot, a private mount namespace): skipped" >&2; exit 77; }
 stage_rel=/tmp/dwivedi-fidelity-$$
 stage=$root$stage_rel
 mkdir -p "$stage/deps" "$stage/home" "$results"

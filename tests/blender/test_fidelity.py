@@ -176,4 +176,29 @@ for _kind in ("default_sphere", "slab", "cube"):
         if not ONLY or any(part and part in _name for part in ONLY.split(",")):
             setattr(FidelityTest, _name, _make(_kind, _method))
 
-harness.run(FidelityTest)
+
+class MappingTest(harness.unittest.TestCase):
+    """The add-on's table of methods per Blender version (export.subsurface_model, footprint_rule),
+    for every release, whichever Blender runs it."""
+
+    def test_methods_per_version(self):
+        names = [n for n in sys.modules if n == "dwivedi_bake" or n.endswith(".dwivedi_bake")]
+        export = sys.modules[names[0] + ".export"]
+        cases = [((3, 4, 1), 'RANDOM_WALK_FIXED_RADIUS', "fixed_radius"),
+                 ((3, 6, 0), 'RANDOM_WALK', "blender3_random_walk"),
+                 ((4, 2, 0), 'RANDOM_WALK', "blender4_random_walk"),
+                 ((4, 3, 2), 'RANDOM_WALK_SKIN', "blender4_skin"),
+                 ((5, 1, 0), 'RANDOM_WALK', "blender4_random_walk"),
+                 ((5, 2, 2), 'RANDOM_WALK', "blender52_random_walk"),
+                 ((5, 2, 2), 'RANDOM_WALK_LEGACY', "blender52_legacy"),
+                 ((5, 2, 2), 'RANDOM_WALK_SKIN', "blender52_skin")]
+        for version, method, model in cases:
+            self.assertEqual(export.subsurface_model(version, method), (model, None), (version, method))
+        model, note = export.subsurface_model((4, 3, 0), 'BURLEY')
+        self.assertEqual(model, "fixed_radius")
+        self.assertIn("Christensen-Burley", note)
+        self.assertEqual([export.footprint_rule(v) for v in ((3, 4, 1), (4, 0, 0), (4, 4, 9), (4, 5, 0), (5, 2, 2))],
+                         [0.0, 0.25, 0.25, 0.0, 0.0])
+
+
+harness.run(FidelityTest, MappingTest)
