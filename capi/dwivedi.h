@@ -700,10 +700,18 @@ typedef struct dwv_bake_options_t {
     uint32_t channel_walks;   /* dwv_channel_walks_t, DWV_CHANNEL_WALKS_*; a reserved 0 (AUTO) in older headers */
     dwv_progress_callback_t progress;  /* optional */
     void *progress_user;
+    /* Added after 0.1.0 (a caller whose struct_size ends before them gets 0, 0: the whole bake).
+     * A chunk of a split bake (docs/farm.md): sample_count > 0 bakes sample indices sample_first
+     * to sample_first + sample_count - 1 of every pixel, exactly the samples those indices have
+     * in a whole bake of `samples` per pixel (which stays the total: auto's pilot depends on it,
+     * never on the range); sample_first + sample_count <= samples; no time_limit or
+     * target_error. The image keeps its exact sums for dwv_image_write_partial. */
+    uint64_t sample_first;
+    uint64_t sample_count;
 } dwv_bake_options_t;
 #define DWV_BAKE_OPTIONS_INIT                                                                       \
     {sizeof(dwv_bake_options_t), DWV_BAKE_CAMERA, 256u, 256u, 0u, 16u, DWV_TECHNIQUE_AUTO, 64u, 0.0,  \
-     0.0, 0u, 0u, 0u, 0u, 0u, NULL, NULL}
+     0.0, 0u, 0u, 0u, 0u, 0u, NULL, NULL, 0u, 0u}
 
 typedef struct dwv_bake_s dwv_bake_t;
 typedef struct dwv_image_s dwv_image_t;
@@ -813,6 +821,23 @@ DWV_API dwv_result_t dwv_image_write_display_png(const dwv_image_t *image, const
 /* The same pixels in memory: 4 x width x height bytes, as the PNG would hold them. */
 DWV_API dwv_result_t dwv_image_to_display(const dwv_image_t *image, const dwv_display_options_t *display,
                                           uint8_t *rgba8, uint64_t size);
+
+/* ---------------------------------------------------------------------------------------------
+ * Split bakes (docs/farm.md): chunks of sample indices baked apart, merged into the bits of the
+ * whole bake. A pixel's sums are exact (fixed point, 2^-48, in 128-bit integers), so they add in
+ * any order to the same bits.
+ * ------------------------------------------------------------------------------------------- */
+/* Writes the image of a chunk bake (sample_count > 0) as a partial file: per pixel its counts and
+ * exact sums, the error data, the scene's and options' hashes, the seed, the range, the library
+ * version and a checksum; atomically (a killed writer leaves no file under `path`). */
+DWV_API dwv_result_t dwv_image_write_partial(const dwv_image_t *image, const char *path);
+/* Reads `count` partial files, checks that they come from one scene, options, seed and library
+ * version and that their ranges tile 0 .. samples - 1 exactly once (the message names the file
+ * at fault: missing range, duplicate, overlap, truncated or corrupt file, foreign chunk), and
+ * makes the image a single bake would have made: the same pixels, variance, counts and estimated
+ * error. Its error_vs_time has one point per chunk prefix in sample order; its seconds are the
+ * chunks' bake seconds added up (the time one machine would have taken for them in turn). */
+DWV_API dwv_result_t dwv_merge_partials(const char *const *paths, uint32_t count, dwv_image_t **image);
 
 /* ---------------------------------------------------------------------------------------------
  * Scene files (JSON, docs/scene-format.md) and the built-in default scene.

@@ -35,10 +35,11 @@ from typing import NamedTuple, Tuple
 
 from . import _library
 from ._library import Error, library_path, use_library
-from .baker import (AreaLight, Bake, BakeSettings, BakeStats, Camera, Cancelled, DisplaySettings, ErrorPoint, Image,
+from .baker import (AreaLight, Bake, BakeSettings, BakeStats, Camera, Cancelled, DisplaySettings, ErrorPoint, Image, merge_partials,
                     Material, PointLight, Progress, Scene, SunLight, bake, feature_names, start_bake, techniques)
 
 __all__ = [
+    "merge_partials",
     "Error",
     "Cancelled",
     "library_path",

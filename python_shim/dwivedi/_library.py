@@ -235,6 +235,8 @@ class BakeOptions(_SizedStructure):
         ("channel_walks", ctypes.c_uint32),
         ("progress", ProgressCallback),
         ("progress_user", ctypes.c_void_p),
+        ("sample_first", ctypes.c_uint64),
+        ("sample_count", ctypes.c_uint64),
     ]
 
     def __init__(self) -> None:
@@ -365,6 +367,8 @@ _BAKER_PROTOTYPES: Dict[str, Tuple[object, Sequence[object]]] = {
     "dwv_image_release": (None, (_handle_p,)),
     "dwv_image_create": (_result_t, (ctypes.c_uint32, ctypes.c_uint32, ctypes.c_void_p, _handle_pp)),
     "dwv_image_write_exr": (_result_t, (_handle_p, ctypes.c_char_p)),
+    "dwv_image_write_partial": (_result_t, (_handle_p, ctypes.c_char_p)),
+    "dwv_merge_partials": (_result_t, (ctypes.POINTER(ctypes.c_char_p), ctypes.c_uint32, ctypes.POINTER(_handle_p))),
     "dwv_image_write_display_png": (_result_t, (_handle_p, ctypes.c_char_p, _p(DisplayOptions))),
     "dwv_image_to_display": (_result_t, (_handle_p, _p(DisplayOptions), ctypes.c_void_p, ctypes.c_uint64)),
     "dwv_scene_load": (_result_t, (ctypes.c_char_p, _handle_pp, _p(BakeOptions))),

@@ -379,6 +379,10 @@ class BakeSettings:
     seed: int = 0
     tile_size: int = 0
     channel_walks: str = "auto"
+    # A chunk of a split bake (docs/farm.md): sample indices sample_first .. sample_first +
+    # sample_count - 1 of `samples` in all; 0 (the default): the whole bake.
+    sample_first: int = 0
+    sample_count: int = 0
 
     def _to_c(self) -> _library.BakeOptions:
         out = _library.BakeOptions()
@@ -396,6 +400,8 @@ class BakeSettings:
         out.seed = _uint("seed", self.seed, 64)
         out.tile_size = _uint("tile_size", self.tile_size)
         out.channel_walks = _name_code("channel_walks", self.channel_walks, _CHANNEL_WALKS)
+        out.sample_first = _uint("sample_first", self.sample_first, 64)
+        out.sample_count = _uint("sample_count", self.sample_count, 64)
         return out
 
     @classmethod
@@ -946,6 +952,10 @@ class Image:
         the file appears complete or not at all."""
         _call("dwv_image_write_exr", self._live(), os.fsencode(path))
 
+    def write_partial(self, path: PathLike) -> None:
+        """Writes a chunk's exact sums (a bake with sample_count > 0) for merge_partials."""
+        _call("dwv_image_write_partial", self._live(), os.fsencode(path))
+
     def write_png(self, path: PathLike, display: Optional[DisplaySettings] = None, **overrides: Any) -> None:
         """Writes an 8-bit RGBA PNG through the display transform (DisplaySettings or its fields as
         keywords: write_png("a.png", view="Filmic", exposure=1.0))."""
@@ -984,3 +994,13 @@ class Image:
 
     def __repr__(self) -> str:
         return f"<dwivedi.Image {self.width} x {self.height}>"
+
+
+def merge_partials(paths: Sequence[PathLike]) -> "Image":
+    """Merges the partial files of a split bake into the image one bake would have made
+    (dwv_merge_partials; docs/farm.md). Raises Error naming the chunk at fault."""
+    encoded = [os.fsencode(p) for p in paths]
+    array = (ctypes.c_char_p * max(len(encoded), 1))(*encoded)
+    handle = _library._handle_p()
+    _call("dwv_merge_partials", array, len(encoded), ctypes.byref(handle))
+    return Image._adopt(handle.value)

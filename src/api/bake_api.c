@@ -2,6 +2,7 @@
  * holding a reference to its scene while it lives. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -11,6 +12,7 @@
 #include "util/error.h"
 #include "image_handle.h"
 #include "scene_handle.h"
+#include "partial.h"
 
 #define MAX_SIDE 16384u
 #define MAX_PIXELS (1u << 26)
@@ -65,6 +67,21 @@ static dwv_result_t check_options(const char *fn, const dwvb_scene *s, const dwv
     if (o->samples < 1u || o->samples > MAX_SAMPLES)
         return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: samples = %llu is outside [1, %llu]", fn,
                         (unsigned long long)o->samples, MAX_SAMPLES);
+    if (o->sample_count > 0u) {
+        if (o->sample_first >= o->samples || o->sample_count > o->samples - o->sample_first)
+            return dwv_fail(DWV_ERROR_OUT_OF_RANGE,
+                            "%s: the sample range %llu:%llu (first:count) does not lie within the bake's %llu samples",
+                            fn, (unsigned long long)o->sample_first, (unsigned long long)o->sample_count,
+                            (unsigned long long)o->samples);
+        if (o->time_limit != 0.0 || o->target_error != 0.0)
+            return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
+                            "%s: a chunk (sample_count > 0) bakes its whole range: time_limit and target_error must be 0", fn);
+        if (o->target != DWV_BAKE_CAMERA)
+            return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: split bakes (sample_count > 0) are camera bakes only so far", fn);
+    } else if (o->sample_first != 0u) {
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: sample_first = %llu needs sample_count > 0", fn,
+                        (unsigned long long)o->sample_first);
+    }
     DWV_TRY(dwv_check_range(fn, "time_limit", o->time_limit, 0.0, HUGE_VAL));
     DWV_TRY(dwv_check_range(fn, "target_error", o->target_error, 0.0, HUGE_VAL));
     if (o->threads > MAX_THREADS)
@@ -102,12 +119,15 @@ dwv_result_t dwv_bake_start(dwv_scene_t *scene, const dwv_bake_options_t *option
     DWV_TRY(dwv_check_pointer(fn, "bake", bake));
     *bake = NULL;
     DWV_TRY(dwv_check_pointer(fn, "scene", scene));
-    DWV_TRY(dwv_check_struct(fn, "options", options, (uint32_t)sizeof(dwv_bake_options_t)));
+    /* Callers whose struct ends before sample_first (older headers) get 0, 0: a whole bake. */
+    DWV_TRY(dwv_check_struct(fn, "options", options, (uint32_t)offsetof(dwv_bake_options_t, sample_first)));
     dwvb_scene *s = dwv_scene_object(scene);
     if (!s->committed) return dwv_fail(DWV_ERROR_INVALID_STATE, "%s: the scene is not committed (dwv_scene_commit)", fn);
-    DWV_TRY(check_options(fn, s, options));
-    dwv_bake_options_t resolved = *options;
+    dwv_bake_options_t resolved;
+    memset(&resolved, 0, sizeof resolved);
+    memcpy(&resolved, options, options->struct_size < sizeof resolved ? options->struct_size : sizeof resolved);
     resolved.struct_size = (uint32_t)sizeof resolved;
+    DWV_TRY(check_options(fn, s, &resolved));
     if (resolved.threads == 0u) {
         long cores = sysconf(_SC_NPROCESSORS_ONLN);
         resolved.threads = cores < 1 ? 1u : cores > (long)MAX_THREADS ? MAX_THREADS : (uint32_t)cores;
@@ -164,6 +184,10 @@ dwv_result_t dwv_bake_finish(dwv_bake_t *bake, dwv_image_t **image)
     char message[256];
     dwv_result_t result = dwvb_bake_finish(bake->bake, &made, message, sizeof message);
     if (result != DWV_SUCCESS) return dwv_fail(result, "%s: %s", fn, message);
+    if (made->partial) {
+        made->partial->scene_hash = dwv_scene_hash(dwv_scene_object(bake->scene));
+        made->partial->options_hash = dwv_options_hash(dwvb_bake_options(bake->bake));
+    }
     *image = dwv_image_handle(made);
     return DWV_SUCCESS;
 }

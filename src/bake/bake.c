@@ -114,13 +114,13 @@ static void *worker(void *arg)
                     double rgb[3], alpha;
                     sample_pixel(bake, index, s, rgb, &alpha, tally);
                     for (int c = 0; c < 3; ++c) {
-                        p->sum[c] += rgb[c];
-                        p->sum_squares[c] += rgb[c] * rgb[c];
+                        p->sum[c] += dwvb_to_fixed(rgb[c]);
+                        p->sum_squares[c] += dwvb_to_fixed(rgb[c] * rgb[c]);
                     }
                     double l = dwvb_luminance(rgb);
-                    p->sum_luminance_squares += l * l;
-                    p->replicate_luminance[s % REPLICATES] += l;
-                    p->sum_alpha += alpha;
+                    p->sum_luminance_squares += dwvb_to_fixed(l * l);
+                    p->replicate_luminance[s % REPLICATES] += dwvb_to_fixed(l);
+                    p->sum_alpha += dwvb_to_fixed(alpha);
                     ++bake->counts[index];
                 }
             }
@@ -140,7 +140,8 @@ static double fraction_done(dwvb_bake *bake)
 {
     double pass_share = bake->tile_count ? (double)atomic_load(&bake->tiles_done) / bake->tile_count : 0.0;
     double spp = (double)bake->spp_done + pass_share * (double)(bake->pass_end - bake->pass_first);
-    double f = spp / (double)bake->options.samples;
+    uint64_t total = bake->options.sample_count ? bake->options.sample_count : bake->options.samples;
+    double f = spp / (double)total;
     if (bake->options.time_limit > 0.0) f = fmax(f, dwvb_bake_elapsed(bake) / bake->options.time_limit);
     /* The error falls as 1/sqrt(samples): (target / error)^2 is the share of samples done. */
     if (bake->options.target_error > 0.0 && isfinite(bake->error) && bake->error > 0.0)
@@ -225,19 +226,22 @@ static dwv_result_t fail(dwvb_bake *bake, dwv_result_t result, const char *messa
 
 static dwv_result_t run(dwvb_bake *bake)
 {
-    uint64_t samples = bake->options.samples;
+    /* A chunk (sample_count > 0) bakes sample_first .. + sample_count - 1; the pilot above used the
+     * whole bake's samples, so it chooses the same in every chunk. */
+    uint64_t first = bake->options.sample_first;
+    uint64_t samples = bake->options.sample_count ? bake->options.sample_count : bake->options.samples;
     int pilot = dwvb_pilot_choose(bake);
     if (pilot < 0) return fail(bake, DWV_ERROR_OUT_OF_MEMORY, "no memory for auto's pilot");
     if (atomic_load(&bake->cancelled)) return fail(bake, DWV_ERROR_CANCELLED, "the bake was cancelled");
     while (bake->spp_done < samples) {
         uint64_t pass = bake->spp_done == 0 ? 2u : bake->spp_done;
         if (pass > samples - bake->spp_done) pass = samples - bake->spp_done;
-        bake->pass_first = bake->spp_done;
-        bake->pass_end = bake->spp_done + pass;
+        bake->pass_first = first + bake->spp_done;
+        bake->pass_end = first + bake->spp_done + pass;
         if (run_pass(bake)) return fail(bake, DWV_ERROR_INTERNAL, "could not start a worker thread");
         if (atomic_load(&bake->cancelled)) return fail(bake, DWV_ERROR_CANCELLED, "the bake was cancelled");
         int cut = atomic_load(&bake->time_up);
-        if (!cut) bake->spp_done = bake->pass_end;
+        if (!cut) bake->spp_done = bake->pass_end - first;
         bake->error = dwvb_bake_estimate_error(bake);
         dwv_error_point_t point = {dwvb_bake_elapsed(bake), bake->error, bake->spp_done};
         if (!cut && dwvb_image_add_error_point(bake->image, point))
@@ -468,6 +472,11 @@ void dwvb_bake_free(dwvb_bake *bake)
     dwvb_bake_cancel(bake);
     join(bake);
     release_parts(bake);
+}
+
+const dwv_bake_options_t *dwvb_bake_options(const dwvb_bake *bake)
+{
+    return &bake->options;
 }
 
 long long dwvb_scene_geometry_bytes(const dwvb_scene *scene)

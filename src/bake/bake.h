@@ -2,8 +2,8 @@
  * committed scene, each pass split into tiles that a pool of threads takes in turn.
  *
  * Determinism: sample s of pixel p uses random numbers keyed by (seed, p, s) only, and a pixel's
- * samples are added in the order of s by the one thread that holds its tile, so the image is the
- * same bit for bit for any thread count and tile order. Per-tile counters are summed in tile order.
+ * samples are added as exact fixed-point integers (bake_internal.h), so the image is the same bit
+ * for bit for any thread count, tile order and split into sample ranges (docs/farm.md). Per-tile counters are summed in tile order.
  * Budgets: samples per pixel (passes of 2, 2, 4, 8... samples, so that every pass after the first
  * doubles the count), a time limit checked before each tile (pixels keep the samples they got),
  * and a target relative error checked after each pass. */
@@ -32,6 +32,9 @@ void dwvb_bake_cancel(dwvb_bake *bake);
 dwv_result_t dwvb_bake_finish(dwvb_bake *bake, dwvb_image **image, char *message, size_t size);
 /* Cancels if running, waits, frees. */
 void dwvb_bake_free(dwvb_bake *bake);
+
+/* The bake's resolved options. */
+const dwv_bake_options_t *dwvb_bake_options(const dwvb_bake *bake);
 
 /* Embree's memory for the scene's geometry, in bytes (for memory per triangle). */
 long long dwvb_scene_geometry_bytes(const dwvb_scene *scene);

@@ -4,6 +4,7 @@
 #ifndef DWV_BAKE_BAKE_INTERNAL_H
 #define DWV_BAKE_BAKE_INTERNAL_H
 
+#include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdint.h>
@@ -24,11 +25,33 @@
 /* A pixel's samples form two independent replicates (dwvb_bake_sample): even samples and odd ones. */
 #define REPLICATES 2u
 
+/* A pixel's sums are exact: each sample's values are rounded once to fixed point (units of
+ * 2^-DWVB_FIXED_BITS, magnitudes clamped at DWVB_FIXED_LIMIT) and added as 128-bit integers, so
+ * any split of a pixel's samples into chunks, added in any order, gives the same bits as one bake
+ * (docs/farm.md). A double accumulated in sample order would not: (a + b) + c != a + (b + c).
+ * 2^40 x 2^48 x 2^32 samples stays below 2^127. */
+#define DWVB_FIXED_BITS 48
+#define DWVB_FIXED_LIMIT 1099511627776.0 /* 2^40 */
+__extension__ typedef __int128 dwvb_fixed;
+
+static inline dwvb_fixed dwvb_to_fixed(double x)
+{
+    if (!(x > -DWVB_FIXED_LIMIT)) x = -DWVB_FIXED_LIMIT; /* NaN too (samples are checked finite) */
+    if (x > DWVB_FIXED_LIMIT) x = DWVB_FIXED_LIMIT;
+    return (dwvb_fixed)nearbyint(ldexp(x, DWVB_FIXED_BITS));
+}
+
+static inline double dwvb_from_fixed(dwvb_fixed x)
+{
+    return ldexp((double)x, -DWVB_FIXED_BITS);
+}
+
 typedef struct dwvb_pixel_sums {
-    double sum[3], sum_squares[3];
-    double sum_alpha, sum_luminance_squares;
-    double replicate_luminance[REPLICATES]; /* the sum of each replicate's luminances */
+    dwvb_fixed sum[3], sum_squares[3];
+    dwvb_fixed sum_alpha, sum_luminance_squares;
+    dwvb_fixed replicate_luminance[REPLICATES]; /* the sum of each replicate's luminances */
 } dwvb_pixel_sums;
+#define DWVB_PIXEL_SUM_FIELDS 10 /* fixed-point values per pixel, in the order above */
 
 struct dwvb_bake {
     const dwvb_scene *scene;

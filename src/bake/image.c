@@ -46,5 +46,10 @@ void dwvb_image_free(dwvb_image *image)
     free(image->variance);
     free(image->samples);
     free(image->error_vs_time);
+    if (image->partial) {
+        free(image->partial->sums);
+        free(image->partial->counts);
+        free(image->partial);
+    }
     free(image);
 }

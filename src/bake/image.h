@@ -8,6 +8,17 @@
 
 #include <dwivedi.h>
 
+struct dwvb_pixel_sums;
+
+/* What a chunk of a split bake keeps beyond its image, for dwv_image_write_partial. */
+typedef struct dwvb_partial {
+    struct dwvb_pixel_sums *sums; /* width x height (bake_internal.h) */
+    uint32_t *counts;             /* width x height */
+    int uv;
+    uint64_t first, count, total, seed;
+    uint64_t scene_hash, options_hash; /* set by the API (dwv_bake_finish) */
+} dwvb_partial;
+
 typedef struct dwvb_image {
     atomic_uint references;
     uint32_t width, height;
@@ -21,6 +32,7 @@ typedef struct dwvb_image {
      * steps, in checked ball mode the ray-free steps whose ray met the surface, and mixture terms
      * (what the auto pilot's cost model counts). */
     uint64_t rays, point_queries, ray_free_steps, ray_free_misses, mixture_terms;
+    dwvb_partial *partial; /* chunks of split bakes only; else NULL */
 } dwvb_image;
 
 /* A zeroed image of the given size with reference count 1 (stats zeroed but struct_size set),

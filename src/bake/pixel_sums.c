@@ -2,22 +2,32 @@
 #include "bake/pixel_sums.h"
 
 #include <math.h>
+#include <stdlib.h>
+#include <string.h>
 
 /* Whether pixel `index` counts in the image's error and mean: UV texels of the islands; camera
  * pixels that saw a surface (all pixels when none did). */
-static int covered(const dwvb_bake *bake, uint32_t index, int any_surface)
+static int covered(const dwvb_sums_view *view, uint32_t index, int any_surface)
 {
-    if (bake->options.target == DWV_BAKE_UV) return bake->raster.texels[index].triangle >= 0;
-    return !any_surface || bake->sums[index].sum_alpha > 0.0;
+    if (view->texels) return view->texels[index].triangle >= 0;
+    return !any_surface || view->sums[index].sum_alpha > 0;
 }
 
-static int any_surface_seen(const dwvb_bake *bake)
+static int any_surface_seen(const dwvb_sums_view *view)
 {
-    if (bake->options.target != DWV_BAKE_CAMERA) return 1;
-    size_t pixels = (size_t)bake->width * bake->height;
+    if (view->texels) return 1;
+    size_t pixels = (size_t)view->width * view->height;
     for (size_t i = 0; i < pixels; ++i)
-        if (bake->sums[i].sum_alpha > 0.0) return 1;
+        if (view->sums[i].sum_alpha > 0) return 1;
     return 0;
+}
+
+static dwvb_sums_view bake_view(const dwvb_bake *bake)
+{
+    dwvb_sums_view view = {bake->width, bake->height,
+                           bake->options.target == DWV_BAKE_UV ? bake->raster.texels : NULL, bake->sums,
+                           bake->counts};
+    return view;
 }
 
 /* The variance of a pixel's mean from its sums: (sum x^2 - (sum x)^2 / n) / (n (n - 1)); 0 below
@@ -48,22 +58,23 @@ static double mean_variance(double sum, double sum_squares, uint32_t n)
  * correlated, and overstate the error: 1.1x to 1.4x with shared walks, 2.2x with channel walks,
  * which share a sample's stratified numbers over three walks (docs/speed.md). It is used below
  * REPLICATE_MIN_PIXELS covered pixels, where the replicates' spread is too noisy. */
-double dwvb_bake_estimate_error(const dwvb_bake *bake)
+double dwvb_sums_estimate_error(const dwvb_sums_view *view)
 {
-    int any = any_surface_seen(bake);
-    size_t pixels = (size_t)bake->width * bake->height;
+    int any = any_surface_seen(view);
+    size_t pixels = (size_t)view->width * view->height;
     double spread = 0.0, own = 0.0, total = 0.0, count = 0.0;
     for (size_t i = 0; i < pixels; ++i) {
-        if (!covered(bake, (uint32_t)i, any)) continue;
+        if (!covered(view, (uint32_t)i, any)) continue;
         count += 1.0;
-        uint32_t n = bake->counts[i];
+        uint32_t n = view->counts[i];
         if (n < 2u) return INFINITY;
-        const dwvb_pixel_sums *p = &bake->sums[i];
-        double l = dwvb_luminance(p->sum);
+        const dwvb_pixel_sums *p = &view->sums[i];
+        double rgb[3] = {dwvb_from_fixed(p->sum[0]), dwvb_from_fixed(p->sum[1]), dwvb_from_fixed(p->sum[2])};
+        double l = dwvb_luminance(rgb);
         total += l / n;
-        own += mean_variance(l, p->sum_luminance_squares, n);
+        own += mean_variance(l, dwvb_from_fixed(p->sum_luminance_squares), n);
         double n0 = (double)((n + 1u) / 2u), n1 = (double)(n / 2u);
-        double d = p->replicate_luminance[0] / n0 - p->replicate_luminance[1] / n1;
+        double d = dwvb_from_fixed(p->replicate_luminance[0]) / n0 - dwvb_from_fixed(p->replicate_luminance[1]) / n1;
         spread += d * d * n0 * n1 / ((double)n * (double)n);
     }
     double variance = count >= REPLICATE_MIN_PIXELS ? spread : own;
@@ -71,30 +82,66 @@ double dwvb_bake_estimate_error(const dwvb_bake *bake)
     return total > 0.0 ? sqrt(count * variance) / total : INFINITY;
 }
 
-dwv_result_t dwvb_bake_make_image(dwvb_bake *bake, double seconds)
+double dwvb_bake_estimate_error(const dwvb_bake *bake)
 {
-    dwvb_image *image = bake->image;
-    size_t pixels = (size_t)bake->width * bake->height;
-    int any = any_surface_seen(bake);
+    dwvb_sums_view view = bake_view(bake);
+    return dwvb_sums_estimate_error(&view);
+}
+
+void dwvb_sums_fill_image(const dwvb_sums_view *view, dwvb_image *image)
+{
+    size_t pixels = (size_t)view->width * view->height;
+    int any = any_surface_seen(view);
     dwv_bake_stats_t *st = &image->stats;
     double mean[3] = {0.0, 0.0, 0.0};
     uint64_t covered_count = 0, samples = 0, largest = 0;
     for (size_t i = 0; i < pixels; ++i) {
-        uint32_t n = bake->counts[i];
-        const dwvb_pixel_sums *p = &bake->sums[i];
+        uint32_t n = view->counts[i];
+        const dwvb_pixel_sums *p = &view->sums[i];
         samples += n;
         if (n > largest) largest = n;
         if (n == 0u) continue;
         for (int c = 0; c < 3; ++c) {
-            image->rgba[4 * i + c] = (float)(p->sum[c] / n);
-            image->variance[3 * i + c] = (float)mean_variance(p->sum[c], p->sum_squares[c], n);
+            double sum = dwvb_from_fixed(p->sum[c]);
+            image->rgba[4 * i + c] = (float)(sum / n);
+            image->variance[3 * i + c] = (float)mean_variance(sum, dwvb_from_fixed(p->sum_squares[c]), n);
         }
-        image->rgba[4 * i + 3] = (float)(p->sum_alpha / n);
+        image->rgba[4 * i + 3] = (float)(dwvb_from_fixed(p->sum_alpha) / n);
         image->samples[i] = n;
-        if (covered(bake, (uint32_t)i, any)) {
+        if (covered(view, (uint32_t)i, any)) {
             ++covered_count;
-            for (int c = 0; c < 3; ++c) mean[c] += p->sum[c] / n;
+            for (int c = 0; c < 3; ++c) mean[c] += dwvb_from_fixed(p->sum[c]) / n;
         }
+    }
+    st->samples_per_pixel = largest;
+    st->samples = samples;
+    for (int c = 0; c < 3; ++c) st->mean_rgb[c] = covered_count ? mean[c] / (double)covered_count : 0.0;
+}
+
+dwv_result_t dwvb_bake_make_image(dwvb_bake *bake, double seconds)
+{
+    dwvb_image *image = bake->image;
+    size_t pixels = (size_t)bake->width * bake->height;
+    dwv_bake_stats_t *st = &image->stats;
+    dwvb_sums_view view = bake_view(bake);
+    dwvb_sums_fill_image(&view, image);
+    uint64_t samples = st->samples;
+    if (bake->options.sample_count > 0u) {
+        /* A chunk: its image keeps the exact sums for dwv_image_write_partial. */
+        image->partial = malloc(sizeof *image->partial);
+        if (!image->partial) return DWV_ERROR_OUT_OF_MEMORY;
+        dwvb_partial *part = image->partial;
+        *part = (dwvb_partial){0};
+        part->sums = malloc(pixels * sizeof(dwvb_pixel_sums));
+        part->counts = malloc(pixels * sizeof *part->counts);
+        if (!part->sums || !part->counts) return DWV_ERROR_OUT_OF_MEMORY;
+        memcpy(part->sums, bake->sums, pixels * sizeof(dwvb_pixel_sums));
+        memcpy(part->counts, bake->counts, pixels * sizeof *part->counts);
+        part->uv = bake->options.target == DWV_BAKE_UV;
+        part->first = bake->options.sample_first;
+        part->count = bake->options.sample_count;
+        part->total = bake->options.samples;
+        part->seed = bake->options.seed;
     }
     dwvb_tally total = {0};
     for (uint32_t t = 0; t < bake->tile_count; ++t) {
@@ -109,8 +156,6 @@ dwv_result_t dwvb_bake_make_image(dwvb_bake *bake, double seconds)
         for (int c = 0; c < 3; ++c) total.truncated[c] += bake->tile_tallies[t].truncated[c];
     }
     st->technique = bake->options.technique;
-    st->samples_per_pixel = largest;
-    st->samples = samples;
     st->events = total.events;
     image->rays = total.rays;
     image->point_queries = total.point_queries;
@@ -120,10 +165,7 @@ dwv_result_t dwvb_bake_make_image(dwvb_bake *bake, double seconds)
     st->walks = total.walks;
     st->seconds = seconds;
     st->estimated_relative_error = bake->error;
-    for (int c = 0; c < 3; ++c) {
-        st->mean_rgb[c] = covered_count ? mean[c] / (double)covered_count : 0.0;
-        st->truncated_weight[c] = samples ? total.truncated[c] / (double)samples : 0.0;
-    }
+    for (int c = 0; c < 3; ++c) st->truncated_weight[c] = samples ? total.truncated[c] / (double)samples : 0.0;
     st->features = bake->features;
     st->threads = bake->threads;
     st->warnings = bake->scene->warnings + total.warnings;

@@ -15,6 +15,7 @@
 #include <dwivedi.h>
 
 static const char verb[] = "bake";
+static const char *verb_name = "bake"; /* "merge" while merging: the messages say which */
 
 static void help(FILE *out)
 {
@@ -22,7 +23,7 @@ static void help(FILE *out)
             "usage: dwivedi bake [SCENE.json] --out PREFIX [--spp N] [--time SECONDS] [--error REL]\n"
             "           [--technique T] [--channel-walks C] [--threads N] [--seed S] [--width W] [--height H]\n"
             "           [--ocio CONFIG] [--display NAME] [--view NAME] [--look NAME]\n"
-            "           [--exposure E] [--gamma G] [--quiet]\n\n"
+            "           [--exposure E] [--gamma G] [--samples FIRST:COUNT] [--quiet]\n\n"
             "Bakes SCENE.json (docs/scene-format.md), or without it the built-in default scene: a thin\n"
             "back-lit leaf-like shell beside a thick front-lit wax-like shape. Writes\n"
             "  PREFIX.exr   float RGBA, scene-linear Rec.709, plus variance and sample-count layers\n"
@@ -43,6 +44,9 @@ static void help(FILE *out)
             "  --width W, --height H   image size (default: the scene's)\n"
             "  --ocio CONFIG  OpenColorIO config (default: $OCIO, else the config dwivedi ships)\n"
             "  --display, --view, --look, --exposure, --gamma   colour management as in Blender\n"
+            "  --samples FIRST:COUNT   a chunk of a split bake (docs/farm.md): sample indices FIRST to\n"
+            "                 FIRST+COUNT-1 of the --spp in all, written to PREFIX.dwvpart only (exact sums\n"
+            "                 for 'dwivedi merge'); no --time or --error\n"
             "  --quiet        no progress bar (it is shown only on a terminal anyway)\n");
 }
 
@@ -56,6 +60,8 @@ static void on_interrupt(int signal_number)
 
 typedef struct bake_flags {
     const char *scene_path, *prefix;
+    int chunk, budget; /* --samples given; --time or --error given */
+    uint64_t first, count;
     dwv_display_options_t display;
     int quiet;
 } bake_flags;
@@ -78,14 +84,29 @@ static int parse_overrides(int argc, char **argv, bake_flags *f, dwv_bake_option
         static const char *const flags[] = {"--out",     "--spp",   "--time",    "--error",   "--technique",
                                             "--threads", "--seed",  "--width",   "--height",  "--ocio",
                                             "--display", "--view",  "--look",    "--exposure", "--gamma",
-                                            "--channel-walks"};
+                                            "--channel-walks", "--samples"};
         int known = 0;
         for (size_t k = 0; k < sizeof flags / sizeof flags[0]; ++k) known |= strcmp(flag, flags[k]) == 0;
         if (!known) return cli_usage_error(verb, "unknown argument '%.64s'", flag);
         if (!(value = cli_flag_value(verb, argc, argv, &i))) return CLI_USAGE;
         uint64_t whole;
         double number;
-        if (strcmp(flag, "--out") == 0) {
+        if (strcmp(flag, "--samples") == 0) {
+            const char *colon = strchr(value, ':');
+            char head[32];
+            if (!colon || (size_t)(colon - value) >= sizeof head)
+                return cli_usage_error(verb, "--samples: '%.64s' is not FIRST:COUNT", value);
+            memcpy(head, value, (size_t)(colon - value));
+            head[colon - value] = '\0';
+            if (cli_parse_u64(verb, flag, head, &f->first) || cli_parse_u64(verb, flag, colon + 1, &f->count))
+                return CLI_USAGE;
+            if (f->count == 0u) return cli_usage_error(verb, "--samples: COUNT must be at least 1");
+            f->chunk = 1;
+            if (apply) {
+                o->sample_first = f->first;
+                o->sample_count = f->count;
+            }
+        } else if (strcmp(flag, "--out") == 0) {
             if (value[0] == '\0') return cli_usage_error(verb, "--out: the prefix is empty");
             f->prefix = value;
         } else if (strcmp(flag, "--ocio") == 0) {
@@ -112,6 +133,7 @@ static int parse_overrides(int argc, char **argv, bake_flags *f, dwv_bake_option
             if (apply) o->channel_walks = channel_walks;
         } else if (strcmp(flag, "--time") == 0 || strcmp(flag, "--error") == 0) {
             if (cli_parse_double(verb, flag, value, &number)) return CLI_USAGE;
+            f->budget = 1;
             if (apply) *(flag[2] == 't' ? &o->time_limit : &o->target_error) = number;
         } else {
             if (cli_parse_u64(verb, flag, value, &whole)) return CLI_USAGE;
@@ -159,13 +181,19 @@ static void end_progress(progress_state *state)
     state->drawn = 0;
 }
 
+static double s_seconds(const dwv_image_t *image)
+{
+    dwv_bake_stats_t s = DWV_BAKE_STATS_INIT;
+    return dwv_image_stats(image, &s) == DWV_SUCCESS ? s.seconds : 0.0;
+}
+
 /* path = prefix + suffix, or NULL after reporting when it does not fit. */
 static char *join(const char *prefix, const char *suffix)
 {
     size_t a = strlen(prefix), b = strlen(suffix);
     char *path = malloc(a + b + 1);
     if (!path) {
-        fprintf(stderr, "dwivedi bake: out of memory\n");
+        fprintf(stderr, "dwivedi %s: out of memory\n", verb_name);
         return NULL;
     }
     memcpy(path, prefix, a);
@@ -203,20 +231,20 @@ static int write_stats_json(const char *path, const dwv_image_t *image, const dw
     dwv_error_point_t *points = NULL;
     if (dwv_image_stats(image, &s) != DWV_SUCCESS ||
         dwv_image_error_vs_time(image, NULL, 0u, &count) != DWV_SUCCESS) {
-        fprintf(stderr, "dwivedi bake: %s\n", dwv_last_error_message());
+        fprintf(stderr, "dwivedi %s: %s\n", verb_name, dwv_last_error_message());
         return -1;
     }
     if (count > 0u) {
         points = calloc(count, sizeof *points);
         if (!points || dwv_image_error_vs_time(image, points, count, &count) != DWV_SUCCESS) {
-            fprintf(stderr, "dwivedi bake: %s\n", points ? dwv_last_error_message() : "out of memory");
+            fprintf(stderr, "dwivedi %s: %s\n", verb_name, points ? dwv_last_error_message() : "out of memory");
             free(points);
             return -1;
         }
     }
     FILE *out = fopen(path, "wb");
     if (!out) {
-        fprintf(stderr, "dwivedi bake: cannot write %s: %s\n", path, strerror(errno));
+        fprintf(stderr, "dwivedi %s: cannot write %s: %s\n", verb_name, path, strerror(errno));
         free(points);
         return -1;
     }
@@ -257,7 +285,7 @@ static int write_stats_json(const char *path, const dwv_image_t *image, const dw
     failed |= fflush(out) != 0;
     failed |= fsync(fileno(out)) != 0;
     if (fclose(out) != 0 || failed) {
-        fprintf(stderr, "dwivedi bake: cannot write %s: %s\n", path, strerror(errno));
+        fprintf(stderr, "dwivedi %s: cannot write %s: %s\n", verb_name, path, strerror(errno));
         remove(path);
         return -1;
     }
@@ -279,12 +307,12 @@ static int write_outputs(const char *prefix, const dwv_image_t *image, const dwv
             goto done;
     }
     if (dwv_image_write_exr(image, temp_path[0]) != DWV_SUCCESS) {
-        fprintf(stderr, "dwivedi bake: %s\n", dwv_last_error_message());
+        fprintf(stderr, "dwivedi %s: %s\n", verb_name, dwv_last_error_message());
         goto done;
     }
     written = 1;
     if (dwv_image_write_display_png(image, temp_path[1], display) != DWV_SUCCESS) {
-        fprintf(stderr, "dwivedi bake: %s\n", dwv_last_error_message());
+        fprintf(stderr, "dwivedi %s: %s\n", verb_name, dwv_last_error_message());
         goto done;
     }
     written = 2;
@@ -292,7 +320,7 @@ static int write_outputs(const char *prefix, const dwv_image_t *image, const dwv
     written = 3;
     for (int k = 0; k < 3; ++k) {
         if (rename(temp_path[k], final_path[k]) != 0) {
-            fprintf(stderr, "dwivedi bake: cannot rename %s to %s: %s\n", temp_path[k], final_path[k],
+            fprintf(stderr, "dwivedi %s: cannot rename %s to %s: %s\n", verb_name, temp_path[k], final_path[k],
                     strerror(errno));
             goto done;
         }
@@ -319,7 +347,7 @@ static int check_outputs_possible(const char *prefix, const dwv_display_options_
     if (!probe) return -1;
     FILE *f = fopen(probe, "wb");
     if (!f) {
-        fprintf(stderr, "dwivedi bake: --out %s: cannot create files there (%s): %s\n", prefix, probe, strerror(errno));
+        fprintf(stderr, "dwivedi %s: --out %s: cannot create files there (%s): %s\n", verb_name, prefix, probe, strerror(errno));
         free(probe);
         return -1;
     }
@@ -332,7 +360,7 @@ static int check_outputs_possible(const char *prefix, const dwv_display_options_
     int status = 0;
     if (dwv_image_create(1u, 1u, grey, &pixel) != DWV_SUCCESS ||
         dwv_image_to_display(pixel, display, rgba8, sizeof rgba8) != DWV_SUCCESS) {
-        fprintf(stderr, "dwivedi bake: %s\n", dwv_last_error_message());
+        fprintf(stderr, "dwivedi %s: %s\n", verb_name, dwv_last_error_message());
         status = -1;
     }
     dwv_image_release(pixel);
@@ -341,7 +369,7 @@ static int check_outputs_possible(const char *prefix, const dwv_display_options_
 
 static int run(int argc, char **argv)
 {
-    bake_flags f = {NULL, NULL, DWV_DISPLAY_OPTIONS_INIT, 0};
+    bake_flags f = {NULL, NULL, 0, 0, 0u, 0u, DWV_DISPLAY_OPTIONS_INIT, 0};
     dwv_bake_options_t o = DWV_BAKE_OPTIONS_INIT;
     /* first pass: syntax and the scene path; the scene's settings come next, then the flags win */
     if (parse_overrides(argc, argv, &f, &o, 0)) return CLI_USAGE;
@@ -350,12 +378,21 @@ static int run(int argc, char **argv)
     dwv_scene_t *scene = NULL;
     dwv_result_t r = f.scene_path ? dwv_scene_load(f.scene_path, &scene, &o) : dwv_scene_create_default(&scene, &o);
     if (r != DWV_SUCCESS) {
-        fprintf(stderr, "dwivedi bake: %s\n", dwv_last_error_message());
+        fprintf(stderr, "dwivedi %s: %s\n", verb_name, dwv_last_error_message());
         return CLI_FAILED;
     }
     if (parse_overrides(argc, argv, &f, &o, 1)) {
         dwv_scene_release(scene);
         return CLI_USAGE;
+    }
+    if (f.chunk) {
+        /* A chunk bakes its whole range: the scene file's budgets do not apply, explicit ones are refused. */
+        if (f.budget) {
+            dwv_scene_release(scene);
+            return cli_usage_error(verb, "--samples bakes the whole range: no --time or --error");
+        }
+        o.time_limit = 0.0;
+        o.target_error = 0.0;
     }
     if (check_outputs_possible(f.prefix, &f.display) != 0) {
         dwv_scene_release(scene);
@@ -375,7 +412,7 @@ static int run(int argc, char **argv)
     int exit_code = CLI_FAILED;
     r = dwv_bake_start(scene, &o, &bake);
     if (r != DWV_SUCCESS) {
-        fprintf(stderr, "dwivedi bake: %s\n", dwv_last_error_message());
+        fprintf(stderr, "dwivedi %s: %s\n", verb_name, dwv_last_error_message());
         exit_code = r == DWV_ERROR_OUT_OF_MEMORY ? CLI_FAILED : CLI_USAGE;
         goto done;
     }
@@ -391,12 +428,28 @@ static int run(int argc, char **argv)
     end_progress(&progress);
     r = dwv_bake_finish(bake, &image);
     if (r == DWV_ERROR_CANCELLED) {
-        fprintf(stderr, "dwivedi bake: cancelled; nothing written\n");
+        fprintf(stderr, "dwivedi %s: cancelled; nothing written\n", verb_name);
         exit_code = 130;
         goto done;
     }
     if (r != DWV_SUCCESS) {
-        fprintf(stderr, "dwivedi bake: %s\n", dwv_last_error_message());
+        fprintf(stderr, "dwivedi %s: %s\n", verb_name, dwv_last_error_message());
+        goto done;
+    }
+    if (f.chunk) {
+        char *path = join(f.prefix, ".dwvpart");
+        if (!path) goto done;
+        r = dwv_image_write_partial(image, path);
+        if (r != DWV_SUCCESS) {
+            fprintf(stderr, "dwivedi bake: %s\n", dwv_last_error_message());
+            free(path);
+            goto done;
+        }
+        printf("baked samples %llu:%llu of %llu, %ux%u, %.2f s\nwrote %s\n", (unsigned long long)o.sample_first,
+               (unsigned long long)o.sample_count, (unsigned long long)o.samples, o.width, o.height,
+               s_seconds(image), path);
+        free(path);
+        exit_code = CLI_OK;
         goto done;
     }
     if (write_outputs(f.prefix, image, &o, &f.display, f.scene_path ? f.scene_path : "default") != 0) goto done;
@@ -416,5 +469,95 @@ done:
     sigaction(SIGTERM, &old_term, NULL);
     return exit_code;
 }
+
+static void merge_help(FILE *out)
+{
+    fprintf(out,
+            "usage: dwivedi merge PART.dwvpart... --out PREFIX [--ocio CONFIG] [--display NAME] [--view NAME]\n"
+            "           [--look NAME] [--exposure E] [--gamma G]\n\n"
+            "Merges the chunks of a split bake ('dwivedi bake ... --samples FIRST:COUNT', docs/farm.md) into\n"
+            "PREFIX.exr, PREFIX.png and PREFIX.json, bit for bit what one 'dwivedi bake' of the same scene,\n"
+            "options, seed and --spp makes. The chunks must come from one scene, options, seed and library\n"
+            "version and cover the samples 0 to spp-1 exactly once, in any order; else nothing is written\n"
+            "and the message names the chunk at fault. error_vs_time has a point per chunk prefix in sample\n"
+            "order; its seconds are the chunks' bake seconds added up.\n");
+}
+
+static int merge_run(int argc, char **argv)
+{
+    static const char merge_verb[] = "merge";
+    verb_name = merge_verb;
+    dwv_display_options_t display = DWV_DISPLAY_OPTIONS_INIT;
+    const char *prefix = NULL;
+    const char **parts = calloc((size_t)argc + 1u, sizeof *parts);
+    if (!parts) {
+        fprintf(stderr, "dwivedi merge: out of memory\n");
+        return CLI_FAILED;
+    }
+    uint32_t count = 0;
+    int code = CLI_USAGE;
+    for (int i = 1; i < argc; ++i) {
+        const char *flag = argv[i], *value;
+        if (flag[0] != '-' || flag[1] == '\0') {
+            parts[count++] = flag;
+            continue;
+        }
+        static const char *const flags[] = {"--out", "--ocio", "--display", "--view", "--look", "--exposure", "--gamma"};
+        int known = 0;
+        for (size_t k = 0; k < sizeof flags / sizeof flags[0]; ++k) known |= strcmp(flag, flags[k]) == 0;
+        if (!known) {
+            cli_usage_error(merge_verb, "unknown argument '%.64s'", flag);
+            goto done;
+        }
+        if (!(value = cli_flag_value(merge_verb, argc, argv, &i))) goto done;
+        if (strcmp(flag, "--out") == 0) {
+            if (value[0] == '\0') {
+                cli_usage_error(merge_verb, "--out: the prefix is empty");
+                goto done;
+            }
+            prefix = value;
+        } else if (strcmp(flag, "--ocio") == 0) display.config_path = value;
+        else if (strcmp(flag, "--display") == 0) display.display = value;
+        else if (strcmp(flag, "--view") == 0) display.view = value;
+        else if (strcmp(flag, "--look") == 0) display.look = value;
+        else if (cli_parse_double(merge_verb, flag, value, strcmp(flag, "--gamma") == 0 ? &display.gamma : &display.exposure))
+            goto done;
+    }
+    if (!prefix) {
+        cli_usage_error(merge_verb, "--out PREFIX is required");
+        goto done;
+    }
+    if (count == 0u) {
+        cli_usage_error(merge_verb, "no chunk files given");
+        goto done;
+    }
+    code = CLI_FAILED;
+    if (check_outputs_possible(prefix, &display) != 0) goto done;
+    dwv_image_t *image = NULL;
+    if (dwv_merge_partials(parts, count, &image) != DWV_SUCCESS) {
+        fprintf(stderr, "dwivedi merge: %s\n", dwv_last_error_message());
+        goto done;
+    }
+    dwv_image_info_t info = DWV_IMAGE_INFO_INIT;
+    dwv_image_info(image, &info);
+    dwv_bake_options_t o = DWV_BAKE_OPTIONS_INIT;
+    o.width = info.width;
+    o.height = info.height;
+    if (write_outputs(prefix, image, &o, &display, "merged") == 0) {
+        dwv_bake_stats_t s = DWV_BAKE_STATS_INIT;
+        dwv_image_stats(image, &s);
+        printf("merged %u chunk(s): %ux%u, %llu spp, %.2f s of bakes, estimated relative error %.3g%%\n", count,
+               info.width, info.height, (unsigned long long)s.samples_per_pixel, s.seconds,
+               100.0 * s.estimated_relative_error);
+        printf("wrote %s.exr, %s.png, %s.json\n", prefix, prefix, prefix);
+        code = CLI_OK;
+    }
+    dwv_image_release(image);
+done:
+    free(parts);
+    return code;
+}
+
+const cli_verb cli_verb_merge = {"merge", "merge the chunks of a split bake into EXR, PNG and JSON", merge_run, merge_help};
 
 const cli_verb cli_verb_bake = {"bake", "bake a scene (or the default scene) to EXR, PNG and JSON", run, help};

@@ -19,6 +19,7 @@ extern const cli_verb cli_verb_v0;
 extern const cli_verb cli_verb_bench;
 extern const cli_verb cli_verb_estimate;
 extern const cli_verb cli_verb_bake;
+extern const cli_verb cli_verb_merge;
 
 /* `dwivedi bench bake` (bench_bake.c), reached through the bench verb. */
 int cli_bench_bake(int argc, char **argv);

@@ -5,7 +5,7 @@
 #include "cli.h"
 #include <dwivedi.h>
 
-static const cli_verb *const verbs[] = {&cli_verb_bake, &cli_verb_estimate, &cli_verb_v0, &cli_verb_bench};
+static const cli_verb *const verbs[] = {&cli_verb_bake, &cli_verb_merge, &cli_verb_estimate, &cli_verb_v0, &cli_verb_bench};
 #define VERB_COUNT (sizeof verbs / sizeof verbs[0])
 
 static void print_help(FILE *out)

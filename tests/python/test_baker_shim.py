@@ -81,7 +81,7 @@ class StructLayoutTest(unittest.TestCase):
         if ctypes.sizeof(ctypes.c_void_p) != 8:
             self.skipTest("the sizes below are those of an LP64 ABI")
         sizes = {"dwv_material_t": 192, "dwv_mesh_t": 152, "dwv_light_desc_t": 216, "dwv_camera_t": 128,
-                 "dwv_bake_progress_t": 48, "dwv_bake_options_t": 96, "dwv_image_info_t": 40,
+                 "dwv_bake_progress_t": 48, "dwv_bake_options_t": 112, "dwv_image_info_t": 40,
                  "dwv_bake_stats_t": 128, "dwv_error_point_t": 24, "dwv_display_options_t": 56}
         for name, size in sizes.items():
             self.assertEqual(ctypes.sizeof(self.STRUCTS[name]), size, name)
@@ -115,7 +115,7 @@ class StructLayoutTest(unittest.TestCase):
     def test_defaults_are_the_init_macros(self):
         options = _library.BakeOptions()
         self.assertEqual((options.struct_size, options.width, options.height, options.uv_margin, options.samples),
-                         (96, 256, 256, 16, 64))
+                         (112, 256, 256, 16, 64))
         settings = dwivedi.BakeSettings()
         self.assertEqual((settings.width, settings.height, settings.uv_margin, settings.samples, settings.technique),
                          (256, 256, 16, 64, "auto"))
