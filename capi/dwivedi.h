@@ -430,6 +430,64 @@ enum {
     DWV_SUBSURFACE_EXIT_PRINCIPLED_V1 = 1
 };
 
+/* Which Cycles subsurface model a material's walk follows (dwv_material_t.subsurface_model):
+ * how the radius becomes the medium's extinction, the colour its single-scattering albedo, the
+ * anisotropy's clamp, and how light enters. Every model: a channel whose radius x scale is below
+ * 1e-8 is Lambertian diffuse; the walk's throughput is scaled by alpha / 0.2 where alpha < 0.2
+ * (alpha raised to 0.2); the exit is subsurface_exit's. Cycles' source (bssrdf.h,
+ * subsurface_random_walk.h, subsurface.h) per release; docs/blender-compatibility.md. */
+typedef int32_t dwv_subsurface_model_t;
+enum {
+    /* Blender 3.x "Random Walk (Fixed Radius)" (and every material made before this field):
+     * reduced mean free path d = radius x scale / (4 pi), sigma_t = 1 / (d (1 - g)), albedo by
+     * Cycles' fit after Chiang et al. 2016, g clamped to [0, 0.9], entry cosine-weighted diffuse
+     * transmission. */
+    DWV_SUBSURFACE_MODEL_FIXED_RADIUS = 0,
+    /* Blender 3.x "Random Walk": as above but d = radius x scale x sqrt(3 (1 - a')), a' the
+     * albedo for which Jensen's dipole Rd(a') = a'/2 (1 + exp(-(4/3) A s)) exp(-s), s =
+     * sqrt(3 (1 - a')), A = (1 + Fdr) / (1 - Fdr), Fdr(subsurface_ior clamped to [1.01, 3.8]), is
+     * the colour (Cycles' 12 bisection steps); diffuse entry. */
+    DWV_SUBSURFACE_MODEL_BLENDER3_RANDOM_WALK = 1,
+    /* Blender 4.0-5.1 "Random Walk" (stored as the old Fixed Radius): the fixed-radius medium,
+     * entered by GGX refraction (VNDF sampling with alpha = roughness^2, then refraction with ior
+     * clamped to [1.01, 3.8]; unit weight: Cycles uses it as a direction distribution only). */
+    DWV_SUBSURFACE_MODEL_BLENDER4_RANDOM_WALK = 2,
+    /* Blender 4.0-5.1 "Random Walk (Skin)": the 3.x Random Walk's rescaled radius (with
+     * subsurface_ior), entered half by diffuse transmission, half by GGX refraction with
+     * subsurface_ior at alpha 1. */
+    DWV_SUBSURFACE_MODEL_BLENDER4_SKIN = 3,
+    /* Blender 5.2 "Random Walk": mean free path = radius x scale (sigma_t = 1 / mfp), albedo by van
+     * de Hulst's mapping (d'Eon, "A Hitchhiker's Guide to Multiple Scattering", Eq. 53.7),
+     * alpha = (1 - s^2) / (1 - g s^2), s = 4.20863 A - sqrt(9.59217 + 41.6808 A + 17.7126 A^2)
+     * + 4.09712, g clamped to [-0.99, 0.99]; refraction entry as 4.x. */
+    DWV_SUBSURFACE_MODEL_BLENDER52_RANDOM_WALK = 4,
+    /* Blender 5.2 "Random Walk (Legacy)": the 4.x Random Walk with g clamped to [-0.99, 0.9] and,
+     * for g < 0, van de Hulst's albedo with sigma_t = 1 / d. */
+    DWV_SUBSURFACE_MODEL_BLENDER52_LEGACY = 5,
+    /* Blender 5.2 "Random Walk (Skin)": the 4.x Skin with 5.2's Legacy anisotropy rule. */
+    DWV_SUBSURFACE_MODEL_BLENDER52_SKIN = 6
+};
+
+/* The dielectric specular layer over the diffuse and subsurface (dwv_material_t.specular_model).
+ * Lit by the lights and the world at the entry point (one bounce, as the rest of the surface). */
+typedef int32_t dwv_specular_model_t;
+enum {
+    DWV_SPECULAR_NONE = 0,
+    /* Blender 3.x Principled v1 (svm_closure.h, bsdf_microfacet.h): added on top (the diffuse and
+     * subsurface keep their weight): GGX, f = F D G1(V) G1(L) / (4 cosL cosV), alpha = roughness^2,
+     * F = cspec0 + (1 - cspec0) (F_d(L.H, eta) - F0) / (1 - F0), F_d the dielectric Fresnel,
+     * eta = 2 / (1 - sqrt(0.08 specular)) - 1, F0 = F_d(1, eta), cspec0 = 0.08 specular
+     * mix(1, base / lum(base), tint), lum = 0.3 r + 0.6 g + 0.1 b. */
+    DWV_SPECULAR_PRINCIPLED_V1 = 1,
+    /* Blender 4.x/5.x Principled v2: GGX, f = F D G2 / (4 cosL cosV), G2 = 1 / (1 + Lambda(V) +
+     * Lambda(L)) (height-correlated Smith), F = f0 + (1 - f0) clamp((F_d(V.H, eta) - F0) / (1 -
+     * F0)), F0 = ((ior - 1) / (ior + 1))^2 x 2 specular, f0 = F0 x specular_tint, eta from F0;
+     * Multiscatter GGX scales it by 1 + Fms (1 - E) / E (Kulla and Conty 2017). The layers below
+     * (diffuse and subsurface) are weighted by 1 - max over channels of its albedo toward the
+     * viewer (Cycles' closure_layering_weight). */
+    DWV_SPECULAR_PRINCIPLED_V2 = 2
+};
+
 /* A material in the terms of Cycles' Principled BSDF with subsurface method "Random Walk (Fixed
  * Radius)", Blender 4.x naming: the surface is (1 - subsurface_weight) Lambertian diffuse of
  * base_color plus subsurface_weight random-walk subsurface scattering whose multiple-scattering
@@ -454,11 +512,30 @@ typedef struct dwv_material_t {
      * (DWV_SUBSURFACE_EXIT_LAMBERT, roughness 0.5): its materials bake as they always did. */
     dwv_subsurface_exit_t subsurface_exit; /* DWV_SUBSURFACE_EXIT_* */
     uint32_t reserved;            /* 0 */
-    double roughness;             /* in [0, 1]: the retro-reflection lobe's (DWV_SUBSURFACE_EXIT_PRINCIPLED_V1) */
+    double roughness;             /* in [0, 1]: the retro-reflection lobe's (DWV_SUBSURFACE_EXIT_PRINCIPLED_V1),
+                                     the specular layer's and the refraction entry's (Principled Roughness) */
+    /* Added after 0.2 (issue 17). A caller whose struct_size ends before them gets the defaults
+     * (DWV_SUBSURFACE_MODEL_FIXED_RADIUS, DWV_SPECULAR_NONE): its materials bake as they did. */
+    dwv_subsurface_model_t subsurface_model; /* DWV_SUBSURFACE_MODEL_* */
+    dwv_specular_model_t specular_model;     /* DWV_SPECULAR_* */
+    double ior;                   /* in [1, 4]: Principled "IOR" (4.x+: specular layer and refraction entry) */
+    double specular;              /* >= 0, finite: 3.x "Specular" (DWV_SPECULAR_PRINCIPLED_V1) or 4.x+
+                                     "Specular IOR Level" (DWV_SPECULAR_PRINCIPLED_V2; 0.5 keeps ior's F0) */
+    double specular_tint[3];      /* in [0, 1]: 4.x+ "Specular Tint" colour; 3.x's Specular Tint factor is
+                                     specular_tint[0] (the others are ignored) */
+    int32_t specular_multiscatter; /* 0: GGX; 1: Multiscatter GGX (4.x+: energy-compensated; refused with
+                                     DWV_SPECULAR_PRINCIPLED_V1, whose multiscatter is a stochastic walk) */
+    uint32_t reserved2;           /* 0 */
+    /* >= 0, finite: in camera bakes a channel whose radius x scale is below this many times the
+     * camera ray's footprint at the hit (Cycles' sd->dP: distance x the pixel's angular spread, or
+     * the pixel's width for an orthographic camera) is Lambertian there: Cycles 4.0-4.4's "fall back
+     * to diffuse if the radius is smaller than a quarter pixel" (0.25). 0: never (UV bakes: never). */
+    double subsurface_min_footprint;
 } dwv_material_t;
 #define DWV_MATERIAL_INIT                                                                           \
     {sizeof(dwv_material_t), DWV_MATERIAL_SUBSURFACE, {0.8, 0.8, 0.8}, 1.0, {0.8, 0.8, 0.8},         \
-     {1.0, 0.2, 0.1}, 0.05, 0.0, 1.4, DWV_SUBSURFACE_EXIT_LAMBERT, 0u, 0.5}
+     {1.0, 0.2, 0.1}, 0.05, 0.0, 1.4, DWV_SUBSURFACE_EXIT_LAMBERT, 0u, 0.5,                          \
+     DWV_SUBSURFACE_MODEL_FIXED_RADIUS, DWV_SPECULAR_NONE, 1.5, 0.5, {1.0, 1.0, 1.0}, 0, 0u, 0.0}
 
 /* Adds a material; *material_id numbers them from 0 in order. */
 DWV_API dwv_result_t dwv_scene_add_material(dwv_scene_t *scene, const dwv_material_t *material,

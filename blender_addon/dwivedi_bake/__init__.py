@@ -243,6 +243,9 @@ class DwivediBakeSettings(bpy.types.PropertyGroup):
                                 default=0.0, min=0.0, max=1.0, precision=4)
     threads: IntProperty(name="Threads", description="0: all cores", default=0, min=0, max=1024)
     seed: IntProperty(name="Seed", default=0, min=0)
+    walk_event_cap: IntProperty(name="Walk Event Cap", default=0, min=0, description=(
+        "Scattering events per walk at most; 0: 10^6 (dwivedi keeps the light Cycles loses on thick, high-albedo "
+        "objects); 256: Cycles' own cap (BSSRDF_MAX_BOUNCES), to match its render there"))
     output_dir: StringProperty(name="Output Folder", description="Where the EXR and PNG are written",
                                default="//dwivedi_bake/", subtype='DIR_PATH')
     uv_object: PointerProperty(name="UV Object", type=bpy.types.Object, poll=_poll_mesh,
@@ -315,7 +318,8 @@ class _Job:
             target=settings.target.lower(), width=self.exported.width, height=self.exported.height,
             uv_mesh=self.exported.uv_mesh, uv_margin=settings.uv_margin, technique=settings.technique.lower(),
             channel_walks=settings.channel_walks.lower(), samples=settings.samples, time_limit=settings.time_limit,
-            target_error=settings.target_error, threads=settings.threads, seed=settings.seed)
+            target_error=settings.target_error, threads=settings.threads, seed=settings.seed,
+            max_events=settings.walk_event_cap)
         self.display = display_settings(scene, self.dwivedi)
         self.bake = None
 
@@ -565,6 +569,7 @@ class DWIVEDI_PT_bake(bpy.types.Panel):
         col.prop(settings, "time_limit")
         col.prop(settings, "target_error")
         layout.prop(settings, "threads")
+        layout.prop(settings, "walk_event_cap")
         layout.prop(settings, "seed")
         layout.prop(settings, "output_dir")
         layout.prop(settings, "load_result")

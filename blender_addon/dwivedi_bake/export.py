@@ -87,12 +87,63 @@ def _surface_shader(material: Any) -> Any:
     return None
 
 
-def material_from_blender(material: Any, dwivedi: Any, warnings: List[str]) -> Any:
-    """A dwivedi.Material from a Blender material (None: Blender's default grey surface).
+def subsurface_model(version: Tuple[int, ...], method: str) -> Tuple[str, Optional[str]]:
+    """The dwivedi subsurface model (dwivedi.SUBSURFACE_MODELS) of a Blender version's subsurface
+    method (the Principled BSDF's subsurface_method or the Subsurface Scattering node's falloff),
+    and a note where it is not modelled exactly (Christensen-Burley, an unknown method).
 
-    Blender 4.x: Subsurface Weight, Subsurface Scale, Subsurface Radius, the base colour is the
+    The identifiers keep their stored values across releases while their meaning moves: 3.x
+    RANDOM_WALK_FIXED_RADIUS / RANDOM_WALK are 4.0's RANDOM_WALK / RANDOM_WALK_SKIN; 5.2 adds a
+    new RANDOM_WALK and keeps the 4.x one as RANDOM_WALK_LEGACY (docs/blender-compatibility.md)."""
+    version = tuple(version)
+    if version < (4, 0, 0):
+        table = {'RANDOM_WALK_FIXED_RADIUS': "fixed_radius", 'RANDOM_WALK': "blender3_random_walk"}
+    elif version < (5, 2, 0):
+        table = {'RANDOM_WALK': "blender4_random_walk", 'RANDOM_WALK_SKIN': "blender4_skin"}
+    else:
+        table = {'RANDOM_WALK': "blender52_random_walk", 'RANDOM_WALK_LEGACY': "blender52_legacy",
+                 'RANDOM_WALK_SKIN': "blender52_skin"}
+    if method in table:
+        return table[method], None
+    if method == 'BURLEY':
+        return "fixed_radius", ("subsurface method Christensen-Burley is not modelled: baked as 3.x Random Walk "
+                                "(Fixed Radius), whose radius scaling it shares")
+    return "fixed_radius", f"subsurface method {method} is not known to dwivedi: baked as Random Walk (Fixed Radius)"
+
+
+def _nonzero(node: Any, names: Tuple[str, ...]) -> bool:
+    socket = _input(node, names)
+    if socket is None:
+        return False
+    if socket.is_linked:
+        return True
+    value = socket.default_value
+    try:
+        return any(float(v) != 0.0 for v in tuple(value)[:3])  # a colour's alpha is not its amount
+    except TypeError:
+        return float(value) != 0.0
+
+
+# Principled inputs dwivedi does not model, by the name of the feature, per Blender generation.
+_UNMODELLED_3X = (("Metallic", ("Metallic",)), ("Transmission", ("Transmission",)), ("Sheen", ("Sheen",)),
+                  ("Clearcoat", ("Clearcoat",)), ("Anisotropic", ("Anisotropic",)))
+_UNMODELLED_4X = (("Metallic", ("Metallic",)), ("Transmission", ("Transmission Weight",)),
+                  ("Coat", ("Coat Weight",)), ("Sheen", ("Sheen Weight",)), ("Anisotropic", ("Anisotropic",)),
+                  ("Thin Film", ("Thin Film Thickness",)), ("Diffuse Roughness", ("Diffuse Roughness",)))
+
+
+def material_from_blender(material: Any, dwivedi: Any, warnings: List[str],
+                          version: Optional[Tuple[int, ...]] = None) -> Any:
+    """A dwivedi.Material from a Blender material (None: Blender's default grey surface), as the
+    Cycles of Blender `version` (default bpy.app.version) shades it: the subsurface model of the
+    node's method (subsurface_model), the Principled specular layer (3.x v1 or 4.x+ v2) and exit.
+
+    Blender 4.x+: Subsurface Weight, Subsurface Scale, Subsurface Radius, the base colour is the
     subsurface colour. Blender 3.x: Subsurface (a factor that also scales the radius), Subsurface
     Color mixed with Base Color by it, Subsurface Radius (see dwv_material_t)."""
+    if version is None:
+        version = tuple(bpy.app.version) if bpy is not None else (3, 4, 0)
+    version = tuple(version)
     if material is None:
         return dwivedi.Material.diffuse((0.8, 0.8, 0.8))
     name = material.name
@@ -101,49 +152,94 @@ def material_from_blender(material: Any, dwivedi: Any, warnings: List[str]) -> A
         warnings.append(f"material '{name}' has no Principled BSDF or Subsurface Scattering node: baked as "
                         "diffuse in its viewport colour")
         return dwivedi.Material.diffuse(tuple(material.diffuse_color)[:3])
+    blender4 = version >= (4, 0, 0)
     if node.type == 'SUBSURFACE_SCATTERING':
-        # Color is the walk's albedo, Radius x Scale its radius; exit Lambertian (Cycles gives
-        # this node no roughness: no retro-reflection, no Fresnel-weighted exit).
+        # Color is the walk's albedo, Radius x Scale its radius; exit Lambertian (no retro-reflection,
+        # no Fresnel-weighted exit). 4.x+: the entry refracts with the node's IOR and alpha =
+        # Roughness itself (svm_closure.h: bssrdf->alpha = saturate(Roughness)), hence roughness =
+        # sqrt(Roughness) for dwivedi's alpha = roughness^2.
         color = _value(node, ("Color",), (0.8, 0.8, 0.8, 1.0), name, warnings)[:3]
-        out = dwivedi.Material(base_color=color, subsurface_weight=1.0, subsurface_color=color,
-                               subsurface_radius=_value(node, ("Radius",), (1.0, 0.2, 0.1), name, warnings)[:3],
-                               subsurface_scale=_value(node, ("Scale",), 0.05, name, warnings),
-                               subsurface_anisotropy=max(-0.9, min(0.9, _value(node, ("Anisotropy",), 0.0, name,
-                                                                                 warnings))),
-                               subsurface_ior=min(max(_value(node, ("IOR",), 1.4, name, warnings), 1.0), 4.0))
-        if getattr(node, "falloff", 'RANDOM_WALK_FIXED_RADIUS') != 'RANDOM_WALK_FIXED_RADIUS':
-            warnings.append(f"material '{name}': subsurface method {node.falloff} is baked as Random Walk "
-                            "(Fixed Radius)")
-        return out
+        ior = min(max(_value(node, ("IOR",), 1.4, name, warnings), 1.0), 4.0)
+        model, note = subsurface_model(version, getattr(node, "falloff", 'RANDOM_WALK_FIXED_RADIUS'))
+        if note:
+            warnings.append(f"material '{name}': {note}")
+        node_roughness = min(max(_value(node, ("Roughness",), 1.0, name, warnings), 0.0), 1.0) if blender4 else 1.0
+        return dwivedi.Material(base_color=color, subsurface_weight=1.0, subsurface_color=color,
+                                subsurface_min_footprint=footprint_rule(version),
+                                subsurface_radius=_value(node, ("Radius",), (1.0, 0.2, 0.1), name, warnings)[:3],
+                                subsurface_scale=_value(node, ("Scale",), 0.05, name, warnings),
+                                subsurface_anisotropy=max(-0.99, min(0.99, _value(node, ("Anisotropy",), 0.0, name,
+                                                                                  warnings))),
+                                subsurface_ior=ior, ior=ior, roughness=math.sqrt(node_roughness),
+                                subsurface_model=model)
     method = getattr(node, "subsurface_method", 'RANDOM_WALK_FIXED_RADIUS')
     base = _value(node, ("Base Color",), (0.8, 0.8, 0.8, 1.0), name, warnings)[:3]
+    base = tuple(min(max(float(c), 0.0), 1.0) for c in base)
     radius = _value(node, ("Subsurface Radius",), (1.0, 0.2, 0.1), name, warnings)[:3]
     anisotropy = _value(node, ("Subsurface Anisotropy",), 0.0, name, warnings)
-    ior = _value(node, ("Subsurface IOR", "IOR"), 1.4, name, warnings)
-    ior = min(max(ior, 1.0), 4.0)
-    for label, names in (("Metallic", ("Metallic",)), ("Transmission", ("Transmission Weight", "Transmission"))):
-        socket = _input(node, names)
-        if socket is not None and not socket.is_linked and float(socket.default_value) > 0.0:
-            warnings.append(f"material '{name}': {label} is not modelled by dwivedi (ignored)")
-    if _input(node, ("Subsurface Weight",)) is not None:  # Blender 4.x
-        weight = _value(node, ("Subsurface Weight",), 0.0, name, warnings)
+    sss_ior = min(max(_value(node, ("Subsurface IOR",), 1.4, name, warnings), 1.0), 4.0)
+    roughness = min(max(_value(node, ("Roughness",), 0.5, name, warnings), 0.0), 1.0)
+    distribution = getattr(node, "distribution", 'GGX')
+    unmodelled = [label for label, names in (_UNMODELLED_4X if blender4 else _UNMODELLED_3X) if _nonzero(node, names)]
+    if _input(node, ("Emission Strength",)) is not None and _nonzero(node, ("Emission Strength",)) and \
+            _nonzero(node, ("Emission Color", "Emission")):
+        unmodelled.append("Emission")
+    alpha_socket = _input(node, ("Alpha",))
+    if alpha_socket is not None and (alpha_socket.is_linked or float(alpha_socket.default_value) < 1.0):
+        unmodelled.append("Alpha")
+    thin_wall = _input(node, ("Thin Wall",))
+    if thin_wall is not None and (thin_wall.is_linked or bool(thin_wall.default_value)):
+        unmodelled.append("Thin Wall (baked as a solid)")
+    if unmodelled:
+        warnings.append(f"material '{name}': {', '.join(unmodelled)} not modelled by dwivedi (ignored)")
+    if blender4:
+        weight = min(max(_value(node, ("Subsurface Weight",), 0.0, name, warnings), 0.0), 1.0)
         scale = _value(node, ("Subsurface Scale",), 0.05, name, warnings)
+        ior = min(max(_value(node, ("IOR",), 1.5, name, warnings), 1.0), 4.0)
+        level = max(_value(node, ("Specular IOR Level",), 0.5, name, warnings), 0.0)
+        tint = tuple(min(max(float(c), 0.0), 1.0) for c in _value(node, ("Specular Tint",), (1.0, 1.0, 1.0, 1.0),
+                                                                  name, warnings)[:3])
         out = dwivedi.Material(base_color=base, subsurface_weight=weight, subsurface_color=base,
                                subsurface_radius=radius, subsurface_scale=scale, subsurface_anisotropy=anisotropy,
-                               subsurface_ior=ior, kind="subsurface" if weight > 0.0 else "diffuse")
+                               subsurface_ior=sss_ior, kind="subsurface" if weight > 0.0 else "diffuse",
+                               roughness=roughness, ior=ior, specular_model="principled_v2", specular=level,
+                               specular_tint=tint, specular_multiscatter=distribution == 'MULTI_GGX')
     else:  # Blender 3.x
         factor = _value(node, ("Subsurface",), 0.0, name, warnings)
         # Cycles 3.x's Principled (v1) adds to the walk a retro-reflection lobe (by Roughness)
-        # and weights the exit by 1 - (1 - cos)^5 / 2: from_blender_3x selects that exit.
-        roughness = min(max(_value(node, ("Roughness",), 0.5, name, warnings), 0.0), 1.0)
+        # and weights the exit by 1 - (1 - cos)^5 / 2: from_blender_3x selects that exit. Its
+        # specular (GGX over everything, not layered) is DWV_SPECULAR_PRINCIPLED_V1.
         color = _value(node, ("Subsurface Color",), (0.8, 0.8, 0.8, 1.0), name, warnings)[:3]
-        out = dwivedi.Material.from_blender_3x(base, factor, color, radius, anisotropy, ior, roughness)
+        out = dwivedi.Material.from_blender_3x(base, factor, color, radius, anisotropy, sss_ior, roughness)
         if factor <= 0.0:
             out.kind = "diffuse"
-    if out.kind == "subsurface" and method != 'RANDOM_WALK_FIXED_RADIUS':
-        warnings.append(f"material '{name}': subsurface method {method} is baked as Random Walk (Fixed Radius)")
-    out.subsurface_anisotropy = max(-0.9, min(0.9, out.subsurface_anisotropy))  # Cycles' clamp
+        specular = max(_value(node, ("Specular",), 0.5, name, warnings), 0.0)
+        if specular >= 12.5:
+            warnings.append(f"material '{name}': Specular {specular:g} is clamped to 12.4 (Cycles' IOR for it is "
+                            "infinite from 12.5)")
+            specular = 12.4
+        out.specular_model = "principled_v1"
+        out.specular = specular
+        tint = min(max(_value(node, ("Specular Tint",), 0.0, name, warnings), 0.0), 1.0)
+        out.specular_tint = (tint, tint, tint)
+        out.ior = min(max(_value(node, ("IOR",), 1.45, name, warnings), 1.0), 4.0)
+        if distribution == 'MULTI_GGX' and roughness > 0.075:
+            warnings.append(f"material '{name}': Multiscatter GGX (3.x's stochastic microsurface walk) is not "
+                            "modelled: its specular is baked as GGX")
+    if out.kind == "subsurface":
+        model, note = subsurface_model(version, method)
+        out.subsurface_model = model
+        if note:
+            warnings.append(f"material '{name}': {note}")
+    out.subsurface_anisotropy = max(-0.99, min(0.99, out.subsurface_anisotropy))  # the library clamps per model
+    out.subsurface_min_footprint = footprint_rule(version)
     return out
+
+
+def footprint_rule(version: Tuple[int, ...]) -> float:
+    """Cycles 4.0-4.4's bssrdf_setup turns a channel whose radius is below a quarter of the camera
+    ray's footprint into diffuse (removed in 4.5): 0.25 there, else 0."""
+    return 0.25 if (4, 0, 0) <= tuple(version) < (4, 5, 0) else 0.0
 
 
 # ---------------------------------------------------------------------------------------------

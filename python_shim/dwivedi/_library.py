@@ -138,6 +138,14 @@ class Material(_SizedStructure):
         ("subsurface_exit", ctypes.c_int32),
         ("reserved", ctypes.c_uint32),
         ("roughness", ctypes.c_double),
+        ("subsurface_model", ctypes.c_int32),
+        ("specular_model", ctypes.c_int32),
+        ("ior", ctypes.c_double),
+        ("specular", ctypes.c_double),
+        ("specular_tint", _Vec3),
+        ("specular_multiscatter", ctypes.c_int32),
+        ("reserved2", ctypes.c_uint32),
+        ("subsurface_min_footprint", ctypes.c_double),
     ]
 
 

@@ -134,6 +134,11 @@ def feature_names(features: int) -> Tuple[str, ...]:
 
 _MATERIAL_KINDS = {"subsurface": 0, "diffuse": 1}
 _SUBSURFACE_EXITS = {"lambert": 0, "principled_v1": 1}
+# dwv_subsurface_model_t (capi/dwivedi.h): which Cycles release's walk, by Blender version and method.
+SUBSURFACE_MODELS = {"fixed_radius": 0, "blender3_random_walk": 1, "blender4_random_walk": 2, "blender4_skin": 3,
+                     "blender52_random_walk": 4, "blender52_legacy": 5, "blender52_skin": 6}
+# dwv_specular_model_t: the Principled BSDF's dielectric specular layer.
+SPECULAR_MODELS = {"none": 0, "principled_v1": 1, "principled_v2": 2}
 
 
 @dataclass
@@ -149,6 +154,16 @@ class Material:
     subsurface_exit: "lambert" (a Lambertian exit: the Subsurface Scattering node, Blender 4.x's
     Principled) or "principled_v1" (Blender 3.x's Principled: the exit weighted by
     1 - (1 - cos)^5 / 2 and a retro-reflection lobe of this roughness; see capi/dwivedi.h).
+
+    subsurface_model: one of SUBSURFACE_MODELS ("fixed_radius", "blender3_random_walk",
+    "blender4_random_walk", "blender4_skin", "blender52_random_walk", "blender52_legacy",
+    "blender52_skin"): the radius scaling, albedo mapping, anisotropy clamp and entry of that Cycles
+    (dwv_subsurface_model_t). specular_model: "none", "principled_v1" (3.x: Specular, Specular
+    Tint as specular_tint[0], Roughness) or "principled_v2" (4.x+: ior, Specular IOR Level as
+    `specular`, the Specular Tint colour, Roughness, specular_multiscatter for Multiscatter GGX).
+    subsurface_min_footprint: Cycles 4.0-4.4 turn a channel whose radius is below a quarter of the
+    camera ray's footprint into diffuse (0.25; 0: never). The add-on sets all of these from
+    bpy.app.version and the node (blender_addon/dwivedi_bake/export.py).
     """
 
     base_color: Color = (0.8, 0.8, 0.8)
@@ -161,6 +176,13 @@ class Material:
     kind: str = "subsurface"
     subsurface_exit: str = "lambert"
     roughness: float = 0.5
+    subsurface_model: str = "fixed_radius"
+    specular_model: str = "none"
+    ior: float = 1.5
+    specular: float = 0.5
+    specular_tint: Color = (1.0, 1.0, 1.0)
+    specular_multiscatter: bool = False
+    subsurface_min_footprint: float = 0.0
 
     @classmethod
     def diffuse(cls, color: Color) -> "Material":
@@ -197,6 +219,15 @@ class Material:
         out.subsurface_ior = _real("subsurface_ior", self.subsurface_ior)
         out.subsurface_exit = _name_code("subsurface exit", self.subsurface_exit, _SUBSURFACE_EXITS)
         out.roughness = _real("roughness", self.roughness)
+        out.subsurface_model = _name_code("subsurface model", self.subsurface_model, SUBSURFACE_MODELS)
+        out.specular_model = _name_code("specular model", self.specular_model, SPECULAR_MODELS)
+        out.ior = _real("ior", self.ior)
+        out.specular = _real("specular", self.specular)
+        out.specular_tint[:] = real_tuple(self.specular_tint, "specular_tint", 3)
+        if not isinstance(self.specular_multiscatter, (bool, int)) or int(self.specular_multiscatter) not in (0, 1):
+            raise ValueError(f"specular_multiscatter must be True or False, not {self.specular_multiscatter!r}")
+        out.specular_multiscatter = int(self.specular_multiscatter)
+        out.subsurface_min_footprint = _real("subsurface_min_footprint", self.subsurface_min_footprint)
         return out
 
 

@@ -128,6 +128,30 @@ dwv_result_t dwv_scene_add_material(dwv_scene_t *scene, const dwv_material_t *ma
                         "%s: subsurface_exit %d is neither Lambert (0) nor Principled v1 (1)", fn,
                         (int)material->subsurface_exit);
     DWV_TRY(dwv_check_range(fn, "roughness", material->roughness, 0.0, 1.0));
+    if (material->subsurface_model < DWV_SUBSURFACE_MODEL_FIXED_RADIUS ||
+        material->subsurface_model > DWV_SUBSURFACE_MODEL_BLENDER52_SKIN)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
+                        "%s: subsurface_model %d is not a DWV_SUBSURFACE_MODEL_* value (0 to 6)", fn,
+                        (int)material->subsurface_model);
+    if (material->specular_model < DWV_SPECULAR_NONE || material->specular_model > DWV_SPECULAR_PRINCIPLED_V2)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
+                        "%s: specular_model %d is not a DWV_SPECULAR_* value (none 0, Principled v1 1, v2 2)", fn,
+                        (int)material->specular_model);
+    DWV_TRY(dwv_check_range(fn, "ior", material->ior, 1.0, 4.0));
+    DWV_TRY(dwv_check_range(fn, "specular", material->specular, 0.0, HUGE_VAL));
+    DWV_TRY(check_array(fn, "specular_tint", material->specular_tint, 3, 0.0, 1.0));
+    if (material->specular_multiscatter != 0 && material->specular_multiscatter != 1)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: specular_multiscatter = %d is neither 0 (GGX) nor 1", fn,
+                        (int)material->specular_multiscatter);
+    DWV_TRY(dwv_check_range(fn, "subsurface_min_footprint", material->subsurface_min_footprint, 0.0, 1e6));
+    if (material->specular_model == DWV_SPECULAR_PRINCIPLED_V1 && !(material->specular < 12.5))
+        return dwv_fail(DWV_ERROR_OUT_OF_RANGE,
+                        "%s: specular = %.17g: the 3.x Principled v1 specular needs Specular below 12.5 (its IOR "
+                        "2 / (1 - sqrt(0.08 Specular)) - 1 is infinite there)", fn, material->specular);
+    if (material->specular_multiscatter && material->specular_model == DWV_SPECULAR_PRINCIPLED_V1)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
+                        "%s: Multiscatter GGX is not modelled for the 3.x Principled v1 specular (Cycles 3.x walks "
+                        "the microsurface); use GGX (specular_multiscatter 0)", fn);
     if (s->material_count >= DWVB_MAX_MATERIALS)
         return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: a scene holds at most %u materials", fn, DWVB_MAX_MATERIALS);
     if (dwvb_scene_push_material(s, material)) return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "%s: out of memory", fn);

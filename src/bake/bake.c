@@ -386,6 +386,16 @@ dwv_result_t dwvb_bake_start(dwvb_scene *scene, const dwv_bake_options_t *option
     bake->shader.channel_counts = bake->channel_counts;
     bake->shader.needs_closest = bake->needs_closest;
     bake->shader.max_events = options->max_events;
+    if (options->target == DWV_BAKE_CAMERA) {
+        /* The pixel's footprint for Cycles 4.0-4.4's quarter-pixel rule (shade.h). */
+        double px = 2.0 / bake->width, py = 2.0 / bake->height;
+        bake->shader.footprint = scene->camera.kind == DWV_CAMERA_PERSPECTIVE ? 1 : 2;
+        bake->shader.eye = bake->eye;
+        bake->shader.forward = bake->forward;
+        bake->shader.pixel_right = dwvu_scale(bake->right, px);
+        bake->shader.pixel_up = dwvu_scale(bake->up, py);
+        bake->shader.pixel = dwvu_length(bake->shader.pixel_right);
+    }
     bake->start = dwvu_clock_seconds();
     if (pthread_create(&bake->control, NULL, control, bake) != 0) {
         release_parts(bake);

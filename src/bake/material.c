@@ -3,6 +3,22 @@
 #include <math.h>
 
 #define FOUR_PI 12.566370614359172954
+#define PI 3.14159265358979323846
+
+static dwvu_vec3 cross3(dwvu_vec3 a, dwvu_vec3 b)
+{
+    return dwvu_v(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+
+/* Linear interpolation of a table over mu in [0, 1] (DWVB_SPEC_MU points). */
+static double spec_table(const double *t, double mu)
+{
+    double x = fmin(fmax(mu, 0.0), 1.0) * (DWVB_SPEC_MU - 1);
+    int i = (int)x;
+    if (i >= DWVB_SPEC_MU - 1) return t[DWVB_SPEC_MU - 1];
+    double f = x - i;
+    return t[i] * (1.0 - f) + t[i + 1] * f;
+}
 
 /* Horner evaluation of c[0] + c[1] g + ... + c[7] g^7. */
 static double poly7(const double c[8], double g)
@@ -64,6 +80,272 @@ double dwvb_principled_diffuse_factor(double cos_light, double cos_view, double 
     return lambert + dwvb_principled_retro_factor(cos_light, cos_view, light_dot_view, roughness);
 }
 
+double dwvb_fresnel_dielectric(double c, double eta)
+{
+    c = fabs(c);
+    double g = eta * eta - 1.0 + c * c;
+    if (!(g > 0.0)) return 1.0; /* total internal reflection */
+    g = sqrt(g);
+    double a = (g - c) / (g + c);
+    double b = (c * (g + c) - 1.0) / (c * (g - c) + 1.0);
+    return 0.5 * a * a * (1.0 + b * b);
+}
+
+double dwvb_ggx_D(double alpha2, double cos_h)
+{
+    double c2 = fmin(cos_h * cos_h, 1.0);
+    double t = (1.0 - c2) + alpha2 * c2;
+    return alpha2 / (PI * t * t);
+}
+
+double dwvb_ggx_lambda(double alpha2, double cos_theta)
+{
+    double c2 = cos_theta * cos_theta;
+    double tan2 = fmax((1.0 - c2) / c2, 0.0);
+    return 0.5 * (sqrt(1.0 + alpha2 * tan2) - 1.0);
+}
+
+dwvu_vec3 dwvb_ggx_sample_vndf(dwvu_vec3 wi, double alpha, double u1, double u2)
+{
+    /* Stretch to the hemisphere configuration, sample its projected disk, unstretch. */
+    dwvu_vec3 vh = dwvu_normalize(dwvu_v(alpha * wi.x, alpha * wi.y, wi.z));
+    double lensq = vh.x * vh.x + vh.y * vh.y;
+    dwvu_vec3 t1 = lensq > 0.0 ? dwvu_scale(dwvu_v(-vh.y, vh.x, 0.0), 1.0 / sqrt(lensq)) : dwvu_v(1.0, 0.0, 0.0);
+    dwvu_vec3 t2 = cross3(vh, t1);
+    double r = sqrt(u1), phi = 2.0 * PI * u2;
+    double p1 = r * cos(phi), p2 = r * sin(phi);
+    double sh = 0.5 * (1.0 + vh.z);
+    p2 = (1.0 - sh) * sqrt(fmax(0.0, 1.0 - p1 * p1)) + sh * p2;
+    double pz = sqrt(fmax(0.0, 1.0 - p1 * p1 - p2 * p2));
+    dwvu_vec3 nh = dwvu_add(dwvu_add(dwvu_scale(t1, p1), dwvu_scale(t2, p2)), dwvu_scale(vh, pz));
+    return dwvu_normalize(dwvu_v(alpha * nh.x, alpha * nh.y, fmax(1e-12, nh.z)));
+}
+
+double dwvb_ggx_vndf_pdf(dwvu_vec3 wi, dwvu_vec3 h, double alpha)
+{
+    double cos_ih = dwvu_dot(wi, h);
+    if (!(wi.z > 0.0) || !(h.z > 0.0) || !(cos_ih > 0.0)) return 0.0;
+    double a2 = alpha * alpha;
+    double g1 = 1.0 / (1.0 + dwvb_ggx_lambda(a2, wi.z));
+    return g1 * cos_ih * dwvb_ggx_D(a2, h.z) / wi.z;
+}
+
+int dwvb_entry_refract_sample(dwvu_vec3 wi, double alpha, double ior, double u1, double u2, dwvu_vec3 *wo)
+{
+    if (!(wi.z > 0.0)) return 0;
+    dwvu_vec3 h = dwvb_ggx_sample_vndf(wi, alpha, u1, u2);
+    double neta = 1.0 / ior, cos_hi = dwvu_dot(h, wi);
+    /* Snell through h: wo = -neta wi + (neta cos_hi - cos_t) h, cos_t = sqrt(1 - neta^2 sin_i^2). */
+    double arg = 1.0 - neta * neta * (1.0 - cos_hi * cos_hi);
+    double cos_t = sqrt(fmax(arg, 1e-14));
+    *wo = dwvu_normalize(dwvu_add(dwvu_scale(wi, -neta), dwvu_scale(h, neta * cos_hi - cos_t)));
+    return 1;
+}
+
+double dwvb_entry_refract_pdf(dwvu_vec3 wi, dwvu_vec3 wo, double alpha, double ior)
+{
+    if (!(wi.z > 0.0) || !(wo.z < 0.0)) return 0.0;
+    dwvu_vec3 sum = dwvu_add(wi, dwvu_scale(wo, ior));
+    double len = dwvu_length(sum);
+    if (!(len > 0.0)) return 0.0;
+    dwvu_vec3 h = dwvu_scale(sum, -1.0 / len);
+    if (!(h.z > 0.0)) return 0.0;
+    double cos_oh = dwvu_dot(wo, h), cos_ih = dwvu_dot(wi, h);
+    if (!(cos_oh < 0.0) || !(cos_ih > 0.0)) return 0.0;
+    double denom = cos_ih + ior * cos_oh;
+    return dwvb_ggx_vndf_pdf(wi, h, alpha) * ior * ior * fabs(cos_oh) / (denom * denom);
+}
+
+int dwvb_entry_sample(const dwvb_material *m, dwvu_vec3 wi, double u1, double u2, dwvu_vec3 *wo)
+{
+    if (m->entry == DWVB_ENTRY_SKIN) {
+        /* Cycles' Skin: the first number picks the technique and is reused, stretched. */
+        if (u1 < 0.5) {
+            double mu = sqrt(2.0 * u1), phi = 2.0 * PI * u2, st = sqrt(fmax(0.0, 1.0 - mu * mu));
+            *wo = dwvu_v(st * cos(phi), st * sin(phi), -mu);
+            return 1;
+        }
+        u1 = 2.0 * (u1 - 0.5);
+    } else if (m->entry == DWVB_ENTRY_DIFFUSE) {
+        double mu = sqrt(u1), phi = 2.0 * PI * u2, st = sqrt(fmax(0.0, 1.0 - mu * mu));
+        *wo = dwvu_v(st * cos(phi), st * sin(phi), -mu);
+        return 1;
+    }
+    return dwvb_entry_refract_sample(wi, m->entry_alpha, m->entry_ior, u1, u2, wo);
+}
+
+double dwvb_entry_pdf(const dwvb_material *m, dwvu_vec3 wi, dwvu_vec3 wo)
+{
+    double diffuse = wo.z < 0.0 ? -wo.z / PI : 0.0;
+    if (m->entry == DWVB_ENTRY_DIFFUSE) return diffuse;
+    double refract = dwvb_entry_refract_pdf(wi, wo, m->entry_alpha, m->entry_ior);
+    return m->entry == DWVB_ENTRY_SKIN ? 0.5 * diffuse + 0.5 * refract : refract;
+}
+
+/* Jensen et al. 2001's dipole diffuse reflectance, as Cycles' bssrdf_dipole_compute_Rd. */
+static double dipole_rd(double alpha_prime, double four_thirds_A)
+{
+    double s = sqrt(3.0 * (1.0 - alpha_prime));
+    return 0.5 * alpha_prime * (1.0 + exp(-four_thirds_A * s)) * exp(-s);
+}
+
+double dwvb_dipole_alpha_prime(double A, double eta)
+{
+    /* Fdr: the polynomial fit in 1/eta of Cycles' bssrdf_setup_radius (after Jensen 2001). */
+    double inv = 1.0 / eta;
+    double fdr = inv * (-1.440 * inv + 0.710) + 0.668 + 0.0636 * eta;
+    double four_thirds_A = (4.0 / 3.0) * (1.0 + fdr) / (1.0 - fdr);
+    if (A < 1e-4) return 0.0;
+    if (A >= 0.995) return 0.999999;
+    double x0 = 0.0, x1 = 1.0, mid = 0.5;
+    for (int i = 0; i < 12; ++i) {
+        mid = 0.5 * (x0 + x1);
+        if (dipole_rd(mid, four_thirds_A) < A) x0 = mid;
+        else x1 = mid;
+    }
+    return mid;
+}
+
+double dwvb_albedo_van_de_hulst(double A, double g)
+{
+    double t = 4.20863 * A - sqrt(9.59217 + 41.6808 * A + 17.7126 * A * A) + 4.09712;
+    double s2 = t * t;
+    double den = 1.0 - g * s2;
+    double alpha = den != 0.0 ? (1.0 - s2) / den : 0.0;
+    return fmin(fmax(alpha, 0.0), 0.999999);
+}
+
+/* F of the v2 layer: f0 + (1 - f0) s, s the real Fresnel curve's share between F0 and 1
+ * (Cycles' generalized Schlick with a negative exponent). */
+static double v2_share(double cos_hi, double eta, double F0)
+{
+    double s = (dwvb_fresnel_dielectric(cos_hi, eta) - F0) / (1.0 - F0);
+    return fmin(fmax(s, 0.0), 1.0);
+}
+
+void dwvb_ggx_albedo(double alpha, double eta, double mu, int n, double *E, double *s)
+{
+    double a2 = alpha * alpha;
+    mu = fmin(fmax(mu, 1e-4), 1.0);
+    dwvu_vec3 wi = dwvu_v(sqrt(fmax(0.0, 1.0 - mu * mu)), 0.0, mu);
+    double F0 = dwvb_fresnel_dielectric(1.0, eta);
+    double lambda_i = dwvb_ggx_lambda(a2, mu);
+    double sum_e = 0.0, sum_s = 0.0;
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+            dwvu_vec3 h = dwvb_ggx_sample_vndf(wi, alpha, (i + 0.5) / n, (j + 0.5) / n);
+            double c = dwvu_dot(wi, h);
+            dwvu_vec3 wo = dwvu_sub(dwvu_scale(h, 2.0 * c), wi);
+            if (!(wo.z > 0.0)) continue;
+            /* eval / pdf of VNDF sampling: G2 / G1(wi) = (1 + Lambda_i) / (1 + Lambda_i + Lambda_o). */
+            sum_e += (1.0 + lambda_i) / (1.0 + lambda_i + dwvb_ggx_lambda(a2, wo.z));
+            sum_s += v2_share(c, eta, F0);
+        }
+    *E = sum_e / ((double)n * n);
+    *s = sum_s / ((double)n * n);
+}
+
+void dwvb_specular_factor(const dwvb_material *m, dwvu_vec3 n, dwvu_vec3 L, dwvu_vec3 V, double f[3])
+{
+    f[0] = f[1] = f[2] = 0.0;
+    double a2 = m->spec_alpha * m->spec_alpha;
+    double cos_l = dwvu_dot(n, L), cos_v = dwvu_dot(n, V);
+    if (!m->specular || !(a2 > DWVB_GGX_MIN_ALPHA2) || !(cos_l > 0.0) || !(cos_v > 0.0)) return;
+    dwvu_vec3 h = dwvu_add(L, V);
+    double len = dwvu_length(h);
+    if (!(len > 0.0)) return;
+    h = dwvu_scale(h, 1.0 / len);
+    double cos_hv = dwvu_dot(h, V);
+    double D = dwvb_ggx_D(a2, dwvu_dot(n, h));
+    double li = dwvb_ggx_lambda(a2, cos_v), lo = dwvb_ggx_lambda(a2, cos_l);
+    if (m->specular == DWV_SPECULAR_PRINCIPLED_V1) {
+        /* Separable Smith G1(V) G1(L) and F = cspec0 (1 - FH) + FH (Cycles 3.x reflection_color). */
+        double G = 1.0 / ((1.0 + li) * (1.0 + lo));
+        double fh = (dwvb_fresnel_dielectric(cos_hv, m->spec_eta) - m->spec_F0) / (1.0 - m->spec_F0);
+        double common = PI * D * G / (4.0 * cos_l * cos_v);
+        for (int c = 0; c < 3; ++c) f[c] = common * (m->spec_f0[c] * (1.0 - fh) + fh);
+        return;
+    }
+    double G = 1.0 / (1.0 + li + lo);
+    double s = v2_share(cos_hv, m->spec_eta, m->spec_F0);
+    double common = PI * D * G / (4.0 * cos_l * cos_v);
+    double scale[3] = {1.0, 1.0, 1.0};
+    if (m->spec_multiscatter) {
+        /* Energy compensation 1 + Fms (1 - E) / E at the viewer's E (Kulla and Conty 2017). */
+        double E = spec_table(m->spec_E, cos_v);
+        for (int c = 0; c < 3; ++c) scale[c] = 1.0 + m->spec_Fms[c] * (1.0 - E) / E;
+    }
+    for (int c = 0; c < 3; ++c) f[c] = common * (m->spec_f0[c] + (1.0 - m->spec_f0[c]) * s) * scale[c];
+}
+
+double dwvb_specular_layer_weight(const dwvb_material *m, double mu)
+{
+    if (m->specular != DWV_SPECULAR_PRINCIPLED_V2) return 1.0;
+    double s = spec_table(m->spec_s, mu), E = spec_table(m->spec_E, mu), worst = 0.0;
+    for (int c = 0; c < 3; ++c) {
+        double albedo = m->spec_f0[c] + (1.0 - m->spec_f0[c]) * s;
+        /* Multiscatter: Cycles' darkening (1 + Fms (1 - E) / E) E scales the layer's weight. */
+        if (m->spec_multiscatter) albedo *= E + m->spec_Fms[c] * (1.0 - E);
+        worst = fmax(worst, albedo);
+    }
+    return fmin(fmax(1.0 - worst, 0.0), 1.0);
+}
+
+/* The specular layer's constants (svm_closure.h of each release, capi's DWV_SPECULAR_*). */
+static void specular_init(dwvb_material *out, const dwv_material_t *in)
+{
+    out->specular = 0;
+    out->spec_multiscatter = 0;
+    out->spec_alpha = in->roughness * in->roughness;
+    for (int c = 0; c < 3; ++c) out->spec_f0[c] = out->spec_Fms[c] = 0.0;
+    for (int i = 0; i < DWVB_SPEC_MU; ++i) out->spec_E[i] = 1.0, out->spec_s[i] = 0.0;
+    if (in->specular_model == DWV_SPECULAR_PRINCIPLED_V1) {
+        if (!(in->specular > 1e-5)) return; /* CLOSURE_WEIGHT_CUTOFF */
+        out->specular = DWV_SPECULAR_PRINCIPLED_V1;
+        out->spec_eta = 2.0 / (1.0 - sqrt(0.08 * in->specular)) - 1.0;
+        out->spec_F0 = dwvb_fresnel_dielectric(1.0, out->spec_eta);
+        const double *b = in->base_color;
+        double lum = 0.3 * b[0] + 0.6 * b[1] + 0.1 * b[2], t = in->specular_tint[0];
+        for (int c = 0; c < 3; ++c) {
+            double tint = lum > 0.0 ? b[c] / lum : 1.0;
+            out->spec_f0[c] = fmin(fmax(in->specular * 0.08 * ((1.0 - t) + tint * t), 0.0), 1.0);
+        }
+        return;
+    }
+    if (in->specular_model != DWV_SPECULAR_PRINCIPLED_V2) return;
+    /* Specular IOR Level: f0 = F0(ior) x 2 level, eta back from f0 (sqrt(f0) clamped to 0.99). */
+    double r = (in->ior - 1.0) / (in->ior + 1.0), f0 = r * r, eta = in->ior;
+    if (in->specular != 0.5) {
+        f0 *= 2.0 * in->specular;
+        double q = sqrt(fmin(fmax(f0, 0.0), 0.99));
+        eta = (1.0 + q) / (1.0 - q);
+    }
+    if (!(eta != 1.0)) return;
+    out->specular = DWV_SPECULAR_PRINCIPLED_V2;
+    out->spec_multiscatter = in->specular_multiscatter;
+    out->spec_eta = eta;
+    double rr = (eta - 1.0) / (eta + 1.0);
+    out->spec_F0 = rr * rr;
+    for (int c = 0; c < 3; ++c) out->spec_f0[c] = fmin(fmax(f0 * in->specular_tint[c], 0.0), 1.0);
+    for (int i = 0; i < DWVB_SPEC_MU; ++i)
+        dwvb_ggx_albedo(out->spec_alpha, eta, (double)i / (DWVB_SPEC_MU - 1), 48, &out->spec_E[i], &out->spec_s[i]);
+    if (!out->spec_multiscatter) return;
+    /* E_avg = 2 int E(mu) mu dmu (Simpson on the table); Fss from Kulla and Conty's fit of
+     * 2 int F_d(mu) mu dmu, (eta - 1) / (4.08567 + 1.00071 eta), as Cycles. */
+    double e_avg = 0.0, h = 1.0 / (DWVB_SPEC_MU - 1);
+    for (int i = 0; i < DWVB_SPEC_MU; ++i) {
+        double w = (i == 0 || i == DWVB_SPEC_MU - 1) ? 1.0 : (i % 2 ? 4.0 : 2.0);
+        e_avg += w * out->spec_E[i] * i * h;
+    }
+    e_avg *= 2.0 * h / 3.0;
+    double real_fss = (eta - 1.0) / (4.08567 + 1.00071 * eta);
+    double share = fmin(fmax((real_fss - out->spec_F0) / (1.0 - out->spec_F0), 0.0), 1.0);
+    for (int c = 0; c < 3; ++c) {
+        double fss = out->spec_f0[c] + (1.0 - out->spec_f0[c]) * share;
+        out->spec_Fms[c] = fss * e_avg / (1.0 - fss * (1.0 - e_avg));
+    }
+}
+
 void dwvb_material_init(dwvb_material *out, const dwv_material_t *in)
 {
     out->subsurface = 0;
@@ -71,6 +353,18 @@ void dwvb_material_init(dwvb_material *out, const dwv_material_t *in)
     out->principled_v1 = 0;
     out->principled_diffuse = 0;
     out->roughness = 0.0;
+    out->model = in->subsurface_model;
+    out->entry = DWVB_ENTRY_DIFFUSE;
+    out->entry_alpha = in->roughness * in->roughness;
+    specular_init(out, in);
+    out->min_footprint = in->kind == DWV_MATERIAL_SUBSURFACE ? in->subsurface_min_footprint : 0.0;
+    for (int c = 0; c < 3; ++c) {
+        out->radius[c] = in->subsurface_radius[c] * in->subsurface_scale;
+        out->fallback_albedo[c] = (in->kind == DWV_MATERIAL_SUBSURFACE ? in->subsurface_weight : 0.0) * in->subsurface_color[c];
+    }
+    /* The refraction entry's IOR is the specular layer's eta (4.x+ Principled: IOR adjusted by
+     * Specular IOR Level), else `ior` (the Subsurface Scattering node's IOR); clamped as Cycles. */
+    out->entry_ior = fmin(fmax(out->specular == DWV_SPECULAR_PRINCIPLED_V2 ? out->spec_eta : in->ior, 1.01), 3.8);
     for (int c = 0; c < 3; ++c) {
         out->diffuse_albedo[c] = in->base_color[c];
         out->walk_scale[c] = 0.0;
@@ -91,7 +385,30 @@ void dwvb_material_init(dwvb_material *out, const dwv_material_t *in)
         out->roughness = in->roughness;
         for (int c = 0; c < 3; ++c) out->retro_albedo[c] = w * in->subsurface_color[c];
     }
-    double g = fmin(fmax(in->subsurface_anisotropy, 0.0), 0.9);
+    int model = in->subsurface_model;
+    /* Anisotropy clamps (bssrdf_setup / svm_closure.h): [0, 0.9] up to 5.1, 5.2's Random Walk
+     * [-0.99, 0.99], its Legacy and Skin [-0.99, 0.9]. */
+    double g_lo = 0.0, g_hi = 0.9;
+    if (model == DWV_SUBSURFACE_MODEL_BLENDER52_RANDOM_WALK) g_lo = -0.99, g_hi = 0.99;
+    else if (model == DWV_SUBSURFACE_MODEL_BLENDER52_LEGACY || model == DWV_SUBSURFACE_MODEL_BLENDER52_SKIN)
+        g_lo = -0.99;
+    double g = fmin(fmax(in->subsurface_anisotropy, g_lo), g_hi);
+    /* 5.2 maps the albedo by van de Hulst for its Random Walk, and for Legacy and Skin where g < 0. */
+    int hulst = model == DWV_SUBSURFACE_MODEL_BLENDER52_RANDOM_WALK ||
+                ((model == DWV_SUBSURFACE_MODEL_BLENDER52_LEGACY || model == DWV_SUBSURFACE_MODEL_BLENDER52_SKIN) && g < 0.0);
+    int rescaled = model == DWV_SUBSURFACE_MODEL_BLENDER3_RANDOM_WALK || model == DWV_SUBSURFACE_MODEL_BLENDER4_SKIN ||
+                   model == DWV_SUBSURFACE_MODEL_BLENDER52_SKIN;
+    if (model == DWV_SUBSURFACE_MODEL_BLENDER4_RANDOM_WALK || model == DWV_SUBSURFACE_MODEL_BLENDER52_RANDOM_WALK ||
+        model == DWV_SUBSURFACE_MODEL_BLENDER52_LEGACY)
+        out->entry = DWVB_ENTRY_REFRACT;
+    if (model == DWV_SUBSURFACE_MODEL_BLENDER4_SKIN || model == DWV_SUBSURFACE_MODEL_BLENDER52_SKIN) {
+        /* Skin: refraction with Subsurface IOR at alpha 1; the radius rescaled with it too. */
+        out->entry = DWVB_ENTRY_SKIN;
+        out->entry_alpha = 1.0;
+        out->entry_ior = fmin(fmax(in->subsurface_ior, 1.01), 3.8);
+    }
+    /* 3.x Random Walk rescales with Subsurface IOR (svm_closure.h clamps it to [1.01, 3.8]). */
+    double rescale_ior = fmin(fmax(in->subsurface_ior, 1.01), 3.8);
     double sigma_t[3], alpha[3];
     int walking = -1;
     for (int c = 0; c < 3; ++c) {
@@ -102,10 +419,23 @@ void dwvb_material_init(dwvb_material *out, const dwv_material_t *in)
             sigma_t[c] = alpha[c] = 0.0;
             continue;
         }
-        double d = fmax(radius / FOUR_PI, 1e-16);
-        /* Kept inside the walk's range of extinctions [1e-30, 1e30]. */
-        sigma_t[c] = fmin(fmax(1.0 / (d * (1.0 - g)), 1e-30), 1e30);
-        alpha[c] = dwvb_albedo_inversion(in->subsurface_color[c], g);
+        double d;
+        if (model == DWV_SUBSURFACE_MODEL_BLENDER52_RANDOM_WALK)
+            d = radius; /* the mean free path itself */
+        else if (rescaled)
+            d = radius * sqrt(3.0 * (1.0 - dwvb_dipole_alpha_prime(in->subsurface_color[c], rescale_ior)));
+        else
+            d = radius / FOUR_PI;
+        d = fmax(d, 1e-16);
+        /* Kept inside the walk's range of extinctions [1e-30, 1e30]. Van de Hulst's mapping takes
+         * d as the mean free path (sigma_t = 1 / d), Cycles' fit as the reduced one. */
+        if (hulst) {
+            sigma_t[c] = fmin(fmax(1.0 / d, 1e-30), 1e30);
+            alpha[c] = dwvb_albedo_van_de_hulst(in->subsurface_color[c], g);
+        } else {
+            sigma_t[c] = fmin(fmax(1.0 / (d * (1.0 - g)), 1e-30), 1e30);
+            alpha[c] = dwvb_albedo_inversion(in->subsurface_color[c], g);
+        }
         double scale = 1.0;
         if (alpha[c] < DWVB_MIN_ALPHA) {
             scale = alpha[c] / DWVB_MIN_ALPHA;

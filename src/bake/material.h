@@ -30,6 +30,7 @@
 
 #define DWVB_MIN_RADIUS 1e-8
 #define DWVB_MIN_ALPHA 0.2
+#define DWVB_SPEC_MU 33
 
 typedef struct dwvb_material {
     int subsurface;            /* walks run: some channel scatters with a non-zero weight */
@@ -47,7 +48,76 @@ typedef struct dwvb_material {
     /* Each walking channel's own one-channel medium, for walks that carry one channel (channel
      * walks, shade.h); unset where walk_scale[c] is 0 or the material is grey. */
     dwvw_medium channel_medium[3];
+    /* Issue 17: the Cycles subsurface model (dwv_subsurface_model_t), its entry, and the
+     * Principled specular layer around the walk. */
+    int model;
+    int entry;                 /* DWVB_ENTRY_* */
+    double entry_alpha;        /* GGX alpha of the refraction entry */
+    double entry_ior;          /* its IOR, clamped to [1.01, 3.8] */
+    int specular;              /* DWV_SPECULAR_*, 0 where the layer is absent (specular 0, eta 1) */
+    int spec_multiscatter;
+    double spec_alpha;         /* GGX alpha = roughness^2 */
+    double spec_eta;           /* the Fresnel's IOR */
+    double spec_F0;            /* F_d(1, eta) */
+    double spec_f0[3];         /* v1: cspec0; v2: f0 x tint (both saturated) */
+    double spec_E[DWVB_SPEC_MU];  /* v2: GGX albedo (F = 1) toward mu_i = i / (DWVB_SPEC_MU - 1) */
+    double spec_s[DWVB_SPEC_MU];  /* v2: the albedo's interpolation factor between f0 and 1 */
+    double spec_Fms[3];        /* v2 multiscatter: Kulla-Conty's multiple-bounce Fresnel */
+    /* Cycles 4.0-4.4's footprint rule (dwv_material_t.subsurface_min_footprint): a walking channel
+     * c whose radius[c] (radius x scale) is below min_footprint x the camera ray's footprint turns
+     * into a Lambertian lobe of fallback_albedo[c] there. */
+    double min_footprint;
+    double radius[3];
+    double fallback_albedo[3];
 } dwvb_material;
+
+/* Entries into the medium. */
+enum { DWVB_ENTRY_DIFFUSE = 0, DWVB_ENTRY_REFRACT = 1, DWVB_ENTRY_SKIN = 2 };
+
+/* GGX evaluation is skipped (a mirror: no light from sampled lights)
+ * where alpha^2 is at most this, as Cycles' BSDF_ROUGHNESS_SQ_THRESH. */
+#define DWVB_GGX_MIN_ALPHA2 1e-7
+
+/* Exact unpolarised Fresnel reflectance of a dielectric of relative IOR eta for the cosine c
+ * (Cycles' fresnel_dielectric_cos form: g = sqrt(eta^2 - 1 + c^2), 1 past total reflection). */
+double dwvb_fresnel_dielectric(double c, double eta);
+/* GGX (Trowbridge-Reitz) normal distribution D(h) for alpha^2 and cos(n, h) (Walter et al. 2007, Eq. 33). */
+double dwvb_ggx_D(double alpha2, double cos_h);
+/* Smith's Lambda for GGX (Heitz 2014, Eq. 72): (sqrt(1 + alpha^2 tan^2) - 1) / 2. */
+double dwvb_ggx_lambda(double alpha2, double cos_theta);
+/* A visible normal of GGX for the local direction wi (z up, wi.z > 0), isotropic alpha, uniform
+ * u1, u2 (Heitz 2018, "Sampling the GGX Distribution of Visible Normals", Listing 1), and its pdf
+ * D_wi(h) = G1(wi) max(0, wi.h) D(h) / wi.z (Eq. 2 there). */
+dwvu_vec3 dwvb_ggx_sample_vndf(dwvu_vec3 wi, double alpha, double u1, double u2);
+double dwvb_ggx_vndf_pdf(dwvu_vec3 wi, dwvu_vec3 h, double alpha);
+/* Cycles 4.x+'s refraction entry (subsurface.h, subsurface_entry_bounce): h from the visible
+ * normals toward wi, wi refracted through h into a medium of IOR `ior` (> 1, so no total
+ * reflection). Local frame, z the shading normal; returns 0 where wi.z <= 0. Its pdf over
+ * directions (Walter et al. 2007, Eq. 17): D_wi(h) ior^2 |wo.h| / (wi.h + ior wo.h)^2, h =
+ * -(wi + ior wo) / |...|; 0 where wo does not go down or h is not above the surface. */
+int dwvb_entry_refract_sample(dwvu_vec3 wi, double alpha, double ior, double u1, double u2, dwvu_vec3 *wo);
+double dwvb_entry_refract_pdf(dwvu_vec3 wi, dwvu_vec3 wo, double alpha, double ior);
+/* The entry of a material: a unit direction into the medium (local frame, z the shading normal,
+ * wi toward the viewer) from one uniform pair, and the pdf of every technique that could have
+ * produced it (Skin: half cosine-weighted, half refraction). Returns 0 where no entry is drawn. */
+int dwvb_entry_sample(const dwvb_material *m, dwvu_vec3 wi, double u1, double u2, dwvu_vec3 *wo);
+double dwvb_entry_pdf(const dwvb_material *m, dwvu_vec3 wi, dwvu_vec3 wo);
+/* Cycles' 3.x Random Walk / Skin radius rescaling: sqrt(3 (1 - a')) for colour A and IOR eta
+ * (bisection of Jensen's dipole Rd as Cycles does: 12 steps from [0, 1], the last midpoint;
+ * A < 1e-4 gives a' = 0 and A >= 0.995 gives 0.999999). */
+double dwvb_dipole_alpha_prime(double A, double eta);
+/* Van de Hulst's albedo mapping (d'Eon, Hitchhiker's Guide Eq. 53.7), clamped to [0, 0.999999]. */
+double dwvb_albedo_van_de_hulst(double A, double g);
+/* The specular layer's BRDF times pi for light L and viewer V (unit, world), shading normal n,
+ * into f[3]; 0 below either horizon. */
+void dwvb_specular_factor(const dwvb_material *m, dwvu_vec3 n, dwvu_vec3 L, dwvu_vec3 V, double f[3]);
+/* The weight of the layers below the specular toward a viewer at cosine mu to n: 1 for v1 and no
+ * layer; v2: 1 - max_c (albedo of the layer, with its multiscatter darkening). */
+double dwvb_specular_layer_weight(const dwvb_material *m, double mu);
+/* v2's GGX albedo with F = 1 and with the interpolation factor, by quadrature over visible
+ * normals toward mu (what Cycles tabulates as ggx_E and ggx_gen_schlick_ior_s): the mean of
+ * G2 / G1(wi) and of s(wi.h) x [wo above], over a midpoint grid of n x n uniform pairs. */
+void dwvb_ggx_albedo(double alpha, double eta, double mu, int n, double *E, double *s);
 
 /* Cycles' albedo inversion: the single-scattering albedo for multiple-scattering albedo A in
  * [0, 1] and anisotropy g in [0, 0.9] (before the clamps). */

@@ -131,6 +131,30 @@ static double principled_diffuse_factor(const void *context, dwvu_vec3 light)
                                           lobe->roughness);
 }
 
+/* The whole surface BRDF at the entry point where a specular layer is there (material.h): the
+ * layered diffuse (Lambertian, or 3.x Principled's with its Fresnel terms), 3.x's retro-reflection
+ * lobe and the specular layer, per channel. */
+typedef struct surface_lobes {
+    const dwvb_material *material;
+    retro_lobe lobe;
+    double diffuse[3]; /* the diffuse lobe's weight per channel (layered) */
+} surface_lobes;
+
+static void surface_factor(const void *context, dwvu_vec3 light, double f[3])
+{
+    const surface_lobes *s = context;
+    const dwvb_material *m = s->material;
+    double cos_l = dwvu_dot(s->lobe.n, light), l_dot_v = dwvu_dot(light, s->lobe.to_view);
+    double diffuse = m->principled_diffuse
+                         ? dwvb_principled_diffuse_factor(cos_l, s->lobe.cos_view, l_dot_v, s->lobe.roughness)
+                         : 1.0;
+    double retro = m->principled_v1
+                       ? dwvb_principled_retro_factor(cos_l, s->lobe.cos_view, l_dot_v, s->lobe.roughness)
+                       : 0.0;
+    dwvb_specular_factor(m, s->lobe.n, light, s->lobe.to_view, f);
+    for (int c = 0; c < 3; ++c) f[c] += s->diffuse[c] * diffuse + m->retro_albedo[c] * retro;
+}
+
 /* The exit weight of Blender 3.x's Principled BSDF; the context is the exit's shading normal. */
 static double exit_factor(const void *context, dwvu_vec3 light)
 {
@@ -157,6 +181,18 @@ static void exit_light(const dwvb_shader *shader, uint32_t mesh_id, const dwvb_m
                          &exit_n, NULL, direct);
     else
         dwvl_direct(&shader->env, walk->position, exit_n, exit_ng, exit_smooth, exit_top, sampler, pair, direct);
+}
+
+double dwvb_footprint(const dwvb_shader *shader, dwvu_vec3 view, double t)
+{
+    if (shader->footprint == 2) return shader->pixel;
+    if (shader->footprint != 1) return 0.0;
+    double along = dwvu_dot(view, shader->forward);
+    if (!(along > 0.0)) return 0.0;
+    dwvu_vec3 d = dwvu_scale(view, 1.0 / along); /* on the plane at unit distance */
+    dwvu_vec3 dx = dwvu_sub(dwvu_normalize(dwvu_add(d, shader->pixel_right)), view);
+    dwvu_vec3 dy = dwvu_sub(dwvu_normalize(dwvu_add(d, shader->pixel_up)), view);
+    return t * 0.5 * (dwvu_length(dx) + dwvu_length(dy));
 }
 
 void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, const dwvk_sampler *sampler,
@@ -186,6 +222,22 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
     dwvu_vec3 x = dwvg_point(mesh, hit->prim, hit->u, hit->v);
     dwvu_vec3 n = dwvg_shading_normal(mesh, hit->prim, hit->u, hit->v, ng);
     uint32_t light_pairs = dwvl_direct_pairs(&shader->env);
+    /* Cycles 4.0-4.4: channels whose radius is below a quarter of the camera ray's footprint are
+     * Lambertian at this hit (bssrdf_setup); their walks' results are not used. */
+    double diffuse_albedo[3], keep[3] = {1.0, 1.0, 1.0};
+    int walks_left = material->subsurface;
+    for (int c = 0; c < 3; ++c) diffuse_albedo[c] = material->diffuse_albedo[c];
+    if (material->subsurface && material->min_footprint > 0.0 && shader->footprint) {
+        double limit = material->min_footprint * dwvb_footprint(shader, view, hit->t);
+        walks_left = 0;
+        for (int c = 0; c < 3; ++c) {
+            if (material->walk_scale[c] > 0.0 && material->radius[c] < limit) {
+                keep[c] = 0.0;
+                diffuse_albedo[c] += material->fallback_albedo[c];
+            }
+            if (material->walk_scale[c] > 0.0 && keep[c] > 0.0) walks_left = 1;
+        }
+    }
     /* Shadow rays of smooth-shaded triangles leave from the smooth surface near the terminator,
      * as in Cycles with the mesh's geometry offset (src/light/terminator.h). */
     double cutoff = scene->terminator_offsets[hit->mesh];
@@ -193,7 +245,17 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
     const dwvl_terminator *smooth = mesh->normals && cutoff > 0.0 ? &terminator : NULL;
     /* The world's top along ng is known for the outward side of the triangle only. */
     double top = ng_flipped ? INFINITY : dwvg_world_top(&scene->geometry, hit->mesh, hit->prim);
-    if (material->principled_v1) {
+    /* The layers under a 4.x+ specular keep 1 - its albedo toward the viewer (1 otherwise). */
+    double cos_view = -dwvu_dot(n, view);
+    double layer = material->specular ? dwvb_specular_layer_weight(material, cos_view) : 1.0;
+    if (material->specular) {
+        surface_lobes lobes = {material, {n, dwvu_scale(view, -1.0), cos_view, material->roughness}, {0.0, 0.0, 0.0}};
+        for (int c = 0; c < 3; ++c) lobes.diffuse[c] = layer * diffuse_albedo[c];
+        double surface[3];
+        dwvl_direct_rgb(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, surface_factor, &lobes,
+                        surface);
+        for (int c = 0; c < 3; ++c) rgb[c] += surface[c];
+    } else if (material->principled_v1) {
         /* The Lambertian lobe and the retro-reflection lobe from the same light samples. */
         retro_lobe lobe = {n, dwvu_scale(view, -1.0), -dwvu_dot(n, view), material->roughness};
         double direct[3], retro[3];
@@ -205,19 +267,30 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
         dwvl_direct_lobe(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, principled_diffuse_factor, &lobe,
                          NULL, diffuse);
         for (int c = 0; c < 3; ++c) rgb[c] += material->diffuse_albedo[c] * diffuse[c];
-    } else if (material->diffuse_albedo[0] > 0.0 || material->diffuse_albedo[1] > 0.0 ||
-               material->diffuse_albedo[2] > 0.0) {
+    } else if (diffuse_albedo[0] > 0.0 || diffuse_albedo[1] > 0.0 || diffuse_albedo[2] > 0.0) {
         double direct[3];
         dwvl_direct(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, direct);
-        for (int c = 0; c < 3; ++c) rgb[c] += material->diffuse_albedo[c] * direct[c];
+        for (int c = 0; c < 3; ++c) rgb[c] += layer * diffuse_albedo[c] * direct[c];
     }
-    if (!material->subsurface) return;
+    if (!walks_left) return;
     /* Entry: cosine-weighted about -n, rejected (no contribution, as Cycles) where it would not
      * go below the geometric surface. The pdf cos/pi cancels the diffuse transmission f = 1/pi. */
     double u[2];
     dwvk_sampler_pair(sampler, pair, u);
-    double mu = sqrt(u[0]);
-    dwvu_vec3 inward = dwvk_direction_about(dwvu_scale(n, -1.0), mu, 1.0 - mu, 1.0 + mu, u[1]);
+    dwvu_vec3 inward;
+    if (material->entry == DWVB_ENTRY_DIFFUSE) {
+        double mu = sqrt(u[0]);
+        inward = dwvk_direction_about(dwvu_scale(n, -1.0), mu, 1.0 - mu, 1.0 + mu, u[1]);
+    } else {
+        /* Cycles 4.x+: GGX refraction (Skin: half of it), a direction distribution of unit weight
+         * (subsurface_entry_bounce); none where the viewer is below the shading normal. */
+        dwvu_frame frame = dwvu_frame_about(n);
+        dwvu_vec3 to_view = dwvu_scale(view, -1.0);
+        dwvu_vec3 wi = dwvu_v(dwvu_dot(frame.t, to_view), dwvu_dot(frame.s, to_view), dwvu_dot(frame.n, to_view));
+        dwvu_vec3 wo;
+        if (!dwvb_entry_sample(material, wi, u[0], u[1], &wo)) return;
+        inward = dwvu_add(dwvu_add(dwvu_scale(frame.t, wo.x), dwvu_scale(frame.s, wo.y)), dwvu_scale(frame.n, wo.z));
+    }
     if (!(dwvu_dot(inward, ng) < 0.0)) return;
     /* The walk's first events take the pairs after the exit's lights (walk.h, DWVW_PAIR_*). */
     uint32_t walk_pair = pair + DWVB_SHADE_PAIRS + 2u * light_pairs;
@@ -236,7 +309,7 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
             pairs[j].have = pairs[j].stratified = 0u;
         }
         for (int c = 0; c < 3; ++c) {
-            if (!(material->walk_scale[c] > 0.0)) continue;
+            if (!(material->walk_scale[c] > 0.0) || !(keep[c] > 0.0)) continue;
             /* A channel of `count` walks averages them; walk j draws its own stratified pairs
              * (shared with the other channels' walk j) and counter-based numbers. */
             uint32_t count = shader->channel_counts ? shader->channel_counts[3u * hit->mesh + (uint32_t)c] : 1u;
@@ -246,7 +319,7 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
                                       &shader->channel_guides[3u * hit->mesh + (uint32_t)c], hit->prim, x, inward, n,
                                       dwvk_mix64(key_walk + (uint64_t)c + 3u * (uint64_t)j), sampler,
                                       pairs[j].first_pair, &pairs[j], &walk, &exit, tally);
-                double share = material->walk_scale[c] / (double)count;
+                double share = layer * material->walk_scale[c] / (double)count;
                 if (walk.status == DWVW_TRUNCATED) tally->truncated[c] += walk.weight[0] * share;
                 if (!exited) continue;
                 exit_light(shader, hit->mesh, material, &walk, &exit, sampler, exit_pair, direct);
@@ -265,5 +338,5 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
         for (int c = 0; c < 3; ++c) tally->truncated[c] += walk.weight[grey ? 0 : c] * material->walk_scale[c];
     if (!exited) return;
     exit_light(shader, hit->mesh, material, &walk, &exit, sampler, exit_pair, direct);
-    for (int c = 0; c < 3; ++c) rgb[c] += walk.weight[grey ? 0 : c] * material->walk_scale[c] * direct[c];
+    for (int c = 0; c < 3; ++c) rgb[c] += keep[c] * layer * walk.weight[grey ? 0 : c] * material->walk_scale[c] * direct[c];
 }

@@ -30,7 +30,18 @@ typedef struct dwvb_shader {
      * where a channel's variance is worth more walks than its cost (pilot.c). */
     const uint8_t *channel_counts;
     uint32_t max_events;
+    /* Camera bakes: the camera ray's footprint at a hit (Cycles' sd->dP, for
+     * dwvb_material.min_footprint): 1 perspective (eye, forward, and right / up one pixel apart on
+     * the plane at unit distance), 2 orthographic (pixel: a pixel's width); 0 none (UV bakes). */
+    int footprint;
+    dwvu_vec3 eye, pixel_right, pixel_up, forward;
+    double pixel;
 } dwvb_shader;
+
+/* The camera ray's footprint at distance t along unit `view` (Cycles 4.x differentials:
+ * t x 0.5 (|normalize(D + dx) - D'| + |normalize(D + dy) - D'|), D the direction on the unit
+ * plane, D' = view). */
+double dwvb_footprint(const dwvb_shader *shader, dwvu_vec3 view, double t);
 
 /* What samples met, summed by the caller in a fixed order. */
 typedef struct dwvb_tally {

@@ -59,9 +59,12 @@ static int shadow_ray_allowed(const shadow_origins *o, dwvu_vec3 light)
     return dwvu_dot(o->ng, light) > 0.0 || (o->terminator && o->terminator->cutoff > 0.0);
 }
 
-void dwvl_direct_lobe(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, dwvu_vec3 ng,
-                      const dwvl_terminator *terminator, double top, const dwvk_sampler *sampler, uint32_t pair,
-                      dwvl_lobe_factor factor, const void *context, double lambert[3], double lobe[3])
+/* The estimator of dwvl_direct_lobe and dwvl_direct_rgb: a scalar factor (the same in every
+ * channel) or a per-channel one (rgb, when not NULL). */
+static void direct_core(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, dwvu_vec3 ng,
+                        const dwvl_terminator *terminator, double top, const dwvk_sampler *sampler, uint32_t pair,
+                        dwvl_lobe_factor factor, dwvl_rgb_factor rgb, const void *context, double lambert[3],
+                        double lobe[3])
 {
     double plain[3] = {0.0, 0.0, 0.0}, weighted[3] = {0.0, 0.0, 0.0};
     double eps = env->geometry ? env->geometry->epsilon : 0.0;
@@ -99,10 +102,12 @@ void dwvl_direct_lobe(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, dwv
             if (!clear_of(&origins, origin, toward) && dwvg_occluded(env->geometry, origin, toward, 0.0, distance - 2.0 * eps))
                 continue;
         }
-        double f = factor ? factor(context, s.direction) : 0.0;
+        double f[3] = {0.0, 0.0, 0.0};
+        if (rgb) rgb(context, s.direction, f);
+        else if (factor) f[0] = f[1] = f[2] = factor(context, s.direction);
         for (int c = 0; c < 3; ++c) {
             plain[c] += s.value[c] * cos_n * INV_PI;
-            weighted[c] += s.value[c] * cos_n * INV_PI * f;
+            weighted[c] += s.value[c] * cos_n * INV_PI * f[c];
         }
     }
     if (env->world_lit) {
@@ -118,10 +123,12 @@ void dwvl_direct_lobe(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, dwv
             blocked = !clear_of(&origins, origin, w) && dwvg_occluded(env->geometry, origin, w, 0.0, INFINITY);
         }
         if (!blocked) {
-            double f = factor ? factor(context, w) : 0.0;
+            double f[3] = {0.0, 0.0, 0.0};
+            if (rgb) rgb(context, w, f);
+            else if (factor) f[0] = f[1] = f[2] = factor(context, w);
             for (int c = 0; c < 3; ++c) {
                 plain[c] += env->world[c];
-                weighted[c] += env->world[c] * f;
+                weighted[c] += env->world[c] * f[c];
             }
         }
     }
@@ -129,6 +136,20 @@ void dwvl_direct_lobe(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, dwv
         if (lambert) lambert[c] = plain[c];
         if (lobe) lobe[c] = weighted[c];
     }
+}
+
+void dwvl_direct_lobe(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, dwvu_vec3 ng,
+                      const dwvl_terminator *terminator, double top, const dwvk_sampler *sampler, uint32_t pair,
+                      dwvl_lobe_factor factor, const void *context, double lambert[3], double lobe[3])
+{
+    direct_core(env, x, n, ng, terminator, top, sampler, pair, factor, NULL, context, lambert, lobe);
+}
+
+void dwvl_direct_rgb(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, dwvu_vec3 ng,
+                     const dwvl_terminator *terminator, double top, const dwvk_sampler *sampler, uint32_t pair,
+                     dwvl_rgb_factor factor, const void *context, double out[3])
+{
+    direct_core(env, x, n, ng, terminator, top, sampler, pair, NULL, factor, context, NULL, out);
 }
 
 void dwvl_direct(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, dwvu_vec3 ng,

@@ -221,3 +221,110 @@ def lights_scene(kind, resolution=16, samples=64):
     light.location = (0.0, 0.0, 2.0)
     scene.collection.objects.link(light)
     return scene
+
+
+# ---------------------------------------------------------------------------------------------
+# Issue 17: Cycles' own look per Blender version (tests/blender/test_fidelity.py). The materials
+# keep the Principled defaults of that Blender (specular layer, roughness, IOR, distribution)
+# and switch subsurface on; only the method, colour and amount are set.
+# ---------------------------------------------------------------------------------------------
+
+def blender4():
+    return bpy.app.version >= (4, 0, 0)
+
+
+def methods():
+    """The subsurface methods of this Blender's Principled BSDF, the default first."""
+    if bpy.app.version >= (5, 2, 0):
+        return ('RANDOM_WALK', 'RANDOM_WALK_LEGACY', 'RANDOM_WALK_SKIN')
+    if blender4():
+        return ('RANDOM_WALK', 'RANDOM_WALK_SKIN')
+    return ('RANDOM_WALK', 'RANDOM_WALK_FIXED_RADIUS')
+
+
+def default_subsurface_material(name, method, color=None, amount=None, roughness=None, specular=None,
+                                distribution=None):
+    """A new Principled BSDF with subsurface switched on as a user would: 3.x Subsurface = amount
+    (default 0.05, so the radius is as 4.x's default Scale 0.05) with Subsurface Color = colour;
+    4.x+ Subsurface Weight 1 with Subsurface Scale = amount (default: this Blender's own default)
+    and Base Color = colour. Everything else at this Blender's defaults unless given."""
+    material = bpy.data.materials.new(name)
+    material.use_nodes = True
+    bsdf = material.node_tree.nodes["Principled BSDF"]
+    bsdf.subsurface_method = method
+    if distribution is not None:
+        bsdf.distribution = distribution
+    inputs = bsdf.inputs
+    if color is not None:
+        rgba = (color[0], color[1], color[2], 1.0)
+        inputs["Base Color"].default_value = rgba
+        if "Subsurface Color" in inputs:
+            inputs["Subsurface Color"].default_value = rgba
+    if blender4():
+        inputs["Subsurface Weight"].default_value = 1.0
+        if amount is not None:
+            inputs["Subsurface Scale"].default_value = amount
+        if specular is not None:
+            inputs["Specular IOR Level"].default_value = specular
+    else:
+        inputs["Subsurface"].default_value = 0.05 if amount is None else amount
+        if specular is not None:
+            inputs["Specular"].default_value = specular
+    if roughness is not None:
+        inputs["Roughness"].default_value = roughness
+    return material
+
+
+def default_sphere_scene(resolution, method, **material):
+    """sphere_scene's front-lit smooth sphere (radius 1 m, sun 45 degrees off the view) with a
+    default Principled subsurface material of `method`."""
+    scene = _reset()
+    scene.render.resolution_x = resolution
+    scene.render.resolution_y = resolution
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=48, ring_count=24, radius=1.0)
+    sphere = bpy.context.active_object
+    sphere.name = "Sphere"
+    bpy.ops.object.shade_smooth()
+    sphere.data.materials.append(default_subsurface_material("Default", method, **material))
+    _camera(scene, (0.0, -3.5, 0.0), (math.pi / 2, 0.0, 0.0), lens=50.0)
+    _sun(scene, (math.radians(45.0), 0.0, math.radians(-30.0)), 2.0)
+    return scene
+
+
+def backlit_slab_scene(resolution, method):
+    """The issue's back-lit slab: 0.2 m thick, 4 x 4 m, Subsurface 0.3 (4.x+: Scale 0.3),
+    colour (0.9, 0.7, 0.5), a sun from straight below, an orthographic camera above."""
+    scene = _reset()
+    scene.render.resolution_x = resolution
+    scene.render.resolution_y = resolution
+    material = default_subsurface_material("Slab", method, color=(0.9, 0.7, 0.5), amount=0.3)
+    _box(scene, "Slab", (4.0, 4.0, 0.2), (0.0, 0.0, 0.0), material)
+    _camera(scene, (0.0, 0.0, 3.0), (0.0, 0.0, 0.0), ortho_scale=1.0)
+    _sun(scene, (math.pi, 0.0, 0.0), 3.0)
+    return scene
+
+
+def glossy_cube_scene(resolution, method):
+    """A small flat-shaded cube (0.3 m, turned 30 and 20 degrees) of a default subsurface
+    material with colour (0.7, 0.8, 0.9) and Roughness 0.3, lit by a point light off to the side
+    and a dim grey world (the specular layer reflects both), seen in perspective: other shape,
+    light and scale than the sphere and the slab."""
+    scene = _reset()
+    scene.render.resolution_x = resolution
+    scene.render.resolution_y = resolution
+    set_world(scene, (0.2, 0.2, 0.2), 1.0)
+    material = default_subsurface_material("Jade", method, color=(0.7, 0.8, 0.9), roughness=0.3,
+                                           amount=0.02 if blender4() else None)
+    bpy.ops.mesh.primitive_cube_add(size=0.3, location=(0.0, 0.0, 0.0),
+                                    rotation=(math.radians(30.0), math.radians(20.0), 0.0))
+    cube = bpy.context.active_object
+    cube.name = "Cube"
+    cube.data.materials.append(material)
+    _camera(scene, (0.0, -1.2, 0.15), (math.radians(83.0), 0.0, 0.0), lens=50.0)
+    data = bpy.data.lights.new("Point", 'POINT')
+    data.energy = 20.0
+    data.shadow_soft_size = 0.0
+    light = bpy.data.objects.new("Point", data)
+    light.location = (0.6, -0.6, 0.5)
+    scene.collection.objects.link(light)
+    return scene

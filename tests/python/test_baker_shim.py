@@ -82,7 +82,7 @@ class StructLayoutTest(unittest.TestCase):
     def test_sizes_on_lp64(self):
         if ctypes.sizeof(ctypes.c_void_p) != 8:
             self.skipTest("the sizes below are those of an LP64 ABI")
-        sizes = {"dwv_material_t": 128, "dwv_mesh_t": 152, "dwv_light_desc_t": 216, "dwv_camera_t": 128,
+        sizes = {"dwv_material_t": 192, "dwv_mesh_t": 152, "dwv_light_desc_t": 216, "dwv_camera_t": 128,
                  "dwv_bake_progress_t": 48, "dwv_bake_options_t": 112, "dwv_image_info_t": 40,
                  "dwv_bake_stats_t": 128, "dwv_error_point_t": 24, "dwv_display_options_t": 56}
         for name, size in sizes.items():
@@ -124,7 +124,12 @@ class StructLayoutTest(unittest.TestCase):
         material = dwivedi.Material()._to_c()
         self.assertEqual(tuple(material.subsurface_radius), (1.0, 0.2, 0.1))
         self.assertEqual((material.subsurface_scale, material.subsurface_ior), (0.05, 1.4))
-        self.assertEqual((material.struct_size, material.subsurface_exit, material.roughness), (128, 0, 0.5))
+        self.assertEqual((material.struct_size, material.subsurface_exit, material.roughness), (192, 0, 0.5))
+        # Issue 17's fields: the same defaults as DWV_MATERIAL_INIT (fixed radius, no specular).
+        self.assertEqual((material.subsurface_model, material.specular_model, material.ior, material.specular,
+                          tuple(material.specular_tint), material.specular_multiscatter,
+                          material.subsurface_min_footprint),
+                         (0, 0, 1.5, 0.5, (1.0, 1.0, 1.0), 0, 0.0))
         self.assertEqual(_library.DisplayOptions().gamma, 1.0)
 
 
@@ -232,6 +237,32 @@ class SceneTest(unittest.TestCase):
         self.assertEqual((t[3], t[7], t[11]), (0.0, -3.0, 0.0))
         with self.assertRaises(dwivedi.Error):
             dwivedi.Camera.look_at((0, 0, 0), (0, 0, 0))
+
+    def test_subsurface_and_specular_models(self):
+        """Issue 17's fields reach the library by name, and bad values are refused with codes."""
+        from dwivedi import baker
+        self.assertEqual(len(baker.SUBSURFACE_MODELS), 7)
+        for name, code in baker.SUBSURFACE_MODELS.items():
+            self.assertEqual(dwivedi.Material(subsurface_model=name)._to_c().subsurface_model, code)
+        m = dwivedi.Material(specular_model="principled_v2", ior=1.45, specular=0.7, specular_tint=(1, 0.5, 0.25),
+                             specular_multiscatter=True)._to_c()
+        self.assertEqual((m.specular_model, m.ior, m.specular, tuple(m.specular_tint), m.specular_multiscatter),
+                         (2, 1.45, 0.7, (1.0, 0.5, 0.25), 1))
+        with dwivedi.Scene() as scene:
+            scene.add_material(dwivedi.Material(subsurface_model="blender52_random_walk", specular_model="principled_v2"))
+            with self.assertRaises(dwivedi.Error) as caught:
+                scene.add_material(dwivedi.Material(subsurface_model="blender6"))
+            self.assertEqual(caught.exception.code, _library.DWV_ERROR_UNKNOWN_NAME)
+            with self.assertRaises(dwivedi.Error) as caught:
+                scene.add_material(dwivedi.Material(specular_model="principled_v2", ior=0.5))
+            self.assertEqual(caught.exception.code, _library.DWV_ERROR_OUT_OF_RANGE)
+            with self.assertRaises(dwivedi.Error) as caught:
+                scene.add_material(dwivedi.Material(specular_model="principled_v1", specular_multiscatter=True))
+            self.assertEqual(caught.exception.code, _library.DWV_ERROR_INVALID_ARGUMENT)
+            with self.assertRaises(dwivedi.Error):
+                scene.add_material(dwivedi.Material(specular_tint=(1.0, 2.0, 1.0)))
+            with self.assertRaises(ValueError):
+                dwivedi.Material(specular_multiscatter=2)._to_c()
 
     def test_blender_3x_material_mapping(self):
         m = dwivedi.Material.from_blender_3x((1.0, 0.0, 0.0), 0.25, (0.0, 1.0, 0.0), (1.0, 0.5, 0.25))
