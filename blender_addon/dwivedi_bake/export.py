@@ -444,20 +444,6 @@ def camera_from_blender(scene: Any, width: int, height: int, dwivedi: Any, warni
 # The whole scene
 # ---------------------------------------------------------------------------------------------
 
-def model_warning(version: Optional[Tuple[int, ...]] = None) -> Optional[str]:
-    """A warning where this Blender's Cycles subsurface model is not mapped yet, else None.
-
-    Mapped: Cycles 3.x's Random Walk (Fixed Radius), which every version is baked as today. Not
-    yet: 4.0-4.x (entry by GGX refraction, Random Walk / Random Walk (Skin)), 5.0-5.1 (multi-bounce)
-    and 5.2+ (a Random Walk with mfp = radius and van de Hulst albedo, Legacy, Thin Wall)."""
-    version = tuple(version or bpy.app.version)
-    if version < (4, 0, 0):
-        return None
-    name = f"{version[0]}.{version[1]}"
-    return (f"Blender {name}: Cycles {name}'s subsurface model is not mapped yet; subsurface is baked as "
-            "Cycles 3.x Random Walk (Fixed Radius), so it will not match this Cycles' render")
-
-
 def export_scene(context: Any, settings: Any, dwivedi: Any) -> Exported:
     """Builds and commits the dwivedi scene of `context.scene` for the bake `settings`
     (scene.dwivedi_bake); ExportError if it cannot be baked as asked."""
@@ -486,10 +472,6 @@ def export_scene(context: Any, settings: Any, dwivedi: Any) -> Exported:
             key = None if material is None else material.name_full
             if key not in material_ids:
                 converted = material_from_blender(material, dwivedi, warnings)
-                if converted.kind == "subsurface":
-                    note = model_warning()
-                    if note and note not in warnings:
-                        warnings.append(note)
                 material_ids[key] = dw_scene.add_material(converted)
             return material_ids[key]
 

@@ -58,8 +58,8 @@ def principled_material(name, color, radius, scale=1.0, weight=1.0, anisotropy=0
     material = bpy.data.materials.new(name)
     material.use_nodes = True
     bsdf = material.node_tree.nodes["Principled BSDF"]
-    # 3.x's Fixed Radius walk where it exists; 4.0 renamed it Random Walk (5.2 changed it again:
-    # the add-on warns that those models are not mapped yet).
+    # 3.x's Fixed Radius walk where it exists; 4.0 renamed it Random Walk (5.2 made a new Random
+    # Walk, which the add-on maps as 5.2's Cycles does).
     methods = [item.identifier for item in bsdf.bl_rna.properties["subsurface_method"].enum_items]
     bsdf.subsurface_method = 'RANDOM_WALK_FIXED_RADIUS' if 'RANDOM_WALK_FIXED_RADIUS' in methods else 'RANDOM_WALK'
     inputs = bsdf.inputs
