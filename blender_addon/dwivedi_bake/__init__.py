@@ -322,6 +322,7 @@ class _Job:
             max_events=settings.walk_event_cap)
         self.display = display_settings(scene, self.dwivedi)
         self.bake = None
+        self.notes = []
 
     def start(self):
         self.bake = self.dwivedi.start_bake(self.exported.scene, self.bake_settings)
@@ -331,7 +332,17 @@ class _Job:
         image = self.bake.finish()
         try:
             image.write_exr(self.exr)
-            image.write_png(self.png, self.display)
+            try:
+                image.write_png(self.png, self.display)
+            except self.dwivedi.Error as error:
+                # The library's OpenColorIO cannot read this Blender's config (Blender 5.2 ships an
+                # OCIO 2.5 config, the library has 2.1): the PNG through Blender's own colour
+                # management instead (Image.save_render with the scene's view settings).
+                if "OCIO" not in str(error) and "config" not in str(error):
+                    raise
+                png_through_blender(image, context.scene, self.png)
+                self.notes.append("the PNG was made by Blender's colour management (the library's OpenColorIO "
+                                  "cannot read this Blender's config)")
             stats = image.stats
             if settings.load_result:
                 blender_image(image, "Dwivedi " + ("Camera" if settings.target == 'CAMERA' else "UV"), self.exr)
@@ -344,9 +355,10 @@ class _Job:
         # The technique asked for and whether the walks carried the colour channels apart (the
         # Channel Walks setting, or auto's choice per mesh), which the setting alone does not say.
         walks = stats.technique + (" with channel walks" if "channel_walks" in stats.features else "")
+        notes = "".join(f" ({note})" for note in self.notes)
         return (f"Dwivedi bake: {self.exported.width} x {self.exported.height}, {stats.samples_per_pixel} spp, "
                 f"{stats.seconds:.2f} s, est. error {stats.estimated_relative_error:.2%}, {walks}{degenerate} -> "
-                f"{self.exr}")
+                f"{self.exr}{notes}")
 
     def close(self):
         if self.bake is not None:
@@ -355,6 +367,22 @@ class _Job:
         if self.exported.scene is not None:
             self.exported.scene.close()
             self.exported.scene = None
+
+
+def png_through_blender(image, scene, path):
+    """Writes `image` as an 8-bit PNG through Blender's colour management (the scene's display,
+    view, look, exposure, gamma), as Image.save_render does."""
+    target = blender_image(image, "Dwivedi PNG (temporary)", path)
+    settings = scene.render.image_settings
+    saved = (settings.file_format, settings.color_mode, settings.color_depth)
+    try:
+        settings.file_format = 'PNG'
+        settings.color_mode = 'RGBA'
+        settings.color_depth = '8'
+        target.save_render(path, scene=scene)
+    finally:
+        settings.file_format, settings.color_mode, settings.color_depth = saved
+        bpy.data.images.remove(target)
 
 
 def display_settings(scene, dwivedi):
