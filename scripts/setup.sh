@@ -24,5 +24,13 @@ if [ ${#missing[@]} -gt 0 ]; then
   "${as_root[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
 
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "$@"
+# The Blender packages carry the self-contained library, made from static dependencies that
+# scripts/build-portable-deps.sh builds once into a cache (scripts/test.sh runs it): use that cache
+# when it is complete and no -DDWV_PORTABLE_DEPS was given.
+portable=()
+if [[ " $* " != *" -DDWV_PORTABLE_DEPS="* ]]; then
+  prefix=$(scripts/build-portable-deps.sh --print-prefix)
+  [ -f "$prefix/.complete" ] && portable=(-DDWV_PORTABLE_DEPS="$prefix")
+fi
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "${portable[@]}" "$@"
 cmake --build build -j "$(nproc)"
