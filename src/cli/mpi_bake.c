@@ -110,7 +110,9 @@ static void end_all(job *j, int code)
     remove_files(j);
     fflush(stdout);
     fflush(stderr);
-    MPI_Abort(MPI_COMM_WORLD, code);
+    /* A signal (mpirun ending the job, or Ctrl-C): this rank just ends; mpirun ends the others when
+     * a rank exits without MPI_Finalize. Else MPI_Abort ends them all. */
+    if (!interrupted) MPI_Abort(MPI_COMM_WORLD, code);
     _exit(code); /* MPI_Abort does not return; if it did, this rank still ends */
 }
 
@@ -317,10 +319,11 @@ static void next_range(job *j, uint64_t range[2])
     j->next_first += range[1];
 }
 
-static char *range_path(job *j, uint64_t first)
+/* A file for the range from `first` that `rank` baked: the merge's messages name the rank at fault. */
+static char *range_path(job *j, uint64_t first, int rank)
 {
     char path[4200];
-    snprintf(path, sizeof path, "%s/%llu.dwvpart", j->dir, (unsigned long long)first);
+    snprintf(path, sizeof path, "%s/samples-%llu-rank-%d.dwvpart", j->dir, (unsigned long long)first, rank);
     if (j->path_count == j->path_capacity) {
         uint32_t capacity = j->path_capacity ? 2u * j->path_capacity : 16u;
         char **grown = realloc(j->paths, capacity * sizeof *grown);
@@ -348,7 +351,7 @@ static void hand_out(job *j, int peer)
 static void receive_range(job *j, int peer, const uint64_t head[3])
 {
     double start = now();
-    char *path = range_path(j, head[0]);
+    char *path = range_path(j, head[0], peer);
     char *block = malloc(BLOCK_BYTES);
     FILE *out = path ? fopen(path, "wb") : NULL;
     if (!block || !out)
@@ -427,7 +430,7 @@ static int run_root(job *j, double start)
         uint64_t range[2];
         next_range(j, range);
         if (range[1] == 0u) break;
-        char *path = range_path(j, range[0]);
+        char *path = range_path(j, range[0], 0);
         if (!path) root_fail(j, 0, "out of memory");
         if (bake_range(j, range[0], range[1], path, root_service, message, sizeof message) != 0) {
             if (interrupted) {
