@@ -48,7 +48,7 @@ def timed(command: Sequence[str]) -> Tuple[float, float, str]:
 
 class Bench:
     def __init__(self, args: argparse.Namespace, folder: str) -> None:
-        self.cli, self.folder, self.quick = args.cli, folder, args.quick
+        self.cli, self.folder, self.quick, self.pairs = args.cli, folder, args.quick, args.pairs
         self.mpirun = [args.mpirun, "--oversubscribe"] + (["--allow-run-as-root"] if os.geteuid() == 0 else [])
 
     def path(self, name: str) -> str:
@@ -62,12 +62,13 @@ class Bench:
         spp = 256 if self.quick else 2048
         bake = ["--width", "64", "--height", "48", "--spp", str(spp)]
         print(f"== 1 -> 2 ranks: default scene, 64 x 48, {spp} spp, one thread per rank, mpirun --bind-to none")
-        print(f"cores: {os.cpu_count()}; load average before: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
+        print(f"cores: {os.cpu_count()}; nice {os.nice(0)}; load average before: "
+              f"{' '.join(f'{x:.2f}' for x in os.getloadavg())}")
         walls: Dict[int, List[float]] = {1: [], 2: []}
         inner: Dict[int, List[float]] = {1: [], 2: []}  # from MPI_Init to the outputs written (its own print)
         cpus: Dict[int, List[float]] = {1: [], 2: []}
         transfer = (0.0, 0.0)
-        for ranks in (1, 2, 1, 2):
+        for ranks in (1, 2) * self.pairs:
             wall, cpu, out = self.mpi_bake(ranks, bake, f"speed{ranks}")
             walls[ranks].append(wall)
             inner[ranks].append(float(re.search(r"([0-9.]+) s wall", out).group(1)))
@@ -86,6 +87,12 @@ class Bench:
         print(f"speed-up 1 -> 2 ranks, mpirun's wall: {best:.2f}x (best runs; per alternated pair "
               f"{', '.join(f'{p:.2f}x' for p in pairs)}); inside dwivedi (without mpirun's start): "
               f"{min(inner[1]) / min(inner[2]):.2f}x; CPU 2 ranks / 1 rank: {min(cpus[2]) / min(cpus[1]):.2f}")
+        # What the ranks got of the machine: a rank that had a core to itself would use 1 CPU second
+        # per wall second; on a shared machine it gets less, and the wall ratio shows the others' load.
+        share = [sum(cpus[r]) / sum(walls[r]) / r for r in (1, 2)]
+        print(f"CPU per rank per wall second: 1 rank {share[0]:.2f}, 2 ranks {share[1]:.2f} (1.00 on an idle machine); "
+              f"the speed-up with a core per rank, 2 x CPU(1 rank) / CPU(2 ranks): "
+              f"{2 * sum(cpus[1]) / sum(cpus[2]):.2f}x")
         one = json.load(open(self.path("speed1.json")))
         return {"speedup": best, "transfer_bytes": transfer[0], "transfer_seconds": transfer[1],
                 "error": one["estimated_relative_error"], "spp": one["spp"]}
@@ -208,6 +215,8 @@ def main() -> None:
     parser.add_argument("--cli", default=os.path.join(os.path.dirname(__file__), "..", "build", "dwivedi"))
     parser.add_argument("--mpirun", default=shutil.which("mpirun") or "mpirun")
     parser.add_argument("--quick", action="store_true", help="smaller runs (a check that the script works)")
+    parser.add_argument("--pairs", type=int, default=2, help="alternated 1-rank / 2-rank runs (default 2)")
+    parser.add_argument("--speedup-only", action="store_true", help="part 1 only")
     parser.add_argument("--model-pixels", type=int, default=2048 * 2048)
     parser.add_argument("--model-error", type=float, default=0.001)
     parser.add_argument("--model-cores", type=int, default=32)
@@ -216,6 +225,8 @@ def main() -> None:
     with tempfile.TemporaryDirectory(prefix="mpi_bench-") as folder:
         bench = Bench(args, folder)
         speed = bench.speedup()
+        if args.speedup_only:
+            return
         if speed["transfer_seconds"] > 0:
             print(f"transfer (2 ranks, shared memory here, with rank 0 writing the ranges to its disk): "
                   f"{speed['transfer_bytes'] / 1e6:.1f} MB in {speed['transfer_seconds']:.3f} s = "

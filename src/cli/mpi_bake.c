@@ -181,7 +181,8 @@ static int bake_range(job *j, uint64_t first, uint64_t count, const char *path, 
         return -1;
     }
     for (int32_t finished = 0; !finished;) {
-        if (dwv_bake_wait(bake, 0.005, &finished) != DWV_SUCCESS) {
+        /* rank 0 answers within 5 ms; a worker only reports that it lives */
+        if (dwv_bake_wait(bake, j->rank == 0 ? 0.005 : 0.05, &finished) != DWV_SUCCESS) {
             snprintf(message, message_size, "%s", dwv_last_error_message());
             dwv_bake_cancel(bake);
             break;
@@ -221,6 +222,7 @@ static void worker_fail(job *j, const char *message)
     if (send_to(j, text, (int)strlen(text) + 1, MPI_CHAR, 0, TAG_FAILED, "receipt of a failure") == 0) {
         double start = now();
         while (now() - start < j->timeout && !interrupted) pause_briefly();
+        if (interrupted) end_all(j, CLI_FAILED); /* ended by rank 0, which has printed the message */
     }
     fprintf(stderr, "dwivedi bake: rank %d of %d: %s\n", j->rank, j->ranks, message);
     end_all(j, CLI_FAILED);

@@ -152,6 +152,17 @@ class MpiBakeTest(unittest.TestCase):
         self.assertRegex(done.stderr, r"rank-1\.dwvpart' is foreign: another seed")
         self.assert_nothing_written("out")
 
+    def test_a_rank_whose_range_fails_ends_all(self) -> None:
+        # rank 1 cannot write its range's file (its TMPDIR does not exist): its message, from rank 0
+        cli, out = os.environ["DWIVEDI_CLI"], self.path("out")
+        command = [*mpirun_prefix(1), cli, "bake", *SMALL, "--mpi", "--out", out, ":", "-n", "1", "env",
+                   "TMPDIR=" + self.path("absent"), cli, "bake", *SMALL, "--mpi", "--out", out]
+        done = subprocess.run(command, capture_output=True, text=True, timeout=RUN_TIMEOUT, env=self.env)
+        self.assertNotEqual(done.returncode, 0)
+        self.assertRegex(done.stderr, r"rank 1 of 2: samples \d+:\d+: dwv_image_write_partial: cannot write .*absent")
+        self.assertEqual(done.stderr.count("dwv_image_write_partial"), 1, done.stderr)
+        self.assert_nothing_written("out")
+
     def rank_process(self, rank: int, deadline: float) -> int:
         """The pid of this test's `dwivedi` of MPI rank `rank` (found by its environment)."""
         wanted = {f"DWV_TEST_RUN={self.env['DWV_TEST_RUN']}".encode(), f"OMPI_COMM_WORLD_RANK={rank}".encode()}
