@@ -10,7 +10,8 @@ many nodes"): prints
      error constant K = error * sqrt(spp),
   4. the model's time to a given error on 10, 100 and 1000 nodes.
 
-Usage: tools/mpi_bench.py [--cli build/dwivedi] [--mpirun mpirun] [--quick] [--model-pixels N]
+Usage: tools/mpi_bench.py [--cli build/dwivedi] [--mpirun mpirun] [--quick] [--pairs N]
+       [--speedup-only | --skip-speedup] [--model-pixels N]
        [--model-error E] [--model-cores C] [--model-bandwidth BYTES_PER_S]
 Standard library only; any Python 3.8+.
 """
@@ -58,7 +59,7 @@ class Bench:
         return timed([*self.mpirun, "--bind-to", "none", "-n", str(ranks), self.cli, "bake", *bake, "--threads", "1",
                       "--mpi", "--quiet", "--out", self.path(name)])
 
-    def speedup(self) -> Dict[str, float]:
+    def speedup(self) -> None:
         spp = 256 if self.quick else 2048
         bake = ["--width", "64", "--height", "48", "--spp", str(spp)]
         print(f"== 1 -> 2 ranks: default scene, 64 x 48, {spp} spp, one thread per rank, mpirun --bind-to none")
@@ -67,7 +68,6 @@ class Bench:
         walls: Dict[int, List[float]] = {1: [], 2: []}
         inner: Dict[int, List[float]] = {1: [], 2: []}  # from MPI_Init to the outputs written (its own print)
         cpus: Dict[int, List[float]] = {1: [], 2: []}
-        transfer = (0.0, 0.0)
         for ranks in (1, 2) * self.pairs:
             wall, cpu, out = self.mpi_bake(ranks, bake, f"speed{ranks}")
             walls[ranks].append(wall)
@@ -75,9 +75,6 @@ class Bench:
             cpus[ranks].append(cpu)
             print(f"  {ranks} rank(s): {wall:7.2f} s mpirun wall, {inner[ranks][-1]:7.2f} s in dwivedi, {cpu:7.2f} s CPU"
                   f"  | {out.splitlines()[1]}")
-            received = re.search(r"received ([0-9.]+) MB in ([0-9.]+) s", out)
-            if ranks == 2 and received:
-                transfer = (float(received.group(1)) * 1e6, float(received.group(2)))
         for name in ("speed1", "speed2"):
             if open(self.path(name + ".png"), "rb").read() != open(self.path("speed1.png"), "rb").read():
                 sys.exit("mpi_bench: the 1- and 2-rank images differ")
@@ -93,9 +90,6 @@ class Bench:
         print(f"CPU per rank per wall second: 1 rank {share[0]:.2f}, 2 ranks {share[1]:.2f} (1.00 on an idle machine); "
               f"the speed-up with a core per rank, 2 x CPU(1 rank) / CPU(2 ranks): "
               f"{2 * sum(cpus[1]) / sum(cpus[2]):.2f}x")
-        one = json.load(open(self.path("speed1.json")))
-        return {"speedup": best, "transfer_bytes": transfer[0], "transfer_seconds": transfer[1],
-                "error": one["estimated_relative_error"], "spp": one["spp"]}
 
     def sample_cost(self) -> Dict[str, float]:
         """Seconds per sample and pixel on one thread, and the fixed cost of a range inside an MPI run
@@ -116,13 +110,20 @@ class Bench:
         per_range = (min(many) - min(few)) / 15.0
         print(f"per-range fixed cost b = {per_range:.3f} s (1 rank: 1 range {min(few):.2f} s, 16 ranges "
               f"{min(many):.2f} s wall, best of 2)")
+        # the transfer: 2 ranks, ranges of one sample of a 384 x 216 image (13.6 MB each)
+        _, _, out = self.mpi_bake(2, ["--width", "384", "--height", "216", "--spp", "8", "--technique", "classical",
+                                      "--mpi-chunk", "1"], "transfer")
+        received = re.search(r"received ([0-9.]+) MB in ([0-9.]+) s", out)
+        transfer = float(received.group(1)) * 1e6 / max(float(received.group(2)), 1e-9)
+        print(f"transfer into rank 0 (shared memory, rank 0 writing the ranges to its disk): {received.group(1)} MB "
+              f"in {received.group(2)} s = {transfer / 1e9:.2f} GB/s")
         k = single["estimated_relative_error"] * math.sqrt(spp)
         points = single["error_vs_time"]
         slope = (math.log(points[-1]["estimated_relative_error"]) - math.log(points[1]["estimated_relative_error"])) / (
             math.log(points[-1]["spp"]) - math.log(points[1]["spp"]))
         print(f"error constant K = error * sqrt(spp) = {k:.4f} (log-log slope of its error_vs_time "
               f"from {points[1]['spp']} to {points[-1]['spp']} spp: {slope:.3f}; 1/sqrt(spp) is -0.5)")
-        return {"a": per_sample, "b": per_range, "K": k}
+        return {"a": per_sample, "b": per_range, "K": k, "transfer": transfer}
 
     def merge_cost(self) -> Dict[str, float]:
         sizes = [(96, 54), (192, 108)] if self.quick else [(96, 54), (192, 108), (384, 216)]
@@ -130,7 +131,7 @@ class Bench:
         total = max(counts)
         print(f"\n== merge cost: `dwivedi merge` (chunks, EXR, PNG, JSON), {total} spp in equal chunks, "
               "best of 3")
-        print(f"{'pixels':>8} {'chunks':>6} {'MB/chunk':>9} {'wall s':>8} {'CPU s':>7} {'ns/chunk-pixel':>15}")
+        print(f"{'pixels':>8} {'chunks':>6} {'MB/chunk':>9} {'wall s':>8} {'CPU s':>7} {'CPU ns/chunk-pixel':>19}")
         rows = []
         for width, height in sizes:
             pixels = width * height
@@ -149,12 +150,13 @@ class Bench:
                 size = os.path.getsize(parts[0])
                 rows.append((pixels, count, best_wall, best_cpu))
                 print(f"{pixels:8d} {count:6d} {size / 1e6:9.2f} {best_wall:8.3f} {best_cpu:7.3f} "
-                      f"{1e9 * best_wall / (pixels * count):15.1f}")
+                      f"{1e9 * best_cpu / (pixels * count):19.1f}")
                 for part in parts:
                     os.remove(part)
-        # least squares of wall = c0 + c1 * pixels + c2 * pixels * chunks (the outputs, the chunks)
-        c0, c1, c2 = least_squares([(1.0, p, p * c) for p, c, _, _ in rows], [w for _, _, w, _ in rows])
-        print(f"fit: merge wall = {c0:.3f} s + {c1 * 1e9:.1f} ns x pixels + {c2 * 1e9:.1f} ns x pixels x chunks")
+        # least squares of time = c0 + c1 * pixels + c2 * pixels * chunks (the outputs, the chunks), of
+        # the CPU seconds: the merge runs on one thread, and its wall here grows with the others' load
+        c0, c1, c2 = least_squares([(1.0, p, p * c) for p, c, _, _ in rows], [u for _, _, _, u in rows])
+        print(f"fit: merge CPU = {c0:.3f} s + {c1 * 1e9:.1f} ns x pixels + {c2 * 1e9:.1f} ns x pixels x chunks")
         return {"m0": c0, "m_pixel": c1, "m_chunk_pixel": c2}
 
 
@@ -194,7 +196,8 @@ def model(pieces: Dict[str, float], args: argparse.Namespace) -> None:
     spp = math.ceil((k_err / error) ** 2)
     range_bytes = n * PARTIAL_BYTES_PER_PIXEL + PARTIAL_FIXED_BYTES
     print(f"\n== model: time to error {error:g} (spp = (K/E)^2 = {spp}) for {n} pixels, {cores} cores per node, "
-          f"{bandwidth / 1e9:g} GB/s into rank 0; a range is {range_bytes / 1e6:.0f} MB")
+          f"{bandwidth / 1e9:g} GB/s into rank 0 (measured here: {pieces['transfer'] / 1e9:.2f} GB/s); a range is "
+          f"{range_bytes / 1e6:.0f} MB")
     print(f"{'nodes':>6} {'k':>2} {'bake s':>9} {'ranges s':>9} {'send s':>9} {'merge s':>9} {'out s':>6} "
           f"{'total s':>9} {'efficiency':>10}")
     serial = a * n * spp / cores
@@ -217,6 +220,7 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="smaller runs (a check that the script works)")
     parser.add_argument("--pairs", type=int, default=2, help="alternated 1-rank / 2-rank runs (default 2)")
     parser.add_argument("--speedup-only", action="store_true", help="part 1 only")
+    parser.add_argument("--skip-speedup", action="store_true", help="parts 2 to 4 only")
     parser.add_argument("--model-pixels", type=int, default=2048 * 2048)
     parser.add_argument("--model-error", type=float, default=0.001)
     parser.add_argument("--model-cores", type=int, default=32)
@@ -224,13 +228,10 @@ def main() -> None:
     args = parser.parse_args()
     with tempfile.TemporaryDirectory(prefix="mpi_bench-") as folder:
         bench = Bench(args, folder)
-        speed = bench.speedup()
+        if not args.skip_speedup:
+            bench.speedup()
         if args.speedup_only:
             return
-        if speed["transfer_seconds"] > 0:
-            print(f"transfer (2 ranks, shared memory here, with rank 0 writing the ranges to its disk): "
-                  f"{speed['transfer_bytes'] / 1e6:.1f} MB in {speed['transfer_seconds']:.3f} s = "
-                  f"{speed['transfer_bytes'] / speed['transfer_seconds'] / 1e9:.2f} GB/s")
         pieces = bench.sample_cost()
         pieces.update(bench.merge_cost())
         model(pieces, args)
