@@ -183,7 +183,9 @@ def model(pieces: Dict[str, float], args: argparse.Namespace) -> None:
     """Time to relative error E of an image of n pixels on P nodes of c cores, k ranges per rank:
          spp    = (K / E)^2                                   (error ~ 1 / sqrt(spp))
          bake   = a * n * spp / (P * c)                       (the samples, shared by P * c cores)
-         ranges = k * b                                       (each rank's fixed cost per range)
+         ranges = k * (b + R / D)                             (each rank's cost per range: its start and
+                                                               pilot, b, and its file written and read
+                                                               back at D, the rate measured here)
          send   = P * R / B_net + max(0, (k - 1) * P * R / B_net - bake)
                                                               (R = n * 164 B a range: rank 0 takes the
                                                                last wave one after another; the earlier
@@ -204,7 +206,7 @@ def model(pieces: Dict[str, float], args: argparse.Namespace) -> None:
     for nodes in (10, 100, 1000):
         for per_rank in (1, 2):
             bake = serial / nodes
-            ranges = per_rank * b
+            ranges = per_rank * (b + range_bytes / pieces["transfer"])
             send = nodes * range_bytes / bandwidth + max(0.0, (per_rank - 1) * nodes * range_bytes / bandwidth - bake)
             merge = per_rank * nodes * n * pieces["m_chunk_pixel"]
             out = pieces["m0"] + pieces["m_pixel"] * n

@@ -484,6 +484,7 @@ static int check_mpi_flags(cli_bake_flags *f, dwv_bake_options_t *o)
     if (f->chunk) return cli_usage_error("bake", "--mpi hands out the sample ranges itself: no --samples");
     if (f->budget)
         return cli_usage_error("bake", "--mpi bakes exactly --spp samples: no --time or --error (docs/farm.md, \"MPI\")");
+    if (o->samples == 0u) return cli_usage_error("bake", "--mpi: --spp must be at least 1");
     /* as for a chunk: the ranks bake the whole --spp, whatever the scene file's budgets say */
     o->time_limit = 0.0;
     o->target_error = 0.0;

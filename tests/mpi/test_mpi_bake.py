@@ -212,7 +212,8 @@ class MpiBakeTest(unittest.TestCase):
         self.assert_nothing_written("out")
 
     def test_what_mpi_does_not_do_is_refused(self) -> None:
-        for extra, message in ((["--time", "5"], "no --time or --error"), (["--samples", "0:4"], "no --samples")):
+        for extra, message in ((["--time", "5"], "no --time or --error"), (["--samples", "0:4"], "no --samples"),
+                               (["--spp", "0"], "--spp must be at least 1")):
             with self.subTest(extra=extra):
                 done = self.mpirun(1, *SMALL, *extra, "--mpi", "--out", self.path("out"))
                 self.assertEqual(done.returncode, 2, done.stderr)
