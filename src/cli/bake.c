@@ -306,7 +306,7 @@ static int write_stats_json(const char *path, const dwv_image_t *image, const dw
 
 /* Writes the three outputs under temporary names, then renames them into place. */
 int cli_bake_write_outputs(const char *prefix, const dwv_image_t *image, const dwv_bake_options_t *o,
-                         const dwv_display_options_t *display, const char *scene_name)
+                           const dwv_display_options_t *display, const char *scene_name)
 {
     static const char *const final_suffix[3] = {".exr", ".png", ".json"};
     char temp_suffix[3][64];

@@ -349,6 +349,32 @@ static void hand_out(job *j, int peer)
     if (send_to(j, range, 2, MPI_UINT64_T, peer, TAG_WORK, "receipt of a range") != 0) end_all(j, CLI_FAILED);
 }
 
+/* Receives the next block of `peer`'s range into `block` (n bytes), or its failure's message. */
+static void receive_block(job *j, int peer, char *block, int n)
+{
+    double start = now();
+    for (;;) {
+        int waiting = 0;
+        MPI_Status status;
+        MPI_Iprobe(peer, MPI_ANY_TAG, MPI_COMM_WORLD, &waiting, &status);
+        if (waiting && status.MPI_TAG == TAG_BYTES) {
+            MPI_Recv(block, n, MPI_BYTE, peer, TAG_BYTES, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+            return;
+        }
+        if (waiting && status.MPI_TAG == TAG_FAILED) {
+            char text[MESSAGE_BYTES];
+            MPI_Recv(text, MESSAGE_BYTES, MPI_CHAR, peer, TAG_FAILED, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+            text[MESSAGE_BYTES - 1] = '\0';
+            root_fail(j, peer, "%s", text);
+        }
+        if (waiting) root_fail(j, 0, "unexpected message %d from rank %d within a range", status.MPI_TAG, peer);
+        if (interrupted) end_all(j, 130);
+        if (now() - start > j->timeout)
+            root_fail(j, 0, "no bytes of a range from rank %d in %g s (--mpi-timeout)", peer, j->timeout);
+        pause_briefly();
+    }
+}
+
 /* Receives the range that `peer` announced with `head` {first, count, bytes} into rank 0's folder. */
 static void receive_range(job *j, int peer, const uint64_t head[3])
 {
@@ -361,7 +387,7 @@ static void receive_range(job *j, int peer, const uint64_t head[3])
                   (unsigned long long)head[1], peer, path ? strerror(errno) : "out of memory");
     for (uint64_t got = 0; got < head[2];) {
         int n = head[2] - got < BLOCK_BYTES ? (int)(head[2] - got) : (int)BLOCK_BYTES;
-        if (receive_from(j, block, n, MPI_BYTE, peer, TAG_BYTES, "bytes of a range") != 0) end_all(j, CLI_FAILED);
+        receive_block(j, peer, block, n);
         if (fwrite(block, 1, (size_t)n, out) != (size_t)n) root_fail(j, 0, "cannot write %s: %s", path, strerror(errno));
         got += (uint64_t)n;
     }
