@@ -63,7 +63,7 @@ class Bench:
         spp = 256 if self.quick else 2048
         bake = ["--width", "64", "--height", "48", "--spp", str(spp)]
         print(f"== 1 -> 2 ranks: default scene, 64 x 48, {spp} spp, one thread per rank, mpirun --bind-to none")
-        print(f"cores: {os.cpu_count()}; nice {os.nice(0)}; load average before: "
+        print(f"cores: {os.cpu_count()}; nice {os.nice(0)}; {autogroup()}; load average before: "
               f"{' '.join(f'{x:.2f}' for x in os.getloadavg())}")
         walls: Dict[int, List[float]] = {1: [], 2: []}
         inner: Dict[int, List[float]] = {1: [], 2: []}  # from MPI_Init to the outputs written (its own print)
@@ -158,6 +158,17 @@ class Bench:
         c0, c1, c2 = least_squares([(1.0, p, p * c) for p, c, _, _ in rows], [u for _, _, _, u in rows])
         print(f"fit: merge CPU = {c0:.3f} s + {c1 * 1e9:.1f} ns x pixels + {c2 * 1e9:.1f} ns x pixels x chunks")
         return {"m0": c0, "m_pixel": c1, "m_chunk_pixel": c2}
+
+
+def autogroup() -> str:
+    """Whether Linux shares the CPU per session (autogroup): then a second rank started from the same
+    session competes with the first for that session's share, however many cores are idle of it."""
+    try:
+        with open("/proc/sys/kernel/sched_autogroup_enabled") as f:
+            enabled = f.read().strip() == "1"
+    except OSError:
+        return "autogroup unknown"
+    return "autogroup on (the CPU is shared per session)" if enabled else "autogroup off"
 
 
 def least_squares(rows: List[Tuple[float, float, float]], values: List[float]) -> Tuple[float, float, float]:
