@@ -117,12 +117,12 @@ static void end_all(job *j, int code)
 }
 
 /* Waits for `request` to complete, at most the timeout; 0, or -1 after reporting what was awaited. */
-static int wait_for(job *j, MPI_Request *request, MPI_Status *status, const char *what, int peer)
+static int wait_for(job *j, MPI_Request *request, const char *what, int peer)
 {
     double start = now();
     for (;;) {
         int done = 0;
-        MPI_Test(request, &done, status ? status : MPI_STATUS_IGNORE);
+        MPI_Test(request, &done, MPI_STATUS_IGNORE);
         if (done) return 0;
         if (interrupted) return -1;
         if (now() - start > j->timeout) {
@@ -130,8 +130,7 @@ static int wait_for(job *j, MPI_Request *request, MPI_Status *status, const char
             if (peer >= 0) snprintf(from, sizeof from, "rank %d", peer);
             fprintf(stderr, "dwivedi bake: rank %d of %d: no %s from %s in %g s (--mpi-timeout); ending all ranks\n",
                     j->rank, j->ranks, what, from, j->timeout);
-            MPI_Cancel(request);
-            return -1;
+            return -1; /* the caller ends all ranks, this request with them */
         }
         pause_briefly();
     }
@@ -141,14 +140,14 @@ static int send_to(job *j, const void *data, int count, MPI_Datatype type, int p
 {
     MPI_Request request;
     MPI_Isend(data, count, type, peer, tag, MPI_COMM_WORLD, &request);
-    return wait_for(j, &request, NULL, what, peer);
+    return wait_for(j, &request, what, peer);
 }
 
 static int receive_from(job *j, void *data, int count, MPI_Datatype type, int peer, int tag, const char *what)
 {
     MPI_Request request;
     MPI_Irecv(data, count, type, peer, tag, MPI_COMM_WORLD, &request);
-    return wait_for(j, &request, NULL, what, peer);
+    return wait_for(j, &request, what, peer);
 }
 
 /* Threads per rank where neither the scene nor --threads says: the cores this rank is bound to,
@@ -287,7 +286,7 @@ static int run_worker(job *j)
         if (sent != 0) end_all(j, interrupted ? 130 : CLI_FAILED);
     }
     /* rank 0 has taken every "still baking" before the last range (messages do not overtake) */
-    if (j->alive != MPI_REQUEST_NULL && wait_for(j, &j->alive, NULL, "receipt of a report", 0) != 0)
+    if (j->alive != MPI_REQUEST_NULL && wait_for(j, &j->alive, "receipt of a report", 0) != 0)
         end_all(j, CLI_FAILED);
     return CLI_OK;
 }
@@ -554,7 +553,7 @@ int cli_mpi_bake(int argc, char **argv)
     {
         MPI_Request request;
         MPI_Iallreduce(&status, &worst, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD, &request);
-        if (wait_for(&j, &request, NULL, "start (the scene loaded)", -1) != 0) end_all(&j, CLI_FAILED);
+        if (wait_for(&j, &request, "start (the scene loaded)", -1) != 0) end_all(&j, CLI_FAILED);
     }
     if (worst != CLI_OK) {
         if (status == CLI_OK && j.rank == 0)
