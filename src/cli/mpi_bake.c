@@ -112,7 +112,12 @@ static void end_all(job *j, int code)
     fflush(stderr);
     /* A signal (mpirun ending the job, or Ctrl-C): this rank just ends; mpirun ends the others when
      * a rank exits without MPI_Finalize. Else MPI_Abort ends them all. */
-    if (!interrupted) MPI_Abort(MPI_COMM_WORLD, code);
+    if (!interrupted) {
+        /* the files are gone: mpirun's SIGTERM, which MPI_Abort brings here too, may now just end us */
+        signal(SIGTERM, SIG_DFL);
+        signal(SIGINT, SIG_DFL);
+        MPI_Abort(MPI_COMM_WORLD, code);
+    }
     _exit(code); /* MPI_Abort does not return; if it did, this rank still ends */
 }
 
@@ -186,7 +191,13 @@ static int bake_range(job *j, uint64_t first, uint64_t count, const char *path, 
             dwv_bake_cancel(bake);
             break;
         }
-        if (interrupted) dwv_bake_cancel(bake);
+        if (interrupted) {
+            /* mpirun ending the job sends SIGTERM and soon SIGKILL: the caller removes the files
+             * and exits now, without waiting for the bake's threads to stop */
+            dwv_bake_cancel(bake);
+            snprintf(message, message_size, "cancelled; nothing written");
+            return -1;
+        }
         service(j);
     }
     dwv_result_t r = dwv_bake_finish(bake, &image);

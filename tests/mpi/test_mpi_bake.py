@@ -180,14 +180,18 @@ class MpiBakeTest(unittest.TestCase):
             time.sleep(0.05)
         raise AssertionError(f"rank {rank} did not start")
 
-    def signal_rank_mid_bake(self, signal_number: int, *extra: str) -> Tuple[subprocess.CompletedProcess, float]:
-        """Runs a long bake on 2 ranks, sends rank 1 `signal_number` once it is baking, and returns
-        the run and the seconds from the signal to mpirun's exit."""
-        command = [*mpirun_prefix(2), os.environ["DWIVEDI_CLI"], "bake", *LONG, *extra, "--mpi", "--out",
-                   self.path("out")]
+    def signal_rank_mid_bake(self, signal_number: int, *extra: str, rank: int = 1) -> Tuple[subprocess.CompletedProcess, float]:
+        """Runs a long bake on 2 ranks, sends rank `rank` `signal_number` once it is baking, and
+        returns the run and the seconds from the signal to mpirun's exit."""
+        # When mpirun ends a job it sends the ranks SIGTERM, and SIGKILL 1 s later: on a loaded
+        # machine a rank (a stopped one just continued) may not have run by then to remove its
+        # files. 3 s here (mpirun then waits that long), so that the check of no leftovers tests
+        # dwivedi, not the scheduler.
+        command = [*mpirun_prefix(2), "--mca", "odls_base_sigkill_timeout", "3", os.environ["DWIVEDI_CLI"], "bake",
+                   *LONG, *extra, "--mpi", "--out", self.path("out")]
         run = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=self.env)
         try:
-            pid = self.rank_process(1, time.monotonic() + RUN_TIMEOUT)
+            pid = self.rank_process(rank, time.monotonic() + RUN_TIMEOUT)
             time.sleep(1.0)  # past the start: baking its first range
             os.kill(pid, signal_number)
             signalled = time.monotonic()
@@ -208,6 +212,14 @@ class MpiBakeTest(unittest.TestCase):
         done, seconds = self.signal_rank_mid_bake(19, "--mpi-timeout", "2")  # SIGSTOP
         self.assertNotEqual(done.returncode, 0)
         self.assertIn("rank 1 has not been heard from in 2 s", done.stderr)
+        self.assertLess(seconds, RUN_TIMEOUT)
+        self.assert_nothing_written("out")
+
+    def test_a_stopped_rank_0_times_out(self) -> None:
+        # short ranges: rank 1 soon needs rank 0 (to take a range, or to give it the next)
+        done, seconds = self.signal_rank_mid_bake(19, "--mpi-timeout", "2", "--mpi-chunk", "20", rank=0)
+        self.assertNotEqual(done.returncode, 0)
+        self.assertRegex(done.stderr, r"rank 1 of 2: no .* from rank 0 in 2 s \(--mpi-timeout\)")
         self.assertLess(seconds, RUN_TIMEOUT)
         self.assert_nothing_written("out")
 
