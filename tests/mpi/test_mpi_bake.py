@@ -8,6 +8,7 @@ Environment (tests/CMakeLists.txt): DWIVEDI_CLI, DWIVEDI_MPIRUN (unset where MPI
 DWIVEDI_CLI_WITHOUT_MPI (the command built without MPI)."""
 import json
 import os
+import signal
 import struct
 import subprocess
 import tempfile
@@ -163,6 +164,13 @@ class MpiBakeTest(unittest.TestCase):
         self.assertEqual(done.stderr.count("dwv_image_write_partial"), 1, done.stderr)
         self.assert_nothing_written("out")
 
+    def is_ours(self, pid: int) -> bool:
+        try:
+            with open(f"/proc/{pid}/environ", "rb") as f:
+                return f"DWV_TEST_RUN={self.env['DWV_TEST_RUN']}".encode() in f.read().split(b"\0")
+        except OSError:
+            return False
+
     def rank_process(self, rank: int, deadline: float) -> int:
         """The pid of this test's `dwivedi` of MPI rank `rank` (found by its environment)."""
         wanted = {f"DWV_TEST_RUN={self.env['DWV_TEST_RUN']}".encode(), f"OMPI_COMM_WORLD_RANK={rank}".encode()}
@@ -180,7 +188,8 @@ class MpiBakeTest(unittest.TestCase):
             time.sleep(0.05)
         raise AssertionError(f"rank {rank} did not start")
 
-    def signal_rank_mid_bake(self, signal_number: int, *extra: str, rank: int = 1) -> Tuple[subprocess.CompletedProcess, float]:
+    def signal_rank_mid_bake(self, signal_number: int, *extra: str,
+                             rank: int = 1) -> Tuple[subprocess.CompletedProcess, float]:
         """Runs a long bake on 2 ranks, sends rank `rank` `signal_number` once it is baking, and
         returns the run and the seconds from the signal to mpirun's exit."""
         # When mpirun ends a job it sends the ranks SIGTERM, and SIGKILL 1 s later: on a loaded
@@ -190,6 +199,7 @@ class MpiBakeTest(unittest.TestCase):
         command = [*mpirun_prefix(2), "--mca", "odls_base_sigkill_timeout", "3", os.environ["DWIVEDI_CLI"], "bake",
                    *LONG, *extra, "--mpi", "--out", self.path("out")]
         run = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=self.env)
+        pid = 0
         try:
             pid = self.rank_process(rank, time.monotonic() + RUN_TIMEOUT)
             time.sleep(1.0)  # past the start: baking its first range
@@ -201,15 +211,17 @@ class MpiBakeTest(unittest.TestCase):
             if run.poll() is None:
                 run.kill()
                 run.communicate()
+            if pid and self.is_ours(pid):  # a failed test leaves no stopped rank behind
+                os.kill(pid, signal.SIGKILL)
 
     def test_a_killed_rank_ends_all(self) -> None:
-        done, _ = self.signal_rank_mid_bake(9)
+        done, _ = self.signal_rank_mid_bake(signal.SIGKILL)
         self.assertNotEqual(done.returncode, 0)
         self.assertIn("rank 1", done.stderr)
         self.assert_nothing_written("out")
 
     def test_a_stopped_rank_times_out(self) -> None:
-        done, seconds = self.signal_rank_mid_bake(19, "--mpi-timeout", "2")  # SIGSTOP
+        done, seconds = self.signal_rank_mid_bake(signal.SIGSTOP, "--mpi-timeout", "2")
         self.assertNotEqual(done.returncode, 0)
         self.assertIn("rank 1 has not been heard from in 2 s", done.stderr)
         self.assertLess(seconds, RUN_TIMEOUT)
@@ -217,7 +229,7 @@ class MpiBakeTest(unittest.TestCase):
 
     def test_a_stopped_rank_0_times_out(self) -> None:
         # short ranges: rank 1 soon needs rank 0 (to take a range, or to give it the next)
-        done, seconds = self.signal_rank_mid_bake(19, "--mpi-timeout", "2", "--mpi-chunk", "20", rank=0)
+        done, seconds = self.signal_rank_mid_bake(signal.SIGSTOP, "--mpi-timeout", "2", "--mpi-chunk", "20", rank=0)
         self.assertNotEqual(done.returncode, 0)
         self.assertRegex(done.stderr, r"rank 1 of 2: no .* from rank 0 in 2 s \(--mpi-timeout\)")
         self.assertLess(seconds, RUN_TIMEOUT)
