@@ -73,8 +73,8 @@ class Bench:
             walls[ranks].append(wall)
             inner[ranks].append(float(re.search(r"([0-9.]+) s wall", out).group(1)))
             cpus[ranks].append(cpu)
-            print(f"  {ranks} rank(s): {wall:7.2f} s mpirun wall, {inner[ranks][-1]:7.2f} s in dwivedi, {cpu:7.2f} s CPU"
-                  f"  | {out.splitlines()[1]}")
+            print(f"  {ranks} rank(s): {wall:7.2f} s mpirun wall, {inner[ranks][-1]:7.2f} s in dwivedi, "
+                  f"{cpu:7.2f} s CPU  | {out.splitlines()[1]}")
         for name in ("speed1", "speed2"):
             if open(self.path(name + ".png"), "rb").read() != open(self.path("speed1.png"), "rb").read():
                 sys.exit("mpi_bench: the 1- and 2-rank images differ")

@@ -398,7 +398,8 @@ static void receive_range(job *j, int peer, const uint64_t head[3])
     for (uint64_t got = 0; got < head[2];) {
         int n = head[2] - got < BLOCK_BYTES ? (int)(head[2] - got) : (int)BLOCK_BYTES;
         receive_block(j, peer, block, n);
-        if (fwrite(block, 1, (size_t)n, out) != (size_t)n) root_fail(j, 0, "cannot write %s: %s", path, strerror(errno));
+        if (fwrite(block, 1, (size_t)n, out) != (size_t)n)
+            root_fail(j, 0, "cannot write %s: %s", path, strerror(errno));
         got += (uint64_t)n;
     }
     free(block);
@@ -438,7 +439,8 @@ static void root_service(job *j)
     }
     for (int peer = 1; peer < j->ranks; ++peer) {
         if (!j->done[peer] && now() - j->heard[peer] > j->timeout)
-            root_fail(j, 0, "rank %d has not been heard from in %g s (stopped or hung; --mpi-timeout)", peer, j->timeout);
+            root_fail(j, 0, "rank %d has not been heard from in %g s (stopped or hung; --mpi-timeout)", peer,
+                      j->timeout);
     }
 }
 
@@ -519,7 +521,8 @@ static int check_mpi_flags(cli_bake_flags *f, dwv_bake_options_t *o)
 {
     if (f->chunk) return cli_usage_error("bake", "--mpi hands out the sample ranges itself: no --samples");
     if (f->budget)
-        return cli_usage_error("bake", "--mpi bakes exactly --spp samples: no --time or --error (docs/farm.md, \"MPI\")");
+        return cli_usage_error("bake",
+                               "--mpi bakes exactly --spp samples: no --time or --error (docs/farm.md, \"MPI\")");
     if (o->samples == 0u) return cli_usage_error("bake", "--mpi: --spp must be at least 1");
     /* as for a chunk: the ranks bake the whole --spp, whatever the scene file's budgets say */
     o->time_limit = 0.0;

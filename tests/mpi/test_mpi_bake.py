@@ -140,7 +140,8 @@ class MpiBakeTest(unittest.TestCase):
 
     def test_a_rank_that_cannot_start_ends_all(self) -> None:
         missing = self.path("missing.json")
-        done = self.mpmd([*SMALL, "--mpi", "--out", self.path("out")], [missing, *SMALL, "--mpi", "--out", self.path("out")])
+        out = self.path("out")
+        done = self.mpmd([*SMALL, "--mpi", "--out", out], [missing, *SMALL, "--mpi", "--out", out])
         self.assertNotEqual(done.returncode, 0)
         self.assertIn("missing.json: cannot open it", done.stderr)
         self.assertIn("another rank could not start", done.stderr)
