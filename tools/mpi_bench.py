@@ -84,6 +84,24 @@ class Bench:
         print(f"speed-up 1 -> 2 ranks, mpirun's wall: {best:.2f}x (best runs; per alternated pair "
               f"{', '.join(f'{p:.2f}x' for p in pairs)}); inside dwivedi (without mpirun's start): "
               f"{min(inner[1]) / min(inner[2]):.2f}x; CPU 2 ranks / 1 rank: {min(cpus[2]) / min(cpus[1]):.2f}")
+        # The control, without MPI: the same bake as one plain process, and as two plain processes at
+        # once (twice the work): how much this session gets from a second core at all.
+        plain = [self.cli, "bake", *bake, "--threads", "1", "--quiet"]
+        alone, together = [], []
+        for k in range(self.pairs):
+            start = time.monotonic()
+            subprocess.run([*plain, "--out", self.path("plain")], check=True, capture_output=True)
+            alone.append(time.monotonic() - start)
+            start = time.monotonic()
+            both = [subprocess.Popen([*plain, "--out", self.path(f"plain{i}")], stdout=subprocess.DEVNULL)
+                    for i in range(2)]
+            if any(run.wait() != 0 for run in both):
+                sys.exit("mpi_bench: a plain bake failed")
+            together.append(time.monotonic() - start)
+        machine = 2 * min(alone) / min(together)
+        print(f"control without MPI: one plain bake {', '.join(f'{t:.2f}' for t in alone)} s; two at once "
+              f"{', '.join(f'{t:.2f}' for t in together)} s: two processes do {machine:.2f}x the work of one per "
+              f"wall second here; the ranks' speed-up / that: {best / machine:.2f}")
         # What the ranks got of the machine: a rank that had a core to itself would use 1 CPU second
         # per wall second; on a shared machine it gets less, and the wall ratio shows the others' load.
         share = [sum(cpus[r]) / sum(walls[r]) / r for r in (1, 2)]
