@@ -11,6 +11,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "bake_cli.h"
 #include "cli.h"
 #include <dwivedi.h>
 
@@ -23,7 +24,8 @@ static void help(FILE *out)
             "usage: dwivedi bake [SCENE.json] --out PREFIX [--spp N] [--time SECONDS] [--error REL]\n"
             "           [--technique T] [--channel-walks C] [--threads N] [--seed S] [--width W] [--height H]\n"
             "           [--ocio CONFIG] [--display NAME] [--view NAME] [--look NAME]\n"
-            "           [--exposure E] [--gamma G] [--samples FIRST:COUNT] [--quiet]\n\n"
+            "           [--exposure E] [--gamma G] [--samples FIRST:COUNT] [--quiet]\n"
+            "           [--mpi [--mpi-chunk N] [--mpi-timeout SECONDS]]\n\n"
             "Bakes SCENE.json (docs/scene-format.md), or without it the built-in default scene: a thin\n"
             "back-lit leaf-like shell beside a thick front-lit wax-like shape. Writes\n"
             "  PREFIX.exr   float RGBA, scene-linear Rec.709, plus variance and sample-count layers\n"
@@ -47,7 +49,14 @@ static void help(FILE *out)
             "  --samples FIRST:COUNT   a chunk of a split bake (docs/farm.md): sample indices FIRST to\n"
             "                 FIRST+COUNT-1 of the --spp in all, written to PREFIX.dwvpart only (exact sums\n"
             "                 for 'dwivedi merge'); no --time or --error\n"
-            "  --quiet        no progress bar (it is shown only on a terminal anyway)\n");
+            "  --quiet        no progress bar (it is shown only on a terminal anyway)\n"
+            "  --mpi          under mpirun (docs/farm.md): the ranks bake ranges of N samples each, handed\n"
+            "                 out by rank 0, which merges them exactly and writes the outputs (bit for bit\n"
+            "                 the one-process bake); --spp only (no --time, --error or --samples); threads\n"
+            "                 per rank default to the cores bound to it, shared by the ranks on its node\n"
+            "  --mpi-chunk N  samples per range (default: the --spp cut into 2 ranges per rank)\n"
+            "  --mpi-timeout S  seconds a rank waits on another (start, replies, transfers, a rank's\n"
+            "                 silence while it bakes) before all end with an error (default 300)\n");
 }
 
 static volatile sig_atomic_t interrupted = 0;
@@ -58,21 +67,17 @@ static void on_interrupt(int signal_number)
     interrupted = 1;
 }
 
-typedef struct bake_flags {
-    const char *scene_path, *prefix;
-    int chunk, budget; /* --samples given; --time or --error given */
-    uint64_t first, count;
-    dwv_display_options_t display;
-    int quiet;
-} bake_flags;
-
 /* Parses argv into flags and options (the scene's own settings already in *o). Returns 0 or CLI_USAGE. */
-static int parse_overrides(int argc, char **argv, bake_flags *f, dwv_bake_options_t *o, int apply)
+static int parse_overrides(int argc, char **argv, cli_bake_flags *f, dwv_bake_options_t *o, int apply)
 {
     for (int i = 1; i < argc; ++i) {
         const char *flag = argv[i], *value = NULL;
         if (strcmp(flag, "--quiet") == 0) {
             f->quiet = 1;
+            continue;
+        }
+        if (strcmp(flag, "--mpi") == 0) {
+            f->mpi = 1;
             continue;
         }
         if (flag[0] != '-' || flag[1] == '\0') {
@@ -84,14 +89,21 @@ static int parse_overrides(int argc, char **argv, bake_flags *f, dwv_bake_option
         static const char *const flags[] = {"--out",     "--spp",   "--time",    "--error",   "--technique",
                                             "--threads", "--seed",  "--width",   "--height",  "--ocio",
                                             "--display", "--view",  "--look",    "--exposure", "--gamma",
-                                            "--channel-walks", "--samples"};
+                                            "--channel-walks", "--samples", "--mpi-chunk", "--mpi-timeout"};
         int known = 0;
         for (size_t k = 0; k < sizeof flags / sizeof flags[0]; ++k) known |= strcmp(flag, flags[k]) == 0;
         if (!known) return cli_usage_error(verb, "unknown argument '%.64s'", flag);
         if (!(value = cli_flag_value(verb, argc, argv, &i))) return CLI_USAGE;
         uint64_t whole;
         double number;
-        if (strcmp(flag, "--samples") == 0) {
+        if (strcmp(flag, "--mpi-chunk") == 0) {
+            if (cli_parse_u64(verb, flag, value, &f->mpi_chunk)) return CLI_USAGE;
+            if (f->mpi_chunk == 0u) return cli_usage_error(verb, "--mpi-chunk: at least 1 sample");
+        } else if (strcmp(flag, "--mpi-timeout") == 0) {
+            if (cli_parse_double(verb, flag, value, &f->mpi_timeout)) return CLI_USAGE;
+            if (!(f->mpi_timeout > 0.0 && f->mpi_timeout <= 1e6))
+                return cli_usage_error(verb, "--mpi-timeout: '%.64s' seconds: more than 0, at most 1e6", value);
+        } else if (strcmp(flag, "--samples") == 0) {
             const char *colon = strchr(value, ':');
             char head[32];
             if (!colon || (size_t)(colon - value) >= sizeof head)
@@ -293,8 +305,8 @@ static int write_stats_json(const char *path, const dwv_image_t *image, const dw
 }
 
 /* Writes the three outputs under temporary names, then renames them into place. */
-static int write_outputs(const char *prefix, const dwv_image_t *image, const dwv_bake_options_t *o,
-                         const dwv_display_options_t *display, const char *scene_name)
+int cli_bake_write_outputs(const char *prefix, const dwv_image_t *image, const dwv_bake_options_t *o,
+                           const dwv_display_options_t *display, const char *scene_name)
 {
     static const char *const final_suffix[3] = {".exr", ".png", ".json"};
     char temp_suffix[3][64];
@@ -339,7 +351,7 @@ done:
 /* Checks, before any time is spent baking, what would otherwise fail only at the end: that a file
  * can be created beside PREFIX (a probe file, created and removed: access() says yes to root on any
  * folder) and that the OCIO config, display, view and look exist (a 1 x 1 image through them). */
-static int check_outputs_possible(const char *prefix, const dwv_display_options_t *display)
+int cli_bake_check_outputs(const char *prefix, const dwv_display_options_t *display)
 {
     char suffix[64];
     snprintf(suffix, sizeof suffix, ".probe-%ld", (long)getpid());
@@ -367,24 +379,58 @@ static int check_outputs_possible(const char *prefix, const dwv_display_options_
     return status;
 }
 
-static int run(int argc, char **argv)
+int cli_bake_load(int argc, char **argv, cli_bake_flags *f, dwv_bake_options_t *o, dwv_scene_t **scene)
 {
-    bake_flags f = {NULL, NULL, 0, 0, 0u, 0u, DWV_DISPLAY_OPTIONS_INIT, 0};
-    dwv_bake_options_t o = DWV_BAKE_OPTIONS_INIT;
+    const cli_bake_flags none = {NULL, NULL, 0, 0, 0u, 0u, DWV_DISPLAY_OPTIONS_INIT, 0, 0, 0u, CLI_MPI_TIMEOUT_DEFAULT};
+    const dwv_bake_options_t defaults = DWV_BAKE_OPTIONS_INIT;
+    *f = none;
+    *o = defaults;
+    *scene = NULL;
     /* first pass: syntax and the scene path; the scene's settings come next, then the flags win */
-    if (parse_overrides(argc, argv, &f, &o, 0)) return CLI_USAGE;
-    if (!f.prefix) return cli_usage_error(verb, "--out PREFIX is required");
-
-    dwv_scene_t *scene = NULL;
-    dwv_result_t r = f.scene_path ? dwv_scene_load(f.scene_path, &scene, &o) : dwv_scene_create_default(&scene, &o);
+    if (parse_overrides(argc, argv, f, o, 0)) return CLI_USAGE;
+    if (!f->prefix) return cli_usage_error(verb, "--out PREFIX is required");
+    dwv_result_t r = f->scene_path ? dwv_scene_load(f->scene_path, scene, o) : dwv_scene_create_default(scene, o);
     if (r != DWV_SUCCESS) {
         fprintf(stderr, "dwivedi %s: %s\n", verb_name, dwv_last_error_message());
         return CLI_FAILED;
     }
-    if (parse_overrides(argc, argv, &f, &o, 1)) {
-        dwv_scene_release(scene);
+    if (parse_overrides(argc, argv, f, o, 1)) {
+        dwv_scene_release(*scene);
+        *scene = NULL;
         return CLI_USAGE;
     }
+    return CLI_OK;
+}
+
+/* Whether argv asks for --mpi (before anything else is parsed: MPI starts first). */
+static int wants_mpi(int argc, char **argv)
+{
+    for (int i = 1; i < argc; ++i)
+        if (strcmp(argv[i], "--mpi") == 0) return 1;
+    return 0;
+}
+
+static int run(int argc, char **argv)
+{
+    if (wants_mpi(argc, argv)) {
+#ifdef DWV_CLI_MPI
+        return cli_mpi_bake(argc, argv);
+#else
+        fprintf(stderr, "dwivedi bake: --mpi: this dwivedi was built without MPI (install libopenmpi-dev, then "
+                        "configure and build again; docs/farm.md)\n");
+        return CLI_FAILED;
+#endif
+    }
+    cli_bake_flags f;
+    dwv_bake_options_t o;
+    dwv_scene_t *scene = NULL;
+    int loaded = cli_bake_load(argc, argv, &f, &o, &scene);
+    if (loaded != CLI_OK) return loaded;
+    if (f.mpi_chunk != 0u || f.mpi_timeout != CLI_MPI_TIMEOUT_DEFAULT) {
+        dwv_scene_release(scene);
+        return cli_usage_error(verb, "--mpi-chunk and --mpi-timeout need --mpi");
+    }
+    dwv_result_t r;
     if (f.chunk) {
         /* A chunk bakes its whole range: the scene file's budgets do not apply, explicit ones are refused. */
         if (f.budget) {
@@ -394,7 +440,7 @@ static int run(int argc, char **argv)
         o.time_limit = 0.0;
         o.target_error = 0.0;
     }
-    if (check_outputs_possible(f.prefix, &f.display) != 0) {
+    if (cli_bake_check_outputs(f.prefix, &f.display) != 0) {
         dwv_scene_release(scene);
         return CLI_FAILED;
     }
@@ -452,7 +498,7 @@ static int run(int argc, char **argv)
         exit_code = CLI_OK;
         goto done;
     }
-    if (write_outputs(f.prefix, image, &o, &f.display, f.scene_path ? f.scene_path : "default") != 0) goto done;
+    if (cli_bake_write_outputs(f.prefix, image, &o, &f.display, f.scene_path ? f.scene_path : "default") != 0) goto done;
 
     dwv_bake_stats_t s = DWV_BAKE_STATS_INIT;
     dwv_image_stats(image, &s);
@@ -532,7 +578,7 @@ static int merge_run(int argc, char **argv)
         goto done;
     }
     code = CLI_FAILED;
-    if (check_outputs_possible(prefix, &display) != 0) goto done;
+    if (cli_bake_check_outputs(prefix, &display) != 0) goto done;
     dwv_image_t *image = NULL;
     if (dwv_merge_partials(parts, count, &image) != DWV_SUCCESS) {
         fprintf(stderr, "dwivedi merge: %s\n", dwv_last_error_message());
@@ -543,7 +589,7 @@ static int merge_run(int argc, char **argv)
     dwv_bake_options_t o = DWV_BAKE_OPTIONS_INIT;
     o.width = info.width;
     o.height = info.height;
-    if (write_outputs(prefix, image, &o, &display, "merged") == 0) {
+    if (cli_bake_write_outputs(prefix, image, &o, &display, "merged") == 0) {
         dwv_bake_stats_t s = DWV_BAKE_STATS_INIT;
         dwv_image_stats(image, &s);
         printf("merged %u chunk(s): %ux%u, %llu spp, %.2f s of bakes, estimated relative error %.3g%%\n", count,
