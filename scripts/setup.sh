@@ -12,6 +12,8 @@ packages+=(blender)
 # The add-on's packages in Blender 4.3 and 5.2: clean Debian chroots (scripts/blender-chroots.sh);
 # lld-14 links the aarch64 library the load checks are tested with (tests/blender/fixtures.py).
 packages+=(mmdebstrap lld-14)
+# A split bake through a real single-node Slurm in tests/farm (issue 21; the test starts its own daemons).
+packages+=(slurm-wlm munge)
 
 missing=()
 for p in "${packages[@]}"; do
