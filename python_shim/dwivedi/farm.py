@@ -153,7 +153,12 @@ def plan(scene: str, spp: int, chunks: int, folder: str, *, name: Optional[str] 
     if "\n" in shown:
         raise PlanError("the scene's path holds a line break")
     stem = os.path.splitext(os.path.basename(scene))[0]
-    return Plan(scene=shown, spp=spp, chunks=split_samples(spp, chunks), name=_check_name(name or stem), seed=seed,
+    outputs = lambda n: {os.path.join(folder_abs, n + suffix) for suffix in (".exr", ".png", ".json")}  # noqa: E731
+    if name is None:
+        name = stem if scene_abs not in outputs(stem) else stem + "_merged"
+    if scene_abs in outputs(_check_name(name)):
+        raise PlanError(f"the merge's {name}.json would replace the scene file: choose another output name")
+    return Plan(scene=shown, spp=spp, chunks=split_samples(spp, chunks), name=name, seed=seed,
                 dwivedi=dwivedi, bake_args=_check_flags(bake_args, BAKE_FLAGS, "bake options"),
                 merge_args=_check_flags(merge_args, DISPLAY_FLAGS, "merge options"),
                 cpus_per_task=cpus_per_task, partition=partition, time_limit=time_limit)

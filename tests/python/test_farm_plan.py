@@ -45,6 +45,12 @@ class FarmPlanTest(unittest.TestCase):
                 with self.assertRaises(farm.PlanError, msg=change) as caught:
                     farm.plan(args.pop("scene"), args.pop("spp"), args.pop("chunks"), args.pop("folder"), **args)
                 self.assertIn(word, str(caught.exception))
+            inside = os.path.join(folder, "shot.json")
+            shutil.copy(SCENE, inside)
+            with self.assertRaises(farm.PlanError) as caught:
+                farm.plan(inside, 8, 2, folder, name="shot")
+            self.assertIn("would replace the scene file", str(caught.exception))
+            self.assertEqual(farm.plan(inside, 8, 2, folder).name, "shot_merged")
 
     def test_chunk_commands_merge_to_the_one_machine_bake(self) -> None:
         cli = os.environ["DWIVEDI_CLI"]
