@@ -9,6 +9,8 @@ writes into FOLDER (scripts are written under temporary names and renamed into p
   chunks.txt     one shell command a chunk, line i for chunk i (for any farm manager that runs one
                  command per task: Flamenco, Deadline, OpenCue; docs/farm.md)
   merge.txt      the merge command, to run when every chunk succeeded
+  run-chunk.sh   `run-chunk.sh N` runs line N + 1 of chunks.txt in FOLDER (Deadline's <STARTFRAME>,
+                 OpenCue's #IFRAME#)
   bake.sbatch    Slurm: the chunks as one job array (task i bakes chunk i)
   merge.sbatch   Slurm: the merge
   submit.sh      Slurm: submits both, the merge with --dependency=afterok on the array (it never
@@ -245,6 +247,23 @@ def submit_sh(plan: Plan) -> str:
         "exit 1", ""])
 
 
+def run_chunk_sh(plan: Plan) -> str:
+    """Runs chunk N of the plan (line N + 1 of chunks.txt) in its folder: for farm managers that
+    give each task a number (Deadline's <STARTFRAME>, OpenCue's #IFRAME#)."""
+    count = len(plan.chunks)
+    return "\n".join([
+        "#!/bin/bash",
+        f"# Runs chunk N (0 to {count - 1}) of this plan, line N + 1 of chunks.txt, in this folder",
+        "# (written by `python3 -m dwivedi.farm`; docs/farm.md).",
+        "set -euo pipefail",
+        'cd "$(dirname "$0")"',
+        'n="${1:-}"',
+        f'case "$n" in ""|*[!0-9]*) echo "run-chunk.sh: \'$n\' is not a chunk number (0 to {count - 1})" >&2; exit 2 ;; esac',
+        f'if [ "$n" -ge {count} ]; then echo "run-chunk.sh: no chunk $n (0 to {count - 1})" >&2; exit 2; fi',
+        'mkdir -p parts',
+        'exec bash -c "$(sed -n "$((n + 1))p" chunks.txt)"', ""])
+
+
 def plan_json(plan: Plan) -> Dict[str, object]:
     return {"format": PLAN_FORMAT, "version": PLAN_VERSION, "scene": plan.scene, "spp": plan.spp, "seed": plan.seed,
             "name": plan.name, "bake_args": plan.bake_args, "merge_args": plan.merge_args,
@@ -294,6 +313,7 @@ def write_plan(plan: Plan, folder: str) -> List[str]:
         ("bake.sbatch", bake_sbatch(plan), False),
         ("merge.sbatch", merge_sbatch(plan), False),
         ("submit.sh", submit_sh(plan), True),
+        ("run-chunk.sh", run_chunk_sh(plan), True),
     ]
     written = []
     for name, text, executable in files:

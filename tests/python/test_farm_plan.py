@@ -72,9 +72,16 @@ class FarmPlanTest(unittest.TestCase):
             with open(os.path.join(moved, "chunks.txt"), encoding="utf-8") as f:
                 commands = f.read().splitlines()
             self.assertEqual(len(commands), 3)
-            for command in reversed(commands):
-                done = subprocess.run(["bash", "-c", command], cwd=moved, capture_output=True, text=True)
-                self.assertEqual(done.returncode, 0, command + "\n" + done.stderr)
+            done = subprocess.run(["bash", "-c", commands[2]], cwd=moved, capture_output=True, text=True)
+            self.assertEqual(done.returncode, 0, commands[2] + "\n" + done.stderr)
+            for number in ("1", "0"):  # a farm's task number, from any working directory
+                done = subprocess.run([os.path.join(moved, "run-chunk.sh"), number], cwd=folder, capture_output=True,
+                                      text=True)
+                self.assertEqual(done.returncode, 0, done.stderr)
+            for bad in ("3", "-1", "x", ""):
+                done = subprocess.run([os.path.join(moved, "run-chunk.sh"), bad], capture_output=True, text=True)
+                self.assertEqual(done.returncode, 2, bad)
+                self.assertIn("chunk", done.stderr)
             with open(os.path.join(moved, "merge.txt"), encoding="utf-8") as f:
                 done = subprocess.run(["bash", "-c", f.read()], cwd=moved, capture_output=True, text=True)
             self.assertEqual(done.returncode, 0, done.stderr)
