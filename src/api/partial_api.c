@@ -67,6 +67,15 @@ uint64_t dwv_scene_hash(const dwvb_scene *s)
         ADD(&f, m->subsurface_ior);
         ADD(&f, m->subsurface_exit);
         ADD(&f, m->roughness);
+        /* Every field that changes the image, the later ones too: chunks of scenes that differ in
+         * one of them are another scene's and must never merge. */
+        ADD(&f, m->subsurface_model);
+        ADD(&f, m->specular_model);
+        ADD(&f, m->ior);
+        ADD(&f, m->specular);
+        fnv_add(&f, m->specular_tint, sizeof m->specular_tint);
+        ADD(&f, m->specular_multiscatter);
+        ADD(&f, m->subsurface_min_footprint);
     }
     ADD(&f, s->mesh_count);
     for (uint32_t i = 0; i < s->mesh_count; ++i) {
