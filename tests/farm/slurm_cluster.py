@@ -7,7 +7,8 @@ spool, log and pid file under one temporary folder). Debian's slurm-wlm and mung
         subprocess.run(["sbatch", ...], env=cluster.env)
 
 Everything it starts is stopped on the way out, whatever happened (jobs cancelled, each daemon
-sent SIGTERM, then SIGKILL to its process group after a grace period), and the folder removed.
+sent SIGTERM, then SIGKILL to its process group after a grace period), and the folder removed; a
+test process killed outright takes the daemons with it (PR_SET_PDEATHSIG).
 Standard library only.
 """
 import os
@@ -29,6 +30,14 @@ class ClusterError(RuntimeError):
 
 def missing_programs() -> List[str]:
     return [p for p in SLURM_PROGRAMS if shutil.which(p) is None]
+
+
+def _die_with_parent() -> None:
+    """In the daemon, before exec: SIGTERM when the test process dies, even by SIGKILL (a ctest
+    timeout), so that no daemon outlives it (Linux prctl PR_SET_PDEATHSIG)."""
+    import ctypes
+    PR_SET_PDEATHSIG = 1
+    ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, int(signal.SIGTERM), 0, 0, 0)
 
 
 def _free_ports(count: int) -> List[int]:
@@ -67,7 +76,8 @@ class SlurmCluster:
         out = open(self._path("log", log + ".stdout"), "wb")
         try:
             self._daemons.append(subprocess.Popen(argv, stdout=out, stderr=subprocess.STDOUT, env=self.env,
-                                                  start_new_session=True, cwd=self.folder))
+                                                  start_new_session=True, cwd=self.folder,
+                                                  preexec_fn=_die_with_parent))
         finally:
             out.close()
 

@@ -14,6 +14,7 @@ import os
 import subprocess
 import sys
 import tempfile
+import time
 import unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -100,6 +101,38 @@ class SlurmFarmTest(unittest.TestCase):
         self.assertEqual(self.cluster.queue(), [], "the merge was left pending")
         for s, content in good.items():
             self.assertEqual(read(os.path.join(job, "shot" + s)), content, f"shot{s} changed")
+
+    def test_cancelled_chunks_leave_no_part_and_no_merge(self) -> None:
+        job = self.path("long")
+        # Chunks of about a minute each (25000 spp of 40 x 24 px on one thread), cancelled (scancel:
+        # SIGTERM, then SIGKILL) while baking; bounded, should the test itself be killed first.
+        made = farm.plan(SCENE, 50000, 2, job, name="long", seed=SEED, dwivedi=self.cli, bake_args=SETTINGS)
+        farm.write_plan(made, job)
+        submit = subprocess.Popen([os.path.join(job, "submit.sh"), "--wait"], stdout=subprocess.PIPE,
+                                  stderr=subprocess.PIPE, text=True, env=self.cluster.env)
+        try:
+            deadline = time.monotonic() + 60
+            running = []
+            while time.monotonic() < deadline and len(running) < 2:
+                running = [line for line in self.cluster.queue() if " RUNNING " in line and "_" in line.split()[0]]
+                time.sleep(0.3)
+            self.assertEqual(len(running), 2, self.cluster.queue())
+            time.sleep(1.0)  # both chunks are baking
+            array = running[0].split()[0].split("_")[0]
+            done = subprocess.run(["scancel", array], capture_output=True, text=True, env=self.cluster.env)
+            self.assertEqual(done.returncode, 0, done.stderr)
+            out, err = submit.communicate(timeout=120)
+        finally:
+            if submit.poll() is None:
+                submit.kill()
+                submit.wait()
+        self.assertEqual(submit.returncode, 1, out + err)
+        self.assertIn("the merge did not run", err)
+        for chunk in made.chunks:
+            self.assertIn(f"{chunk.part} was not written", err)
+        self.assertEqual([n for n in os.listdir(os.path.join(job, "parts")) if not n.startswith(".")], [])
+        self.assertFalse(os.path.exists(os.path.join(job, "logs", "merge.status")), "the merge ran")
+        self.assertEqual(self.cluster.queue(), [], "the merge was left pending")
 
 
 if __name__ == "__main__":
