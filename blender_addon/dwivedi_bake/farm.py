@@ -75,31 +75,34 @@ class DwivediFarmSettings(bpy.types.PropertyGroup):
     last_result: StringProperty(default="", options={'SKIP_SAVE'})
 
 
-def _report_failure(operator, context, what, error):
-    message = str(error) or type(error).__name__
-    if not isinstance(error, (export.ExportError, ValueError, OSError, TypeError)):
-        traceback.print_exc()
-    operator.report({'ERROR'}, f"{what} failed: {message}")
-    context.scene.dwivedi_farm.last_result = message.splitlines()[0] if message else ""
-    return {'CANCELLED'}
+class _FarmOperator:
+    """What both farm operators do around their work (`run`, returning a one-line summary): every
+    failure reported as an error and CANCELLED, none escaping into Blender; the summary shown."""
+
+    def execute(self, context):
+        farm_settings = context.scene.dwivedi_farm
+        try:
+            summary = self.run(context)
+        except Exception as error:
+            message = str(error) or type(error).__name__
+            if not isinstance(error, (export.ExportError, ValueError, OSError, TypeError)):
+                traceback.print_exc()
+            self.report({'ERROR'}, f"{self.bl_label} failed: {message}")
+            farm_settings.last_result = message.splitlines()[0] if message else ""
+            return {'CANCELLED'}
+        farm_settings.last_result = summary
+        self.report({'INFO'}, summary)
+        return {'FINISHED'}
 
 
-class DWIVEDI_OT_farm_export(bpy.types.Operator):
+class DWIVEDI_OT_farm_export(_FarmOperator, bpy.types.Operator):
     """Write the scene file and the chunk commands (and a Slurm job array with its merge) for a farm"""
     bl_idname = "dwivedi.farm_export"
     bl_label = "Export for a Farm"
     bl_options = {'REGISTER'}
 
-    def execute(self, context):
-        bake = context.scene.dwivedi_bake
-        farm_settings = context.scene.dwivedi_farm
-        try:
-            summary = self._export(context, bake, farm_settings)
-        except Exception as error:  # every failure is reported, none escapes into Blender
-            return _report_failure(self, context, "Export for a farm", error)
-        farm_settings.last_result = summary
-        self.report({'INFO'}, summary)
-        return {'FINISHED'}
+    def run(self, context):
+        return self._export(context, context.scene.dwivedi_bake, context.scene.dwivedi_farm)
 
     def _export(self, context, bake, farm_settings):
         addon = _addon()
@@ -133,21 +136,14 @@ class DWIVEDI_OT_farm_export(bpy.types.Operator):
                 f"{folder} (chunks.txt, merge.txt; Slurm: submit.sh)")
 
 
-class DWIVEDI_OT_farm_merge(bpy.types.Operator):
+class DWIVEDI_OT_farm_merge(_FarmOperator, bpy.types.Operator):
     """Merge the chunks in the farm folder and load the result as a Blender image"""
     bl_idname = "dwivedi.farm_merge"
     bl_label = "Merge Farm Chunks"
     bl_options = {'REGISTER'}
 
-    def execute(self, context):
-        farm_settings = context.scene.dwivedi_farm
-        try:
-            summary = self._merge(context, farm_folder(farm_settings))
-        except Exception as error:
-            return _report_failure(self, context, "Merge", error)
-        farm_settings.last_result = summary
-        self.report({'INFO'}, summary)
-        return {'FINISHED'}
+    def run(self, context):
+        return self._merge(context, farm_folder(context.scene.dwivedi_farm))
 
     def _merge(self, context, folder):
         addon = _addon()
