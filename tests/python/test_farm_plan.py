@@ -6,6 +6,7 @@ import json
 import os
 import shutil
 import subprocess
+import sys
 import tempfile
 import unittest
 
@@ -51,6 +52,23 @@ class FarmPlanTest(unittest.TestCase):
                 farm.plan(inside, 8, 2, folder, name="shot")
             self.assertIn("would replace the scene file", str(caught.exception))
             self.assertEqual(farm.plan(inside, 8, 2, folder).name, "shot_merged")
+
+    def test_the_command(self) -> None:
+        with tempfile.TemporaryDirectory() as folder:
+            job = os.path.join(folder, "job")
+            done = subprocess.run([sys.executable, "-m", "dwivedi.farm", SCENE, "--spp", "10", "--chunks", "4", "--out",
+                                   job, "--width", "30", "--view", "Standard"], capture_output=True, text=True)
+            self.assertEqual(done.returncode, 0, done.stderr)
+            self.assertIn("4 chunks (0:3, 3:3, 6:2, 8:2) of 10 spp", done.stdout)
+            with open(os.path.join(job, "chunks.txt"), encoding="utf-8") as f:
+                self.assertIn("--width 30 --samples 6:2 --out parts/chunk-2", f.read().splitlines()[2])
+            with open(os.path.join(job, "merge.txt"), encoding="utf-8") as f:
+                self.assertTrue(f.read().rstrip().endswith("--out backlit_slab --view Standard"))
+            done = subprocess.run([sys.executable, "-m", "dwivedi.farm", SCENE, "--spp", "3", "--chunks", "4", "--out",
+                                   job], capture_output=True, text=True)
+            self.assertEqual(done.returncode, 1)
+            self.assertEqual(done.stdout, "")
+            self.assertIn("--chunks must be a whole number from 1 to the samples per pixel (3)", done.stderr)
 
     def test_chunk_commands_merge_to_the_one_machine_bake(self) -> None:
         cli = os.environ["DWIVEDI_CLI"]
