@@ -45,6 +45,7 @@ class PackageTest(unittest.TestCase):
         self.assertTrue(all(n.startswith("dwivedi_bake/") for n in names), names)
         self.assertIn("dwivedi_bake/__init__.py", names)
         self.assertIn("dwivedi_bake/libcheck.py", names)
+        self.assertIn("dwivedi_bake/LICENSE", names)
         self.assertIn("dwivedi_bake/dwivedi/libdwivedi.so.1", names)
         self.assertNotIn("dwivedi_bake/blender_manifest.toml", names)
         with zipfile.ZipFile(extension) as zf:
@@ -54,8 +55,9 @@ class PackageTest(unittest.TestCase):
             mode = zf.getinfo("dwivedi/libdwivedi.so.1").external_attr >> 16
         self.assertIn("__init__.py", ext_names)
         self.assertIn("dwivedi/__init__.py", ext_names)
-        self.assertEqual(library, LIBRARY.resolve().read_bytes())
+        self.assertIn("LICENSE", ext_names)
         self.assertEqual(mode & 0o777, 0o755)
+        self.check_stripped_twin(library)
         for field in ('schema_version = "1.0.0"', 'id = "dwivedi_bake"', 'type = "add-on"',
                       'blender_version_min = "4.2.0"', 'platforms = ["linux-x64"]', "[permissions]", "files = "):
             self.assertIn(field, manifest)
@@ -66,6 +68,45 @@ class PackageTest(unittest.TestCase):
         first = extension.read_bytes()
         self.assertEqual(package(SOURCE_DIR, self.work).returncode, 0)
         self.assertEqual(extension.read_bytes(), first)
+
+    def check_stripped_twin(self, packaged: bytes) -> None:
+        """The packaged library is the built one without debug sections and local symbols: smaller
+        (when the build has any to strip), the same SONAME, NEEDED entries and exports, accepted by
+        the add-on's own check, and it loads and answers through the shim."""
+        built = LIBRARY.resolve()
+        copy = self.work / "packaged" / "libdwivedi.so.1"
+        copy.parent.mkdir()
+        copy.write_bytes(packaged)
+        sections = subprocess.run(["readelf", "-S", "-W", str(copy)], capture_output=True, text=True, check=True).stdout
+        self.assertNotIn(".debug_info", sections)
+        self.assertNotIn(".symtab", sections)
+        if ".debug_info" in subprocess.run(["readelf", "-S", "-W", str(built)], capture_output=True, text=True,
+                                           check=True).stdout:
+            self.assertLess(len(packaged), built.stat().st_size)
+        packaged_info, problem = libcheck.read_elf(str(copy))
+        self.assertIsNone(problem)
+        built_info, _ = libcheck.read_elf(str(built))
+        self.assertEqual(packaged_info.soname, built_info.soname)
+        self.assertEqual(packaged_info.needed, built_info.needed)
+        self.assertIsNone(libcheck.check_file(str(copy), dwivedi.ABI_VERSION, dwivedi.LIBRARY_FUNCTIONS))
+
+        def exports(path: Path) -> list:
+            table = subprocess.run(["nm", "-D", "--defined-only", str(path)], capture_output=True, text=True,
+                                   check=True).stdout
+            return sorted(line.split()[-1] for line in table.splitlines() if line.strip())
+        self.assertEqual(exports(copy), exports(built))
+        probe = subprocess.run([sys.executable, "-c", "import dwivedi; print(dwivedi.version())"],
+                               env={**os.environ, "DWIVEDI_LIBRARY": str(copy),
+                                    "PYTHONPATH": str(SOURCE_DIR / "python_shim")},
+                               capture_output=True, text=True, timeout=60)
+        self.assertEqual(probe.returncode, 0, probe.stderr)
+        self.assertEqual(probe.stdout.strip(), dwivedi_version())
+
+    def test_objcopy_missing_is_an_error(self) -> None:
+        done = package(SOURCE_DIR, self.work, "--objcopy", "dwivedi-no-such-objcopy")
+        self.assertEqual(done.returncode, 1)
+        self.assertIn("dwivedi-no-such-objcopy is not on PATH", done.stderr)
+        self.assertEqual(list(self.work.iterdir()), [], "nothing written")
 
     def test_manifest_must_agree_with_bl_info(self) -> None:
         tree = self.work / "tree"

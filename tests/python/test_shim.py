@@ -452,9 +452,10 @@ class DiscoveryTest(unittest.TestCase):
         # The source tree's own layout: the shim in python_shim/, libraries in build*/ (ctest's
         # build directory is one of them).
         build_dir = Path(os.environ["DWIVEDI_BUILD_DIR"]).resolve()
-        self.assertEqual(build_dir.parent, SOURCE_DIR.resolve(),
-                         "these tests expect the build directory directly under the source tree")
-        self.assertTrue(build_dir.name.startswith("build"))
+        if build_dir.parent != SOURCE_DIR.resolve() or not build_dir.name.startswith("build"):
+            # An out-of-tree build (cmake -B /elsewhere): the layout this search looks at is absent,
+            # so there is nothing to find; make_tree's tests below cover the search itself.
+            self.skipTest(f"the build directory {build_dir} is not a build*/ folder of {SOURCE_DIR}")
         report = run_child(child_env(SOURCE_DIR / "python_shim", None), str(self.work))
         self.assertEqual(report.get("version"), header_version(), report)
         found = Path(str(report["path"]))
