@@ -85,16 +85,16 @@ class Plan:
     partition: Optional[str] = None
     time_limit: Optional[str] = None
 
-    def chunk_args(self, chunk: Chunk, program: Optional[str] = None) -> List[str]:
+    def chunk_args(self, chunk: Chunk) -> List[str]:
         """argv of chunk `chunk`'s bake, run in the plan's folder."""
-        args = [program or self.dwivedi, "bake", self.scene, "--spp", str(self.spp)]
+        args = [self.dwivedi, "bake", self.scene, "--spp", str(self.spp)]
         if self.seed is not None:
             args += ["--seed", str(self.seed)]
         return args + self.bake_args + ["--samples", chunk.samples, "--out", chunk.part[:-len(".dwvpart")], "--quiet"]
 
-    def merge_argv(self, program: Optional[str] = None) -> List[str]:
+    def merge_argv(self) -> List[str]:
         """argv of the merge, run in the plan's folder."""
-        return [program or self.dwivedi, "merge", *[c.part for c in self.chunks], "--out", self.name, *self.merge_args]
+        return [self.dwivedi, "merge", *[c.part for c in self.chunks], "--out", self.name, *self.merge_args]
 
 
 def split_samples(spp: int, chunks: int) -> List[Chunk]:
@@ -170,6 +170,12 @@ def _command(argv: Sequence[str]) -> str:
     return " ".join(shlex.quote(a) for a in argv)
 
 
+def _program_line(plan: Plan) -> str:
+    """The scripts' dwivedi program: $DWIVEDI from the submitting shell, else the plan's (quoted
+    for the shell: an assignment's word is not split, and its quotes are removed)."""
+    return f"dwivedi=${{DWIVEDI:-{shlex.quote(plan.dwivedi)}}}"
+
+
 def _slurm_header(plan: Plan, job: str, log: str) -> List[str]:
     lines = ["#!/bin/bash", f"#SBATCH --job-name={plan.name}-{job}", f"#SBATCH --output=logs/{log}.out",
              f"#SBATCH --error=logs/{log}.err"]
@@ -186,7 +192,7 @@ def bake_sbatch(plan: Plan) -> str:
     lines = _slurm_header(plan, "chunks", "chunk-%a")
     lines += [f"#SBATCH --array=0-{last}", f"#SBATCH --cpus-per-task={plan.cpus_per_task}",
               "# Written by `python3 -m dwivedi.farm` (docs/farm.md); submit with submit.sh, which runs it in its folder.",
-              "set -u", 'dwivedi="${DWIVEDI:-' + plan.dwivedi.replace('"', '\\"') + '}"',
+              "set -u", _program_line(plan),
               'i="${SLURM_ARRAY_TASK_ID:?not run as a Slurm array task}"', 'case "$i" in']
     for c in plan.chunks:
         lines.append(f"  {c.index}) command=({_command(plan.chunk_args(c)[1:])}) ;;")
@@ -206,7 +212,7 @@ def merge_sbatch(plan: Plan) -> str:
     """The merge job; it records its exit status in logs/merge.status."""
     lines = _slurm_header(plan, "merge", "merge")
     lines += ["#SBATCH --cpus-per-task=1", "# Written by `python3 -m dwivedi.farm` (docs/farm.md).", "set -u",
-              'dwivedi="${DWIVEDI:-' + plan.dwivedi.replace('"', '\\"') + '}"',
+              _program_line(plan),
               f'"$dwivedi" {_command(plan.merge_argv()[1:])}', "status=$?",
               'echo "$status" > logs/merge.status', 'exit "$status"', ""]
     return "\n".join(lines)
