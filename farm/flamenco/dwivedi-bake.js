@@ -19,7 +19,7 @@ const JOB_TYPE = {
     description: "A dwivedi bake split into chunks of samples, merged into exactly the one-machine result",
     settings: [
         { key: "folder", type: "string", subtype: "dir_path", required: true, visible: "submission",
-          eval: "bpy.path.abspath(C.scene.dwivedi_farm.folder)",
+          eval: "abspath(C.scene.dwivedi_farm.folder)",
           description: "The folder 'Export for a Farm' wrote (its path as the Workers see it)" },
         { key: "scene_file", type: "string", required: true, default: "dwivedi_scene.json", visible: "submission",
           description: "The scene file in that folder" },
