@@ -14,6 +14,10 @@ packages+=(blender)
 packages+=(mmdebstrap lld-14)
 # MPI for `mpirun -n N dwivedi bake ... --mpi` and its tests (tests/mpi; the CLI only, docs/farm.md).
 packages+=(libopenmpi-dev openmpi-bin)
+# A split bake through a real single-node Slurm in tests/farm (issue 21; the test starts its own daemons).
+packages+=(slurm-wlm munge)
+# node runs the Flamenco job type's compiler in tests/farm/test_flamenco_job.py.
+packages+=(nodejs)
 
 missing=()
 for p in "${packages[@]}"; do

@@ -24,7 +24,7 @@ import traceback
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 
-from . import export, libcheck
+from . import export, farm, libcheck
 
 TECHNIQUES = [
     ('AUTO', "Auto", "Chosen per scene: incident-illumination guiding with a classical share"),
@@ -641,6 +641,7 @@ def register():
     for cls in CLASSES:
         bpy.utils.register_class(cls)
     bpy.types.Scene.dwivedi_bake = PointerProperty(type=DwivediBakeSettings)
+    farm.register()  # its sub-panel's parent is DWIVEDI_PT_bake
     _DWIVEDI_BAKE_REGISTERED = True
     status = check_library()
     if not status.ok:
@@ -652,6 +653,7 @@ def unregister():
     global _DWIVEDI_BAKE_REGISTERED, _status, _status_key
     if not _DWIVEDI_BAKE_REGISTERED:
         return
+    farm.unregister()
     del bpy.types.Scene.dwivedi_bake
     for cls in reversed(CLASSES):
         bpy.utils.unregister_class(cls)

@@ -51,6 +51,14 @@ static void fnv_add(fnv *f, const void *data, size_t size)
 #define FNV_INIT {0xcbf29ce484222325ull}
 #define ADD(f, x) fnv_add((f), &(x), sizeof(x))
 
+/* The hash must cover everything of a scene that changes the image: a field added to one of these
+ * and not hashed lets chunks of two different scenes merge. These sizes (LP64) make such an
+ * addition fail to compile here until the field is added below (or said to change no image). */
+_Static_assert(sizeof(dwv_material_t) == 192, "a new dwv_material_t field: hash it in dwv_scene_hash");
+_Static_assert(sizeof(dwv_light_desc_t) == 216, "a new dwv_light_desc_t field: hash it in dwv_scene_hash");
+_Static_assert(sizeof(dwv_camera_t) == 128, "a new dwv_camera_t field: hash it in dwv_scene_hash");
+_Static_assert(sizeof(dwvb_scene) == 408, "a new dwvb_scene field: hash it in dwv_scene_hash if it changes images");
+
 uint64_t dwv_scene_hash(const dwvb_scene *s)
 {
     fnv f = FNV_INIT;
@@ -67,6 +75,15 @@ uint64_t dwv_scene_hash(const dwvb_scene *s)
         ADD(&f, m->subsurface_ior);
         ADD(&f, m->subsurface_exit);
         ADD(&f, m->roughness);
+        /* Every field that changes the image, the later ones too: chunks of scenes that differ in
+         * one of them are another scene's and must never merge. */
+        ADD(&f, m->subsurface_model);
+        ADD(&f, m->specular_model);
+        ADD(&f, m->ior);
+        ADD(&f, m->specular);
+        fnv_add(&f, m->specular_tint, sizeof m->specular_tint);
+        ADD(&f, m->specular_multiscatter);
+        ADD(&f, m->subsurface_min_footprint);
     }
     ADD(&f, s->mesh_count);
     for (uint32_t i = 0; i < s->mesh_count; ++i) {

@@ -304,6 +304,25 @@ static int write_stats_json(const char *path, const dwv_image_t *image, const dw
     return 0;
 }
 
+/* PREFIX + suffix with a '.' before PREFIX's file name: a hidden file beside the output, for the
+ * temporary names (a process killed before its renames leaves `.NAME.exr.partial-PID`, which no
+ * `*.exr` matches and no file browser shows, never a visible file that looks like an output). */
+static char *hidden_join(const char *prefix, const char *suffix)
+{
+    const char *slash = strrchr(prefix, '/');
+    size_t folder = slash ? (size_t)(slash - prefix) + 1u : 0u, rest = strlen(prefix) - folder, b = strlen(suffix);
+    char *path = malloc(folder + 1u + rest + b + 1u);
+    if (!path) {
+        fprintf(stderr, "dwivedi %s: out of memory\n", verb_name);
+        return NULL;
+    }
+    memcpy(path, prefix, folder);
+    path[folder] = '.';
+    memcpy(path + folder + 1u, prefix + folder, rest);
+    memcpy(path + folder + 1u + rest, suffix, b + 1u);
+    return path;
+}
+
 /* Writes the three outputs under temporary names, then renames them into place. */
 int cli_bake_write_outputs(const char *prefix, const dwv_image_t *image, const dwv_bake_options_t *o,
                            const dwv_display_options_t *display, const char *scene_name)
@@ -311,11 +330,11 @@ int cli_bake_write_outputs(const char *prefix, const dwv_image_t *image, const d
     static const char *const final_suffix[3] = {".exr", ".png", ".json"};
     char temp_suffix[3][64];
     for (int k = 0; k < 3; ++k)
-        snprintf(temp_suffix[k], sizeof temp_suffix[k], ".partial-%ld%s", (long)getpid(), final_suffix[k]);
+        snprintf(temp_suffix[k], sizeof temp_suffix[k], "%s.partial-%ld", final_suffix[k], (long)getpid());
     char *final_path[3] = {0}, *temp_path[3] = {0};
     int status = -1, written = 0;
     for (int k = 0; k < 3; ++k) {
-        if (!(final_path[k] = join(prefix, final_suffix[k])) || !(temp_path[k] = join(prefix, temp_suffix[k])))
+        if (!(final_path[k] = join(prefix, final_suffix[k])) || !(temp_path[k] = hidden_join(prefix, temp_suffix[k])))
             goto done;
     }
     if (dwv_image_write_exr(image, temp_path[0]) != DWV_SUCCESS) {

@@ -10,9 +10,17 @@ static dwv_result_t read_material(dwvs_parser *ps, const cJSON *item, const char
 {
     static const char *const keys[] = {"kind", "base_color", "subsurface_weight", "subsurface_color",
                                        "subsurface_radius", "subsurface_scale", "subsurface_anisotropy",
-                                       "subsurface_ior", "subsurface_exit", "roughness"};
+                                       "subsurface_ior", "subsurface_exit", "roughness", "subsurface_model",
+                                       "specular_model", "ior", "specular", "specular_tint",
+                                       "specular_distribution", "subsurface_min_footprint"};
     static const char *const kinds[] = {"subsurface", "diffuse"};
     static const char *const exits[] = {"lambert", "principled_v1"};
+    /* In the order of dwv_subsurface_model_t's and dwv_specular_model_t's values (0, 1, ...). */
+    static const char *const models[] = {"fixed_radius",          "blender3_random_walk", "blender4_random_walk",
+                                         "blender4_skin",         "blender52_random_walk", "blender52_legacy",
+                                         "blender52_skin"};
+    static const char *const speculars[] = {"none", "principled_v1", "principled_v2"};
+    static const char *const distributions[] = {"ggx", "multiscatter_ggx"};
     DWV_TRY(dwvs_check_keys(item, path, keys, sizeof keys / sizeof keys[0]));
     dwv_material_t m = DWV_MATERIAL_INIT;
     size_t kind = 0, exit = 0; /* DWV_MATERIAL_INIT's: subsurface, lambert */
@@ -28,6 +36,18 @@ static dwv_result_t read_material(dwvs_parser *ps, const cJSON *item, const char
     DWV_TRY(dwvs_opt_choice(item, path, "subsurface_exit", exits, 2, &exit));
     m.subsurface_exit = exit == 0 ? DWV_SUBSURFACE_EXIT_LAMBERT : DWV_SUBSURFACE_EXIT_PRINCIPLED_V1;
     DWV_TRY(dwvs_opt_number(item, path, "roughness", &m.roughness));
+    size_t model = 0, specular = 0, distribution = 0; /* DWV_MATERIAL_INIT's: fixed radius, none, GGX */
+    DWV_TRY(dwvs_opt_choice(item, path, "subsurface_model", models, sizeof models / sizeof models[0], &model));
+    m.subsurface_model = (dwv_subsurface_model_t)model;
+    DWV_TRY(dwvs_opt_choice(item, path, "specular_model", speculars, sizeof speculars / sizeof speculars[0],
+                            &specular));
+    m.specular_model = (dwv_specular_model_t)specular;
+    DWV_TRY(dwvs_opt_number(item, path, "ior", &m.ior));
+    DWV_TRY(dwvs_opt_number(item, path, "specular", &m.specular));
+    DWV_TRY(dwvs_opt_vector(item, path, "specular_tint", 3, m.specular_tint));
+    DWV_TRY(dwvs_opt_choice(item, path, "specular_distribution", distributions, 2, &distribution));
+    m.specular_multiscatter = (int32_t)distribution;
+    DWV_TRY(dwvs_opt_number(item, path, "subsurface_min_footprint", &m.subsurface_min_footprint));
     uint32_t id;
     dwv_result_t r = dwv_scene_add_material(ps->scene, &m, &id);
     if (r != DWV_SUCCESS) return dwvs_prefix_capi(r, path);

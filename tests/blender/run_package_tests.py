@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
-"""Runs tests/blender/test_package.py in one Blender: the host's, or the one in a clean Debian
-chroot made by scripts/blender-chroots.sh (trixie: Blender 4.3, sid: Blender 5.2).
+"""Runs tests/blender/test_package.py (or another script there: --script test_farm.py) in one
+Blender: the host's, or the one in a clean Debian chroot made by scripts/blender-chroots.sh
+(trixie: Blender 4.3, sid: Blender 5.2).
 
     python3 tests/blender/run_package_tests.py --blender host|trixie|sid --build-dir build [--work DIR]
 
@@ -111,6 +112,8 @@ def main(argv=None):
     parser.add_argument("--cc", default=os.environ.get("CC", "cc"))
     parser.add_argument("--clang", default="clang-14" if shutil.which("clang-14") else "clang")
     parser.add_argument("--host-blender", default=shutil.which("blender") or "blender")
+    parser.add_argument("--script", default="test_package.py",
+                        help="the test script in tests/blender to run (test_package.py; test_farm.py)")
     parser.add_argument("--timeout", type=float, default=900.0)
     parser.add_argument("--keep-going", action="store_true",
                         help="run every step even after one failed (diagnosis; later steps build on earlier ones)")
@@ -120,7 +123,8 @@ def main(argv=None):
     for path in (legacy, library):
         if not path.is_file():
             fail(f"{path} is missing (build first)")
-    work = (args.work or build / "tests" / f"package-{args.blender}").resolve()
+    suffix = "" if args.script == "test_package.py" else "-" + Path(args.script).stem
+    work = (args.work or build / "tests" / f"package-{args.blender}{suffix}").resolve()
     if work.exists():
         shutil.rmtree(work)
     work.mkdir(parents=True)
@@ -146,7 +150,7 @@ def main(argv=None):
 
     def stage_files():
         (stage / "scripts").mkdir(parents=True)
-        for name in ("test_package.py", "scenes.py"):
+        for name in sorted({args.script, "scenes.py", "harness.py"}):
             shutil.copy2(HERE / name, stage / "scripts" / name)
         shutil.copy2(legacy, stage / legacy.name)
         shutil.copy2(extension, stage / extension.name)
@@ -189,7 +193,7 @@ def main(argv=None):
         env["DWIVEDI_TEST_KEEP_GOING"] = "1"
     blender = "/usr/bin/blender" if chroot is not None else args.host_blender
     command = [blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python",
-               inside(stage / "scripts" / "test_package.py")]
+               inside(stage / "scripts" / args.script)]
     environment = ["env", "-i"] + [f"{k}={v}" for k, v in env.items()]
     if chroot is not None:
         script = 'mount -t proc proc "$1/proc" && shift && exec chroot "$@"'
