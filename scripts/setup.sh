@@ -12,6 +12,8 @@ packages+=(blender)
 # The add-on's packages in Blender 4.3 and 5.2: clean Debian chroots (scripts/blender-chroots.sh);
 # lld-14 links the aarch64 library the load checks are tested with (tests/blender/fixtures.py).
 packages+=(mmdebstrap lld-14)
+# Blender's real UI for tests/blender/test_ui.py: an X server without a screen (xvfb-run needs xauth).
+packages+=(xvfb xauth)
 
 missing=()
 for p in "${packages[@]}"; do

@@ -235,6 +235,15 @@ class DwivediBakePreferences(bpy.types.AddonPreferences):
         draw_status(layout)
 
 
+def _blend_relative_path_options():
+    """Blender 5.x warns on a "//" path unless the property says it takes one
+    (PATH_SUPPORTS_BLEND_RELATIVE, unknown to older versions, which have no Property RNA field
+    is_path_supports_blend_relative either): the option where it exists."""
+    if "is_path_supports_blend_relative" in bpy.types.Property.bl_rna.properties:
+        return {'PATH_SUPPORTS_BLEND_RELATIVE'}
+    return set()
+
+
 class DwivediBakeSettings(bpy.types.PropertyGroup):
     """The bake's settings, saved with the scene. Nothing about a running bake is here (see _Run)."""
     target: EnumProperty(name="Target", default='CAMERA', items=[
@@ -260,7 +269,8 @@ class DwivediBakeSettings(bpy.types.PropertyGroup):
     walk_event_cap: IntProperty(name="Walk Event Cap", default=0, min=0, description=(
         "Scattering events per walk at most; 0: 10^6 (keeps the light Cycles loses on thick, bright objects); "
         "256: Cycles' own cap, to match its render there"))
-    output_dir: StringProperty(name="Output Folder", default="//dwivedi_bake/", subtype='DIR_PATH', description=(
+    output_dir: StringProperty(name="Output Folder", default="//dwivedi_bake/", subtype='DIR_PATH',
+                               options=_blend_relative_path_options(), description=(
         "Where the baked EXR and PNG are saved (// is the .blend's folder)"))
     uv_margin: IntProperty(name="Margin", description="Pixels the bake extends past the UV islands' edges, so "
                            "that texture filtering does not bleed in the background", default=16, min=0, max=64)

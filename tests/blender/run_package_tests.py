@@ -196,6 +196,8 @@ def main(argv=None):
               "never in a package")
     if root:
         env["DWIVEDI_PRIVATE_MOUNTS"] = "1"
+    if args.ui and os.environ.get("DWIVEDI_UI_SCREENSHOT"):
+        env["DWIVEDI_UI_SCREENSHOT"] = inside(stage / "screenshot.png")  # copied to WORK at the end
     if args.keep_going:
         env["DWIVEDI_TEST_KEEP_GOING"] = "1"
     blender = "/usr/bin/blender" if chroot is not None else args.host_blender
@@ -259,6 +261,8 @@ def main(argv=None):
         print(f"run_package_tests: {args.blender}: FAILED: {'; '.join(problems)} (scratch folder kept: {stage})",
               file=sys.stderr)
         return 1
+    if (stage / "screenshot.png").is_file():
+        shutil.copy2(stage / "screenshot.png", work / "screenshot.png")
     shutil.rmtree(stage)
     print(f"run_package_tests: {args.blender}: passed")
     return 0

@@ -210,6 +210,10 @@ def step_save_and_reopen_during_bake():
     yield from wait_until(lambda: run_state().fraction > 0.0, 20.0, "progress")
     check(run_state().running, "running")
     check(shows_progress(drawn(module().draw_status_bar)), "the status bar shows the progress and a cancel button")
+    if os.environ.get("DWIVEDI_UI_SCREENSHOT"):  # for a person to look at (not compared)
+        yield 1.0
+        with in_editor():
+            bpy.ops.screen.screenshot(filepath=os.environ["DWIVEDI_UI_SCREENSHOT"])
     items = panel()
     check(shows_progress(items), f"the panel shows the progress and a cancel button: {items}")
     check(("operator", "dwivedi.bake", 'RENDER_STILL') not in items, "no Bake button while baking")
