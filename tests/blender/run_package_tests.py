@@ -187,7 +187,7 @@ def main(argv=None):
         "BLENDER_USER_DATAFILES": inside(home / "datafiles"), "BLENDER_USER_EXTENSIONS": inside(home / "extensions"),
         "DWIVEDI_TEST_HOME": inside(home), "DWIVEDI_ADDON_ZIP": inside(stage / legacy.name),
         "DWIVEDI_EXTENSION_ZIP": inside(stage / extension.name), "DWIVEDI_FIXTURES": inside(stage / "fixtures"),
-        "DWIVEDI_TEST_TIMES": inside(times_file), "PYTHONDONTWRITEBYTECODE": "1",
+        "DWIVEDI_TEST_TIMES": inside(times_file), "PYTHONDONTWRITEBYTECODE": "1", "PYTHONUNBUFFERED": "1",
     }
     if copied:
         env["DWIVEDI_TEST_PRELOAD"] = inside(stage / "deps")
@@ -198,6 +198,8 @@ def main(argv=None):
         env["DWIVEDI_PRIVATE_MOUNTS"] = "1"
     if args.ui and os.environ.get("DWIVEDI_UI_SCREENSHOT"):
         env["DWIVEDI_UI_SCREENSHOT"] = inside(stage / "screenshot.png")  # copied to WORK at the end
+    if args.ui and os.environ.get("DWIVEDI_UI_ONLY"):
+        env["DWIVEDI_UI_ONLY"] = os.environ["DWIVEDI_UI_ONLY"]
     if args.keep_going:
         env["DWIVEDI_TEST_KEEP_GOING"] = "1"
     blender = "/usr/bin/blender" if chroot is not None else args.host_blender
