@@ -246,7 +246,8 @@ def _blend_relative_path_options():
 
 class DwivediBakeSettings(bpy.types.PropertyGroup):
     """The bake's settings, saved with the scene. Nothing about a running bake is here (see _Run)."""
-    target: EnumProperty(name="Target", default='CAMERA', items=[
+    target: EnumProperty(name="Target", default='CAMERA', description="What is baked: the camera's view or a UV image",
+                         items=[
         ('CAMERA', "Camera", "What the active camera sees, at the render resolution (like F12)"),
         ('UV', "UV", "The active object's subsurface light in its UV map, into the image of the active Image "
                      "Texture node of its material (like Cycles' Bake)")])
@@ -1024,22 +1025,26 @@ class DWIVEDI_PT_bake(bpy.types.Panel):
 
 
 class _SubPanel:
+    """A sub-panel of the main one (closed by default, as Cycles' are): draws its settings with
+    the Render tab's property split."""
     bl_space_type = 'PROPERTIES'
     bl_region_type = 'WINDOW'
     bl_context = "render"
     bl_parent_id = DWIVEDI_PT_bake.bl_idname
     bl_options = {'DEFAULT_CLOSED'}
 
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        self.draw_settings(layout, context.scene.dwivedi_bake)
+
 
 class DWIVEDI_PT_bake_sampling(_SubPanel, bpy.types.Panel):
     bl_label = "Sampling"
     bl_idname = "DWIVEDI_PT_bake_sampling"
 
-    def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
-        settings = context.scene.dwivedi_bake
+    def draw_settings(self, layout, settings):
         col = layout.column(align=True)
         col.prop(settings, "samples")
         col.prop(settings, "time_limit")
@@ -1051,11 +1056,7 @@ class DWIVEDI_PT_bake_output(_SubPanel, bpy.types.Panel):
     bl_label = "Output"
     bl_idname = "DWIVEDI_PT_bake_output"
 
-    def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
-        settings = context.scene.dwivedi_bake
+    def draw_settings(self, layout, settings):
         layout.prop(settings, "output_dir")
         if settings.target == 'UV':
             layout.prop(settings, "uv_margin")
@@ -1064,14 +1065,11 @@ class DWIVEDI_PT_bake_output(_SubPanel, bpy.types.Panel):
 
 
 class DWIVEDI_PT_bake_advanced(_SubPanel, bpy.types.Panel):
+    """Choices for research and comparisons: how the walks are steered and carried."""
     bl_label = "Advanced"
     bl_idname = "DWIVEDI_PT_bake_advanced"
 
-    def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
-        settings = context.scene.dwivedi_bake
+    def draw_settings(self, layout, settings):
         layout.prop(settings, "technique")
         layout.prop(settings, "channel_walks")
         layout.prop(settings, "walk_event_cap")

@@ -132,13 +132,53 @@ class AddonTest(harness.unittest.TestCase):
             def operator(self, *args, **options):
                 pass
 
-        class Panel:
-            layout = Layout()
-
-        sys.modules["dwivedi_bake"].DWIVEDI_PT_bake_advanced.draw(Panel, bpy.context)
-        drawn = Panel.layout.props
+        layout = Layout()
+        sys.modules["dwivedi_bake"].DWIVEDI_PT_bake_advanced.draw_settings(None, layout, bpy.context.scene.dwivedi_bake)
+        drawn = layout.props
         self.assertIn("channel_walks", drawn)
         self.assertEqual(drawn.index("channel_walks"), drawn.index("technique") + 1, drawn)
+
+    def test_panel_conventions(self):
+        """The Render tab's conventions: the Bake button first, sub-panels closed by default under
+        the main one (whose bl_idname other modules name), every setting and technique with a
+        tooltip of its own, no raw identifiers as names."""
+        module = sys.modules["dwivedi_bake"]
+        small_slab()
+        items = []
+
+        class Layout:
+            scale_y = 1.0
+            use_property_split = use_property_decorate = False
+
+            def prop(self, data, name, **options):
+                items.append(("prop", name))
+
+            def label(self, text="", icon='NONE', **options):
+                items.append(("label", text))
+
+            def operator(self, idname, **options):
+                items.append(("operator", idname))
+
+            def row(self, **options):
+                return self
+
+            column = box = row
+
+        module.DWIVEDI_PT_bake.draw(type("Panel", (), {"layout": Layout()})(), bpy.context)
+        self.assertEqual(items[0], ("operator", "dwivedi.bake"), items)
+        self.assertEqual(module.DWIVEDI_PT_bake.bl_idname, "DWIVEDI_PT_bake")
+        for panel in (module.DWIVEDI_PT_bake_sampling, module.DWIVEDI_PT_bake_output, module.DWIVEDI_PT_bake_advanced):
+            self.assertEqual(panel.bl_parent_id, "DWIVEDI_PT_bake")
+            self.assertIn('DEFAULT_CLOSED', panel.bl_options)
+        properties = bpy.context.scene.dwivedi_bake.bl_rna.properties
+        for prop in properties:
+            if prop.identifier == "rna_type" or prop.identifier == "name":
+                continue
+            self.assertTrue(prop.description and prop.description != prop.name, prop.identifier)
+        for enum in ("technique", "channel_walks", "target"):
+            for item in properties[enum].enum_items:
+                self.assertTrue(item.description, item.identifier)
+                self.assertNotIn("_", item.name, item.identifier)
 
     def test_channel_walks_reach_the_bake(self):
         """The slab's radii differ per channel: Separate walks each channel on its own (the bake
