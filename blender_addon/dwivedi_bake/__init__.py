@@ -1117,7 +1117,7 @@ def register():
     # Read-only (a getter, no setter): drawn as a bar nobody can drag, and nothing is stored.
     bpy.types.WindowManager.dwivedi_bake_progress = FloatProperty(
         name="Progress", description="How far the running Dwivedi bake is", subtype='PERCENTAGE', min=0.0,
-        max=100.0, get=_progress_percent)
+        max=100.0, precision=0, get=_progress_percent)
     bpy.types.TOPBAR_MT_render.append(draw_render_menu)
     bpy.types.STATUSBAR_HT_header.append(draw_status_bar)
     bpy.app.handlers.load_pre.append(_stop_before_load)
