@@ -462,13 +462,15 @@ def output_folder(settings):
 
 
 def lost_at_quit(folder):
-    """A warning when `folder` is a temporary folder whose files do not outlive the session."""
-    temporary = [os.path.realpath(p) for p in (bpy.app.tempdir, ) if p]
+    """A warning when `folder` is in Blender's session temporary folder, which Blender deletes at
+    quit (Cycles' own results there would be lost the same way)."""
+    if not bpy.app.tempdir:
+        return None
+    base = os.path.realpath(bpy.app.tempdir)
     real = os.path.realpath(folder)
-    for base in temporary:
-        if real == base.rstrip(os.sep) or real.startswith(base.rstrip(os.sep) + os.sep):
-            return (f"the output folder {folder} is Blender's temporary folder, which Blender deletes at quit: "
-                    "choose another Output Folder to keep the images")
+    if real == base or real.startswith(base + os.sep):
+        return (f"the output folder {folder} is Blender's temporary folder, which Blender deletes at quit: "
+                "choose another Output Folder to keep the images")
     return None
 
 
@@ -546,7 +548,7 @@ class _Job:
     def start(self):
         self.bake = self.dwivedi.start_bake(self.exported.scene, self.bake_settings)
 
-    def finish(self, settings):
+    def finish(self):
         """Writes the files and the Blender image; returns a one-line summary."""
         image = self.bake.finish()
         self.bake = None
@@ -848,7 +850,7 @@ class DWIVEDI_OT_bake(bpy.types.Operator):
             self._warn(context, job)
             image = job.dwivedi.bake(job.exported.scene, job.bake_settings)
             job.bake = _Finished(image)
-            summary = job.finish(settings)
+            summary = job.finish()
         except KeyboardInterrupt:
             if job is not None:
                 job.close()
@@ -918,9 +920,8 @@ class DWIVEDI_OT_bake(bpy.types.Operator):
             redraw(status_bar=int(100 * progress.fraction) != shown)
             if not progress.done:
                 return {'PASS_THROUGH'}
-            settings = job.scene.dwivedi_bake
-            summary = job.finish(settings)
-            result = job.result
+            summary = job.finish()
+            show = job.target == 'CAMERA' and job.scene.dwivedi_bake.load_result and job.result is not None
         except Exception as error:
             _RUN.stop()
             return self._fail(context, error)
@@ -928,8 +929,8 @@ class DWIVEDI_OT_bake(bpy.types.Operator):
         _RUN.stop()
         _RUN.say('INFO', summary, context, job.warnings)
         self.report({'INFO'}, summary)
-        if job.target == 'CAMERA' and settings.load_result and result is not None:
-            show_in_image_editor(context, result)
+        if show:
+            show_in_image_editor(context, job.result)
         return {'FINISHED'}
 
     def cancel(self, context):

@@ -207,7 +207,7 @@ class AddonTest(harness.unittest.TestCase):
             job = module._Job(bpy.context, props)
             try:
                 job.start()
-                summary = job.finish(props)
+                summary = job.finish()
             finally:
                 job.close()
             self.assertIn(", classical", summary)
