@@ -213,6 +213,9 @@ def step_save_and_reopen_during_bake():
     check(run_state().running, "running")
     check(shows_progress(drawn(module().draw_status_bar)), "the status bar shows the progress and a cancel button")
     if os.environ.get("DWIVEDI_UI_SCREENSHOT"):  # for a person to look at (not compared)
+        with in_editor('PROPERTIES'):  # down to the panel, below Cycles' own
+            for _ in range(40):
+                bpy.ops.view2d.scroll_down()
         yield 1.0
         with in_editor():
             bpy.ops.screen.screenshot(filepath=os.environ["DWIVEDI_UI_SCREENSHOT"])
