@@ -18,6 +18,8 @@ packages+=(libopenmpi-dev openmpi-bin)
 packages+=(slurm-wlm munge)
 # node runs the Flamenco job type's compiler in tests/farm/test_flamenco_job.py.
 packages+=(nodejs)
+# Blender's real UI for tests/blender/test_ui.py: an X server without a screen (xvfb-run needs xauth).
+packages+=(xvfb xauth)
 
 missing=()
 for p in "${packages[@]}"; do

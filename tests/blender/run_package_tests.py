@@ -1,12 +1,14 @@
 #!/usr/bin/env python3
-"""Runs tests/blender/test_package.py (or another script there: --script test_farm.py) in one
-Blender: the host's, or the one in a clean Debian chroot made by scripts/blender-chroots.sh
-(trixie: Blender 4.3, sid: Blender 5.2).
+"""Runs tests/blender/test_package.py headless (or another script there: --script test_farm.py),
+or with --ui tests/blender/test_ui.py (Blender's real UI in a window on Xvfb), in one Blender: the
+host's, or the one in a clean Debian chroot made by scripts/blender-chroots.sh (trixie: Blender
+4.3, sid: Blender 5.2).
 
-    python3 tests/blender/run_package_tests.py --blender host|trixie|sid --build-dir build [--work DIR]
+    python3 tests/blender/run_package_tests.py --blender host|trixie|sid --build-dir build [--work DIR] [--ui]
 
 Steps, each timed (printed at the end and written to WORK/times.json):
-1. the bad library files (tests/blender/fixtures.py) with the C compiler and clang + ld.lld;
+1. the bad library files (tests/blender/fixtures.py) with the C compiler and clang + ld.lld (not
+   for --ui);
 2. for a chroot: the chroot (made once and reused: scripts/blender-chroots.sh), and a scratch
    folder inside it, CHROOT/tmp/dwivedi-test-..., with copies of the two packages, the test
    scripts and the fixtures. If the packaged library still links libraries other than glibc,
@@ -14,12 +16,15 @@ Steps, each timed (printed at the end and written to WORK/times.json):
    (Debian 12's) are put in that scratch folder's deps/ and loaded by the test before the bake:
    a scratch test set-up only, never in a package, said on stdout;
 3. Blender: `blender -b --factory-startup --python-exit-code 1 --python test_package.py` with its
-   user folders and TMPDIR in the scratch folder. As root it runs under `unshare --mount
+   user folders and TMPDIR in the scratch folder; with --ui, `xvfb-run blender --factory-startup
+   --enable-event-simulate --python test_ui.py` (xvfb and xauth: scripts/setup.sh on the host,
+   the chroots' package list in scripts/blender-chroots.sh). As root it runs under `unshare --mount
    --propagation private`: /proc is mounted for it in that namespace (chroot) and the test may
    bind-mount the add-on folder read-only there; every mount goes away with the namespace, on
    failure too;
-4. the verdict: exit status 0, every step passed, and no crash report (*.crash.txt in its TMPDIR
-   or /tmp) written while it ran.
+4. the verdict: exit status 0, every step passed (for --ui: "passed" in the times file the test
+   writes, since the UI quits through wm.quit_blender), and no crash report (*.crash.txt in its
+   TMPDIR or /tmp) written while it ran.
 Exit status 0 only if all of that holds; 1 with a message otherwise (a chroot that cannot be made
 is a failure, never a skip).
 """
@@ -115,6 +120,8 @@ def main(argv=None):
     parser.add_argument("--script", default="test_package.py",
                         help="the test script in tests/blender to run (test_package.py; test_farm.py)")
     parser.add_argument("--timeout", type=float, default=900.0)
+    parser.add_argument("--ui", action="store_true",
+                        help="run test_ui.py in Blender's UI under Xvfb instead of test_package.py headless")
     parser.add_argument("--keep-going", action="store_true",
                         help="run every step even after one failed (diagnosis; later steps build on earlier ones)")
     args = parser.parse_args(argv)
@@ -123,8 +130,10 @@ def main(argv=None):
     for path in (legacy, library):
         if not path.is_file():
             fail(f"{path} is missing (build first)")
-    suffix = "" if args.script == "test_package.py" else "-" + Path(args.script).stem
-    work = (args.work or build / "tests" / f"package-{args.blender}{suffix}").resolve()
+    test_script = "test_ui.py" if args.ui else args.script
+    suffix = "" if test_script in ("test_package.py", "test_ui.py") else "-" + Path(test_script).stem
+    kind = "ui" if args.ui else "package"
+    work = (args.work or build / "tests" / f"{kind}-{args.blender}{suffix}").resolve()
     if work.exists():
         shutil.rmtree(work)
     work.mkdir(parents=True)
@@ -138,7 +147,7 @@ def main(argv=None):
         if not root:
             fail(f"the {args.blender} chroot test needs root (chroot, mounts); DWV_TEST_QUICK=1 leaves it out")
         chroot = step("chroot", make_chroot, args.blender)
-        stage = chroot / "tmp" / f"dwivedi-test-{args.blender}-{os.getpid()}"
+        stage = chroot / "tmp" / f"dwivedi-{kind}-{args.blender}-{os.getpid()}"
         if stage.exists():
             shutil.rmtree(stage)
     else:
@@ -150,15 +159,18 @@ def main(argv=None):
 
     def stage_files():
         (stage / "scripts").mkdir(parents=True)
-        for name in sorted({args.script, "scenes.py", "harness.py"}):
+        for name in sorted({test_script, "scenes.py", "harness.py"}):
             shutil.copy2(HERE / name, stage / "scripts" / name)
         shutil.copy2(legacy, stage / legacy.name)
         shutil.copy2(extension, stage / extension.name)
         fixtures = stage / "fixtures"
-        subprocess.run([sys.executable, str(HERE / "fixtures.py"), "--library", str(library), "--out", str(fixtures),
-                        "--cc", args.cc, "--clang", args.clang], check=False)
-        if not (fixtures / "needs" / "libdwivedi.so.1").is_file():
-            fail("tests/blender/fixtures.py could not build the fixtures (see above)")
+        if args.ui:  # the bad library files are test_package.py's
+            fixtures.mkdir()
+        else:
+            subprocess.run([sys.executable, str(HERE / "fixtures.py"), "--library", str(library), "--out",
+                            str(fixtures), "--cc", args.cc, "--clang", args.clang], check=False)
+            if not (fixtures / "needs" / "libdwivedi.so.1").is_file():
+                fail("tests/blender/fixtures.py could not build the fixtures (see above)")
         # The library the package carries (the self-contained build once there is one), not
         # necessarily build/libdwivedi.so.1: its dependencies decide the scratch set-up.
         import zipfile
@@ -180,7 +192,7 @@ def main(argv=None):
         "BLENDER_USER_DATAFILES": inside(home / "datafiles"), "BLENDER_USER_EXTENSIONS": inside(home / "extensions"),
         "DWIVEDI_TEST_HOME": inside(home), "DWIVEDI_ADDON_ZIP": inside(stage / legacy.name),
         "DWIVEDI_EXTENSION_ZIP": inside(stage / extension.name), "DWIVEDI_FIXTURES": inside(stage / "fixtures"),
-        "DWIVEDI_TEST_TIMES": inside(times_file), "PYTHONDONTWRITEBYTECODE": "1",
+        "DWIVEDI_TEST_TIMES": inside(times_file), "PYTHONDONTWRITEBYTECODE": "1", "PYTHONUNBUFFERED": "1",
     }
     if copied:
         env["DWIVEDI_TEST_PRELOAD"] = inside(stage / "deps")
@@ -189,11 +201,22 @@ def main(argv=None):
               "never in a package")
     if root:
         env["DWIVEDI_PRIVATE_MOUNTS"] = "1"
+    if args.ui and os.environ.get("DWIVEDI_UI_SCREENSHOT"):
+        env["DWIVEDI_UI_SCREENSHOT"] = inside(stage / "screenshot.png")  # copied to WORK at the end
+    if args.ui and os.environ.get("DWIVEDI_UI_ONLY"):
+        env["DWIVEDI_UI_ONLY"] = os.environ["DWIVEDI_UI_ONLY"]
     if args.keep_going:
         env["DWIVEDI_TEST_KEEP_GOING"] = "1"
     blender = "/usr/bin/blender" if chroot is not None else args.host_blender
-    command = [blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python",
-               inside(stage / "scripts" / args.script)]
+    if args.ui:
+        # A display number of its own per Blender (Xvfb's abstract socket is shared by the host
+        # and the chroots, which do not see each other's lock files); -a moves on from it if taken.
+        display = {"host": 90, "trixie": 100, "sid": 110}[args.blender]
+        command = ["xvfb-run", "-a", "-n", str(display), "-s", "-screen 0 1280x800x24 -nolisten tcp", blender,
+                   "--factory-startup", "--enable-event-simulate", "--python", inside(stage / "scripts" / "test_ui.py")]
+    else:
+        command = [blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python",
+                   inside(stage / "scripts" / test_script)]
     environment = ["env", "-i"] + [f"{k}={v}" for k, v in env.items()]
     if chroot is not None:
         script = 'mount -t proc proc "$1/proc" && shift && exec chroot "$@"'
@@ -219,15 +242,19 @@ def main(argv=None):
     sys.stdout.write(output)
     new_crashes = sorted(crash_reports(watched) - before)
     steps = {}
+    passed = None
     if times_file.is_file():
         data = json.loads(times_file.read_text())
         steps = data.get("seconds", {})
+        passed = data.get("passed")
         TIMES["blender version"] = data.get("blender")
     TIMES["steps in Blender"] = steps
     TIMES["total"] = round(time.monotonic() - total, 1)
     (work / "times.json").write_text(json.dumps(TIMES, indent=1))
     print(f"run_package_tests: {args.blender}: times (s): {json.dumps(TIMES)}")
     problems = []
+    if args.ui and passed is not True:
+        problems.append("test_ui.py did not pass (see its output above)")
     if code != 0:
         problems.append(f"Blender exited with {code}" + (" (a crash: a signal)" if isinstance(code, int) and code < 0
                                                          else ""))
@@ -241,6 +268,8 @@ def main(argv=None):
         print(f"run_package_tests: {args.blender}: FAILED: {'; '.join(problems)} (scratch folder kept: {stage})",
               file=sys.stderr)
         return 1
+    if (stage / "screenshot.png").is_file():
+        shutil.copy2(stage / "screenshot.png", work / "screenshot.png")
     shutil.rmtree(stage)
     print(f"run_package_tests: {args.blender}: passed")
     return 0

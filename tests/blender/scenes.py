@@ -328,3 +328,18 @@ def glossy_cube_scene(resolution, method):
     light.location = (0.6, -0.6, 0.5)
     scene.collection.objects.link(light)
     return scene
+
+
+def bake_image(obj, size, name="Baked", float_buffer=True):
+    """What Cycles' UV bake wants, made as an artist makes it: a new image (Image > New, `size` =
+    (width, height)) in an Image Texture node that is the active node of `obj`'s material, and
+    `obj` the active, selected object. Returns the image."""
+    image = bpy.data.images.new(name, size[0], size[1], alpha=True, float_buffer=float_buffer)
+    material = obj.active_material
+    node = material.node_tree.nodes.new('ShaderNodeTexImage')
+    node.image = image
+    material.node_tree.nodes.active = node
+    for other in bpy.context.view_layer.objects:
+        other.select_set(other == obj)
+    bpy.context.view_layer.objects.active = obj
+    return image

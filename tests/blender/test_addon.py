@@ -29,6 +29,14 @@ def small_slab():
     return scene
 
 
+def last_message():
+    return sys.modules["dwivedi_bake"]._RUN.message
+
+
+def last_warnings():
+    return sys.modules["dwivedi_bake"]._RUN.warnings
+
+
 class AddonTest(harness.unittest.TestCase):
     def setUp(self):
         prefs = bpy.context.preferences.addons["dwivedi_bake"].preferences
@@ -41,8 +49,11 @@ class AddonTest(harness.unittest.TestCase):
         self.assertEqual(bpy.types.DWIVEDI_PT_bake.bl_context, "render")
         props = bpy.context.scene.dwivedi_bake
         for name in ("target", "technique", "channel_walks", "samples", "time_limit", "threads", "seed", "output_dir",
-                     "uv_object", "uv_size", "uv_margin"):
+                     "uv_margin", "load_result"):
             self.assertTrue(hasattr(props, name), name)
+        # Nothing about a running bake is scene data (a .blend saved mid-bake would keep it).
+        for name in ("running", "progress", "last_result", "last_warnings", "uv_object", "uv_size"):
+            self.assertFalse(hasattr(props, name), name)
         self.assertEqual(props.target, 'CAMERA')
         self.assertEqual(props.channel_walks, 'AUTO')
         items = props.bl_rna.properties["channel_walks"].enum_items
@@ -74,7 +85,13 @@ class AddonTest(harness.unittest.TestCase):
         self.assertTrue(all(math.isfinite(v) for v in pixels))
         mean_r = sum(pixels[0::4]) / (width * height)
         self.assertGreater(mean_r, 0.0, "light comes through the slab")
-        self.assertIn("spp", scene.dwivedi_bake.last_result)
+        self.assertIn("spp", last_message())
+        # The image is the EXR itself (it comes back after save and reopen) and is kept by saving.
+        self.assertEqual(image.source, 'FILE')
+        self.assertEqual(bpy.path.abspath(image.filepath), str(exr))
+        self.assertTrue(image.use_fake_user)
+        # Film > Transparent off (scenes' default): the background is opaque, as Cycles'.
+        self.assertEqual(min(pixels[3::4]), 1.0)
 
     def test_every_technique_bakes(self):
         """The Technique items are the library's techniques, in its order, and each bakes the back-lit
@@ -92,7 +109,7 @@ class AddonTest(harness.unittest.TestCase):
                 self.assertTrue(all(math.isfinite(v) for v in pixels))
                 self.assertGreater(sum(pixels[0::4]), 0.0, item.identifier)
                 if item.identifier != 'AUTO':
-                    self.assertIn(item.identifier.lower(), scene.dwivedi_bake.last_result)
+                    self.assertIn(item.identifier.lower(), last_message())
 
     def test_panel_shows_channel_walks_after_technique(self):
         small_slab()
@@ -115,13 +132,53 @@ class AddonTest(harness.unittest.TestCase):
             def operator(self, *args, **options):
                 pass
 
-        class Panel:
-            layout = Layout()
-
-        sys.modules["dwivedi_bake"].DWIVEDI_PT_bake.draw(Panel, bpy.context)
-        drawn = Panel.layout.props
+        layout = Layout()
+        sys.modules["dwivedi_bake"].DWIVEDI_PT_bake_advanced.draw_settings(None, layout, bpy.context.scene.dwivedi_bake)
+        drawn = layout.props
         self.assertIn("channel_walks", drawn)
         self.assertEqual(drawn.index("channel_walks"), drawn.index("technique") + 1, drawn)
+
+    def test_panel_conventions(self):
+        """The Render tab's conventions: the Bake button first, sub-panels closed by default under
+        the main one (whose bl_idname other modules name), every setting and technique with a
+        tooltip of its own, no raw identifiers as names."""
+        module = sys.modules["dwivedi_bake"]
+        small_slab()
+        items = []
+
+        class Layout:
+            scale_y = 1.0
+            use_property_split = use_property_decorate = False
+
+            def prop(self, data, name, **options):
+                items.append(("prop", name))
+
+            def label(self, text="", icon='NONE', **options):
+                items.append(("label", text))
+
+            def operator(self, idname, **options):
+                items.append(("operator", idname))
+
+            def row(self, **options):
+                return self
+
+            column = box = row
+
+        module.DWIVEDI_PT_bake.draw(type("Panel", (), {"layout": Layout()})(), bpy.context)
+        self.assertEqual(items[0], ("operator", "dwivedi.bake"), items)
+        self.assertEqual(module.DWIVEDI_PT_bake.bl_idname, "DWIVEDI_PT_bake")
+        for panel in (module.DWIVEDI_PT_bake_sampling, module.DWIVEDI_PT_bake_output, module.DWIVEDI_PT_bake_advanced):
+            self.assertEqual(panel.bl_parent_id, "DWIVEDI_PT_bake")
+            self.assertIn('DEFAULT_CLOSED', panel.bl_options)
+        properties = bpy.context.scene.dwivedi_bake.bl_rna.properties
+        for prop in properties:
+            if prop.identifier == "rna_type" or prop.identifier == "name":
+                continue
+            self.assertTrue(prop.description and prop.description != prop.name, prop.identifier)
+        for enum in ("technique", "channel_walks", "target"):
+            for item in properties[enum].enum_items:
+                self.assertTrue(item.description, item.identifier)
+                self.assertNotIn("_", item.name, item.identifier)
 
     def test_channel_walks_reach_the_bake(self):
         """The slab's radii differ per channel: Separate walks each channel on its own (the bake
@@ -150,7 +207,7 @@ class AddonTest(harness.unittest.TestCase):
             job = module._Job(bpy.context, props)
             try:
                 job.start()
-                summary = job.finish(bpy.context, props)
+                summary = job.finish()
             finally:
                 job.close()
             self.assertIn(", classical", summary)
@@ -186,14 +243,44 @@ class AddonTest(harness.unittest.TestCase):
     def test_uv_bake(self):
         scene = small_slab()
         slab = bpy.data.objects["Slab"]  # the cube primitive comes with a UV map
-        result, error = harness.call_operator(target='UV', uv_object=slab, uv_size=32, uv_margin=2)
+        image = scenes.bake_image(slab, (32, 24))
+        result, error = harness.call_operator(target='UV', uv_margin=2)
         self.assertEqual(result, {'FINISHED'}, error)
-        self.assertTrue((WORK / "out" / f"{scene.name}_uv_Slab.exr").is_file())
-        width, height, pixels = harness.image_pixels("Dwivedi UV")
-        self.assertEqual((width, height), (32, 32))
+        # Into the active Image Texture node's image, at its size, saved as a float EXR.
+        exr = WORK / "out" / f"{scene.name}_uv_Slab.exr"
+        self.assertTrue(exr.is_file())
+        self.assertEqual(image.source, 'FILE')
+        self.assertTrue(image.is_float)
+        self.assertEqual(bpy.path.abspath(image.filepath), str(exr))
+        width, height, pixels = harness.image_pixels(image.name)
+        self.assertEqual((width, height), (32, 24))
         covered = sum(1 for a in pixels[3::4] if a > 0.0)
-        self.assertGreater(covered, 32 * 32 // 4)
-        self.assertIsNotNone(bpy.data.images.get("Dwivedi UV"))
+        self.assertGreater(covered, 32 * 24 // 4)
+        self.assertGreater(sum(pixels[0::4]), 0.0)
+        self.assertIsNone(bpy.data.images.get("Dwivedi UV"), "no image of its own: the user's image")
+        width, height, on_disk = harness.read_pixels(exr)
+        self.assertEqual((width, height), (32, 24))
+        self.assertEqual(on_disk, pixels)
+
+    def test_uv_bake_into_an_8_bit_file_image(self):
+        """An 8-bit sRGB image from a file: the baked texels sRGB-encoded, the others kept; saved
+        to its own file."""
+        small_slab()
+        slab = bpy.data.objects["Slab"]
+        image = scenes.bake_image(slab, (16, 16), name="Byte", float_buffer=False)
+        image.generated_color = (0.0, 0.0, 1.0, 1.0)
+        png = WORK / "byte.png"
+        image.filepath_raw = str(png)
+        image.file_format = 'PNG'
+        image.save()
+        self.assertEqual(image.source, 'FILE')
+        result, error = harness.call_operator(target='UV', uv_margin=0)
+        self.assertEqual(result, {'FINISHED'}, error)
+        _, _, pixels = harness.read_pixels(png)
+        kept = sum(1 for i in range(0, len(pixels), 4) if pixels[i + 2] == 1.0 and pixels[i] == 0.0)
+        baked = sum(1 for i in range(0, len(pixels), 4) if pixels[i] > 0.0)
+        self.assertGreater(kept, 0, "texels outside the UV islands keep their colour")
+        self.assertGreater(baked, 0, "the islands are baked")
 
     def test_modifiers_are_evaluated(self):
         """A subdivision modifier changes what is baked (the evaluated mesh, not the original)."""
@@ -246,17 +333,65 @@ class AddonTest(harness.unittest.TestCase):
         slab = bpy.data.objects["Slab"]
         while slab.data.uv_layers:
             slab.data.uv_layers.remove(slab.data.uv_layers[0])
-        self.assertFails("no UV map", target='UV', uv_object=slab)
+        scenes.bake_image(slab, (8, 8))
+        self.assertFails("no UV map", target='UV')
 
-    def test_uv_target_missing_or_not_a_mesh(self):
+    def test_uv_target_missing(self):
+        """No mesh selected, no image node, a node without an image: each says what to do."""
         small_slab()
-        self.assertFails("choose the object", target='UV', uv_object=None)
-        props = bpy.context.scene.dwivedi_bake
-        try:
-            props.uv_object = bpy.data.objects["Camera"]
-        except (TypeError, ValueError, AttributeError):
-            return  # the property's poll refuses it already
-        self.assertFails("needs a mesh", target='UV')
+        slab = bpy.data.objects["Slab"]
+        for obj in bpy.context.view_layer.objects:
+            obj.select_set(False)
+        bpy.context.view_layer.objects.active = bpy.data.objects["Camera"]
+        self.assertFails("select the mesh to bake", target='UV')
+        bpy.context.view_layer.objects.active = slab
+        self.assertFails("has no active Image Texture node", target='UV')
+        image = scenes.bake_image(slab, (8, 8))
+        slab.active_material.node_tree.nodes.active.image = None
+        self.assertFails("has no image", target='UV')
+        slab.active_material.node_tree.nodes.active.image = image
+        self.assertEqual(harness.call_operator(target='UV')[0], {'FINISHED'})
+
+    def test_unsaved_file_needs_a_folder(self):
+        """An unsaved file has no folder for "//": a script is told so (the UI asks for a folder)."""
+        small_slab()
+        self.assertFalse(bpy.data.filepath)
+        self.assertFails("the .blend is not saved", output_dir="//dwivedi_bake/")
+
+    def test_temporary_folder_warns(self):
+        small_slab()
+        result, error = harness.call_operator(output_dir=bpy.app.tempdir)
+        self.assertEqual(result, {'FINISHED'}, error)
+        self.assertTrue([w for w in last_warnings() if "deletes at quit" in w], last_warnings())
+
+    def test_transparent_film(self):
+        """Film > Transparent: the background's alpha is 0 and the world is taken out of its colour
+        (Cycles' premultiplied alpha); the slab covers the whole view here, so a wider view is used."""
+        scene = small_slab()
+        scenes.set_world(scene, (0.2, 0.4, 0.6), 1.0)
+        bpy.data.objects["Slab"].scale = (0.4, 0.4, 0.1)
+        scene.render.film_transparent = True
+        result, error = harness.call_operator()
+        self.assertEqual(result, {'FINISHED'}, error)
+        _, _, pixels = harness.image_pixels("Dwivedi Camera")
+        background = [i for i in range(0, len(pixels), 4) if pixels[i + 3] == 0.0]
+        self.assertGreater(len(background), 0)
+        self.assertTrue(all(max(pixels[i:i + 3]) < 1e-6 for i in background))
+        scene.render.film_transparent = False
+        result, error = harness.call_operator()
+        _, _, pixels = harness.image_pixels("Dwivedi Camera")
+        self.assertEqual(min(pixels[3::4]), 1.0)
+        self.assertAlmostEqual(pixels[background[0] + 2], 0.6, places=5)
+
+    def test_menu_and_status_bar(self):
+        """The operator is in the Render menu (F3's menu search finds it there) and the status bar
+        has the progress drawer; method identifiers in messages read as Blender names them."""
+        module = sys.modules["dwivedi_bake"]
+        self.assertIn(module.draw_render_menu, bpy.types.TOPBAR_MT_render._dyn_ui_initialize())
+        self.assertIn(module.draw_status_bar, bpy.types.STATUSBAR_HT_header._dyn_ui_initialize())
+        self.assertIn("Random Walk", module.readable("subsurface method RANDOM_WALK is not modelled"))
+        self.assertNotIn("RANDOM_WALK", module.readable("subsurface method RANDOM_WALK is not modelled"))
+        self.assertIn("OCIO", module.readable("the OCIO config"))
 
     def test_unwritable_folder(self):
         small_slab()
@@ -391,11 +526,11 @@ class AddonTest(harness.unittest.TestCase):
         self.assertEqual(result, {'FINISHED'}, error)
         _, _, pixels = harness.image_pixels("Dwivedi Camera")
         self.assertTrue(all(math.isfinite(v) for v in pixels))
-        self.assertIn("geometry warnings", scene.dwivedi_bake.last_result)
+        self.assertIn("geometry warnings", last_message())
         slab.scale = (1.0, 1.0, 1.0)
         result, error = harness.call_operator()
         self.assertEqual(result, {'FINISHED'}, error)
-        self.assertNotIn("geometry warnings", scene.dwivedi_bake.last_result)
+        self.assertNotIn("geometry warnings", last_message())
 
     def test_failures_in_a_row_then_a_bake(self):
         """Every refusal leaves Blender and the add-on usable: after each, a good bake finishes."""
@@ -407,7 +542,10 @@ class AddonTest(harness.unittest.TestCase):
         blocker.write_text("x")
         self.assertFails("output folder", output_dir=str(blocker / "sub"))
         self.assertEqual(harness.call_operator(output_dir=good)[0], {'FINISHED'})
-        self.assertFails("choose the object", target='UV', uv_object=None)
+        bpy.context.view_layer.objects.active = None
+        for obj in bpy.context.view_layer.objects:
+            obj.select_set(False)
+        self.assertFails("select the mesh", target='UV')
         self.assertEqual(harness.call_operator(target='CAMERA')[0], {'FINISHED'})
 
     def test_unregister_and_register(self):

@@ -157,6 +157,9 @@ class CyclesTest(harness.unittest.TestCase):
         view.gamma = 1.3
         scene.display_settings.display_device = 'sRGB'
         scene.render.dither_intensity = 0.0
+        # Film > Transparent: the sphere's edge pixels keep their coverage as alpha (opaque film
+        # makes every pixel's alpha 1, as Cycles').
+        scene.render.film_transparent = True
         scene.render.image_settings.file_format = 'PNG'
         scene.render.image_settings.color_mode = 'RGBA'
         scene.render.image_settings.color_depth = '8'
