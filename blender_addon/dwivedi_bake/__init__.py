@@ -556,7 +556,7 @@ class _Job:
             stats = image.stats
             if self.target == 'CAMERA':
                 self._write_files(image)
-                self.result = camera_image(self.exr)
+                self.result = file_image(self.exr)
                 where = self.exr
             else:
                 where = write_uv_image(image, self.uv_image, self.exr, self.dwivedi)
@@ -681,17 +681,17 @@ def _blender_rows(image):
 CAMERA_IMAGE = "Dwivedi Camera"
 
 
-def camera_image(path):
-    """The Blender image "Dwivedi Camera" showing the EXR at `path`: the file itself (so the
-    image comes back after the .blend is saved and opened again), reloaded after every bake, with
-    a fake user so that saving keeps it even when no editor shows it."""
-    target = bpy.data.images.get(CAMERA_IMAGE)
+def file_image(path, name=CAMERA_IMAGE):
+    """The Blender image `name` ("Dwivedi Camera", or the farm merge's) showing the EXR at `path`:
+    the file itself (so the image comes back after the .blend is saved and opened again), reloaded
+    after every bake, with a fake user so that saving keeps it even when no editor shows it."""
+    target = bpy.data.images.get(name)
     if target is not None and (target.source != 'FILE' or bpy.path.abspath(target.filepath) != path):
         bpy.data.images.remove(target)
         target = None
     if target is None:
         target = bpy.data.images.load(path, check_existing=False)
-        target.name = CAMERA_IMAGE
+        target.name = name
     else:
         target.reload()
     target.use_fake_user = True

@@ -159,6 +159,7 @@ class DWIVEDI_OT_farm_merge(_FarmOperator, bpy.types.Operator):
         try:
             exr = os.path.join(folder, name + ".exr")
             png = os.path.join(folder, name + ".png")
+            addon.film_alpha(image, context.scene)  # the background as Film > Transparent says, as the bake
             image.write_exr(exr)
             try:
                 image.write_png(png, addon.display_settings(context.scene, dwivedi))
@@ -166,7 +167,7 @@ class DWIVEDI_OT_farm_merge(_FarmOperator, bpy.types.Operator):
                 if "OCIO" not in str(error) and "config" not in str(error):
                     raise
                 addon.png_through_blender(image, context.scene, png)  # as the bake does (Blender 5.2's config)
-            addon.blender_image(image, "Dwivedi Farm", exr)
+            addon.file_image(exr, "Dwivedi Farm")
             stats = image.stats
         finally:
             image.close()
