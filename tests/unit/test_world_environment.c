@@ -341,8 +341,98 @@ static void test_spot_input(void)
     dwv_scene_release(scene);
 }
 
+/* Scene files: an environment and a spot light load to the scene the C calls make (bit-identical
+ * bakes); malformed ones fail with their path in the message. */
+static void test_scene_file(void)
+{
+    const char *json =
+        "{\"version\": 1,"
+        " \"materials\": {\"m\": {\"kind\": \"diffuse\", \"subsurface_weight\": 0}},"
+        " \"meshes\": [{\"material\": \"m\", \"positions\": [-1,-1,0, 1,-1,0, 1,1,0, -1,1,0], \"indices\": [0,1,2, 0,2,3]}],"
+        " \"lights\": [{\"kind\": \"spot\", \"position\": [0, 0, 1], \"direction\": [0, 0, -1], \"strength\": 50,"
+        "   \"spot_size\": 60, \"spot_blend\": 0.2, \"spot_falloff\": \"cycles4\"}],"
+        " \"world\": {\"environment\": {\"width\": 4, \"height\": 2, \"interpolation\": \"cubic\", \"strength\": 2,"
+        "   \"rotate\": [0, 0, 90], \"texels\": [1,0,0, 0,1,0, 0,0,1, 1,1,1, 2,2,2, 3,3,3, 4,4,4, 0.5,0.5,0.5]}},"
+        " \"camera\": {\"kind\": \"orthographic\", \"ortho_scale\": 3, \"transform\": {\"translate\": [0, 0, 3]}}}";
+    dwv_scene_t *loaded = NULL;
+    CHECK(dwv_scene_load_json(json, strlen(json), NULL, &loaded, NULL) == DWV_SUCCESS, "load: %s", dwv_last_error_message());
+    dwv_scene_t *made = NULL;
+    dwv_scene_create(&made);
+    dwv_material_t m = DWV_MATERIAL_INIT;
+    m.kind = DWV_MATERIAL_DIFFUSE;
+    m.subsurface_weight = 0.0;
+    uint32_t material_id, mesh_id;
+    dwv_scene_add_material(made, &m, &material_id);
+    const float positions[] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
+    const uint32_t indices[] = {0, 1, 2, 0, 2, 3};
+    dwv_mesh_t mesh = DWV_MESH_INIT;
+    mesh.vertex_count = 4;
+    mesh.triangle_count = 2;
+    mesh.positions = positions;
+    mesh.indices = indices;
+    mesh.material_id = material_id;
+    dwv_scene_add_mesh(made, &mesh, &mesh_id);
+    dwv_light_desc_t spot = DWV_LIGHT_DESC_INIT;
+    spot.kind = DWV_LIGHT_SPOT;
+    spot.position[2] = 1.0;
+    spot.strength = 50.0;
+    spot.spot_size = 60.0 * (PI / 180.0);
+    spot.spot_blend = 0.2;
+    spot.spot_falloff = DWV_SPOT_FALLOFF_CYCLES4;
+    dwv_scene_add_light(made, &spot);
+    const float texels[] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 3, 3, 3, 4, 4, 4, 0.5f, 0.5f, 0.5f};
+    dwv_environment_t e = DWV_ENVIRONMENT_INIT;
+    e.width = 4;
+    e.height = 2;
+    e.texels = texels;
+    e.interpolation = DWV_ENVIRONMENT_CUBIC;
+    e.strength = 2.0;
+    /* Rz(90 degrees) as the scene file's T R S makes it: cos(pi/2) is 6e-17, not 0. */
+    double c = cos(0.5 * PI), s = sin(0.5 * PI);
+    double rz[9] = {c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0};
+    memcpy(e.rotation, rz, sizeof rz);
+    dwv_scene_set_world_environment(made, &e);
+    dwv_camera_t camera = test_ortho_camera(0.0, 0.0, 3.0, 3.0);
+    dwv_scene_set_camera(made, &camera);
+    dwv_scene_commit(made);
+    if (loaded) {
+        dwv_image_t *a = bake(loaded, 16, 4), *b = bake(made, 16, 4);
+        if (a && b) {
+            dwv_image_info_t ia = DWV_IMAGE_INFO_INIT, ib = DWV_IMAGE_INFO_INIT;
+            dwv_image_info(a, &ia);
+            dwv_image_info(b, &ib);
+            CHECK(memcmp(ia.rgba, ib.rgba, 4u * 16u * 16u * sizeof(float)) == 0, "the file's scene bakes differently");
+        }
+        dwv_image_release(a);
+        dwv_image_release(b);
+    }
+    dwv_scene_release(loaded);
+    dwv_scene_release(made);
+    static const struct { const char *json, *part; } bad[] = {
+        {"{\"version\": 1, \"meshes\": [], \"world\": {\"environment\": {\"width\": 2, \"height\": 1, \"texels\": [1,1,1]}}}",
+         "world.environment.texels: 3 numbers: a 2 x 1 image needs 6"},
+        {"{\"version\": 1, \"meshes\": [], \"world\": {\"color\": [1,1,1], \"environment\": {}}}", "either 'environment'"},
+        {"{\"version\": 1, \"meshes\": [], \"world\": {\"environment\": {\"width\": 2, \"height\": 1}}}", "needs 'width'"},
+        {"{\"version\": 1, \"meshes\": [], \"world\": {\"environment\": {\"width\": 2, \"height\": 1, \"texels\": [1,1,1, 1,-1,1]}}}",
+         "world.environment: dwv_scene_set_world_environment: texel (1, 0)"},
+        {"{\"version\": 1, \"meshes\": [], \"world\": {\"environment\": {\"width\": 1, \"height\": 1, \"texels\": [1,1,1], \"interpolation\": \"smart\"}}}",
+         "world.environment.interpolation"},
+        {"{\"version\": 1, \"meshes\": [], \"lights\": [{\"kind\": \"spot\", \"spot_falloff\": \"cycles5\"}]}", "lights[0].spot_falloff"},
+        {"{\"version\": 1, \"meshes\": [], \"lights\": [{\"kind\": \"spot\", \"spot_size\": 0}]}", "lights[0]: dwv_scene_add_light: spot_size"},
+        {"{\"version\": 1, \"meshes\": [], \"lights\": [{\"kind\": \"spot\", \"angle\": 3}]}", "lights[0]: unknown key 'angle'"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        dwv_scene_t *scene = NULL;
+        dwv_result_t r = dwv_scene_load_json(bad[i].json, strlen(bad[i].json), NULL, &scene, NULL);
+        CHECK(r != DWV_SUCCESS && scene == NULL && message_has(bad[i].part), "bad file %zu: %s (%s)", i,
+              dwv_last_error_message(), dwv_result_string(r));
+        dwv_scene_release(scene);
+    }
+}
+
 int main(void)
 {
+    test_scene_file();
     test_bad_environments();
     test_constant_equivalents();
     test_odd_maps();
