@@ -256,6 +256,9 @@ class DwivediBakeSettings(bpy.types.PropertyGroup):
                            min=0, max=64)
     load_result: BoolProperty(name="Load Result", description="Load the baked EXR as a Blender image",
                               default=True)
+    world_resolution: IntProperty(name="World Resolution", default=1024, min=8, max=16384, description=(
+        "Width of the equirectangular image Cycles renders a world into when its nodes are not an Environment "
+        "Texture (the height is half)"))
     # Runtime state shown in the panel while a bake runs.
     running: BoolProperty(default=False, options={'SKIP_SAVE'})
     progress: FloatProperty(name="Progress", default=0.0, min=0.0, max=100.0, subtype='PERCENTAGE',
@@ -601,6 +604,7 @@ class DWIVEDI_PT_bake(bpy.types.Panel):
         layout.prop(settings, "seed")
         layout.prop(settings, "output_dir")
         layout.prop(settings, "load_result")
+        layout.prop(settings, "world_resolution")
         if settings.running:
             layout.prop(settings, "progress", slider=True)
             layout.label(text="Esc cancels", icon='INFO')

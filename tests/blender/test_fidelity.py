@@ -33,23 +33,7 @@ import scenes  # noqa: E402
 
 
 
-def preload_scratch_dependencies():
-    """run_fidelity_chroot.sh's scratch set-up for a library that is not self-contained
-    (DWIVEDI_PRELOAD: a wrapper needing this Blender's malloc, then the library; the host
-    dependencies beside it): one dlopen with RTLD_DEEPBIND, so that the library binds to its own
-    Embree 3 and OpenEXR rather than the Embree 4 / OpenEXR this Blender loaded under the same
-    symbol names (without it every ray misses). The add-on's shim then opens the same file
-    (DWIVEDI_LIBRARY): the same handle. Branch native's self-contained library needs none of it."""
-    wrapper = os.environ.get("DWIVEDI_PRELOAD")
-    if not wrapper or not Path(wrapper).is_file():
-        return
-    import ctypes
-    ctypes.CDLL(wrapper, mode=ctypes.RTLD_LOCAL | getattr(os, "RTLD_DEEPBIND", 8))
-    print(f"test_fidelity: scratch set-up: {wrapper} (the library and its host dependencies) loaded with "
-          "RTLD_DEEPBIND", flush=True)
-
-
-preload_scratch_dependencies()
+harness.preload_scratch_dependencies()
 WORK = harness.install_addon()
 RESOLUTION = int(os.environ.get("DWIVEDI_FIDELITY_RESOLUTION", "48"))
 CYCLES_SAMPLES = int(os.environ.get("DWIVEDI_FIDELITY_CYCLES_SPP", "512"))    # per seed; two seeds
