@@ -505,23 +505,39 @@ def _environment_texture(background: Any) -> Optional[Tuple[Any, List[float]]]:
     return node, rotation
 
 
+def _rgb(image: Any, width: int, height: int) -> Any:
+    """An image's pixels without alpha: an array('f') of 3 x width x height, row 0 at the bottom
+    (standard library only: Debian's Blender has no numpy)."""
+    count = width * height
+    rgba = array.array("f", bytes(16 * count))
+    image.pixels.foreach_get(rgba)
+    rgb = array.array("f", bytes(12 * count))
+    for c in range(3):
+        rgb[c::3] = rgba[c::4]
+    return rgb
+
+
+def _srgb_to_linear(rgb: Any) -> Any:
+    """8-bit sRGB values (k / 255) to linear by the sRGB transfer function (IEC 61966-2-1), by a
+    table of the 256 values."""
+    table = [k / 255.0 / 12.92 if k / 255.0 <= 0.04045 else ((k / 255.0 + 0.055) / 1.055) ** 2.4
+             for k in range(256)]
+    return array.array("f", [table[min(255, max(0, int(round(v * 255.0))))] for v in rgb])
+
+
 def _image_texels(image: Any, what: str) -> Optional[Tuple[Any, int, int]]:
-    """An image's RGB texels as scene-linear float32 (row 0 at the bottom), its width and height;
+    """An image's RGB texels as scene-linear floats (row 0 at the bottom), its width and height;
     None where its colour space is neither linear nor sRGB (the world is rendered instead).
     ExportError where the image has no pixels (a missing file)."""
-    import numpy
     width, height = int(image.size[0]), int(image.size[1])  # reading the size loads the file
     if width == 0 or height == 0:
         raise ExportError(f"{what}: image '{image.name}' has no pixels (is its file '{image.filepath}' missing?)")
     space = image.colorspace_settings.name
     if not image.is_float and space not in LINEAR_SPACES and space != 'sRGB':
         return None
-    pixels = numpy.empty(4 * width * height, dtype=numpy.float32)
-    image.pixels.foreach_get(pixels)
-    rgb = numpy.ascontiguousarray(pixels.reshape(-1, 4)[:, :3])
+    rgb = _rgb(image, width, height)
     if not image.is_float and space == 'sRGB':
-        # The sRGB transfer function (IEC 61966-2-1) to linear.
-        rgb = numpy.where(rgb <= 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4).astype(numpy.float32)
+        rgb = _srgb_to_linear(rgb)
     return rgb, width, height
 
 
@@ -530,10 +546,8 @@ def _render_world(scene: Any, world: Any, width: int) -> Tuple[Any, int, int]:
     looking along +x (where Cycles' environment camera faces the centre of an environment
     texture, blender/camera.cpp), width x width/2 pixels, in a scene of its own that is removed
     afterwards: the texels of dwivedi's equirectangular map."""
-    import math
     import os
     import tempfile
-    import numpy
     height = max(1, width // 2)
     tmp = bpy.data.scenes.new("dwivedi world bake")
     camera_data = bpy.data.cameras.new("dwivedi world bake")
@@ -566,9 +580,7 @@ def _render_world(scene: Any, world: Any, width: int) -> Tuple[Any, int, int]:
         tmp.camera = camera
         bpy.ops.render.render(write_still=True, scene=tmp.name)
         image = bpy.data.images.load(path)
-        pixels = numpy.empty(4 * width * height, dtype=numpy.float32)
-        image.pixels.foreach_get(pixels)
-        return numpy.ascontiguousarray(pixels.reshape(-1, 4)[:, :3]), width, height
+        return _rgb(image, width, height), width, height
     finally:
         if image is not None:
             bpy.data.images.remove(image)
