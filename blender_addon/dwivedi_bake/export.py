@@ -486,21 +486,20 @@ def _environment_texture(background: Any) -> Optional[Tuple[Any, List[float]]]:
     node = link.from_node
     if node.type != 'TEX_ENVIRONMENT' or link.from_socket.name != "Color" or node.projection != 'EQUIRECTANGULAR':
         return None
+    def is_direction(link: Any) -> bool:  # the ray direction, as an unlinked Vector is
+        return link.from_node.type == 'TEX_COORD' and link.from_socket.name == "Generated"
+
     rotation = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
     vector = node.inputs["Vector"]
     if vector.is_linked:
         source = vector.links[0]
         if source.from_node.type == 'MAPPING':
             rotation = _mapping_rotation(source.from_node)
-            if rotation is None:
-                return None
             inner = source.from_node.inputs["Vector"]
-            if inner.is_linked:
-                source = inner.links[0]
-            else:
-                return None  # a Mapping of the zero vector: not a direction
-        if source.from_node.type != 'MAPPING' and not (source.from_node.type == 'TEX_COORD' and
-                                                      source.from_socket.name == "Generated"):
+            # An unlinked Mapping input is the zero vector, not a direction.
+            if rotation is None or not inner.is_linked or not is_direction(inner.links[0]):
+                return None
+        elif not is_direction(source):
             return None
     return node, rotation
 
@@ -533,7 +532,11 @@ def _image_texels(image: Any, what: str) -> Optional[Tuple[Any, int, int]]:
     if width == 0 or height == 0:
         raise ExportError(f"{what}: image '{image.name}' has no pixels (is its file '{image.filepath}' missing?)")
     space = image.colorspace_settings.name
-    if not image.is_float and space not in LINEAR_SPACES and space != 'sRGB':
+    # A float image in a colour space that is not linear (Blender 5.2 tags an EXR it wrote
+    # through a view transform "sRGB") is decoded by Cycles 5.2 otherwise than Image.pixels holds
+    # it above 1 (a 3000 hot spot lit 12% less in Cycles than from Image.pixels): such a world is
+    # rendered by Cycles instead, as is an 8-bit image in a space other than sRGB or linear.
+    if space not in LINEAR_SPACES and (image.is_float or space != 'sRGB'):
         return None
     rgb = _rgb(image, width, height)
     if not image.is_float and space == 'sRGB':
@@ -625,9 +628,11 @@ def world_from_blender(scene: Any, warnings: List[str], render_width: int = 1024
         warnings.append("the world's Environment Texture has no image: Cycles renders it black (so does dwivedi)")
         return World()
     out.texels, out.width, out.height = _render_world(scene, world, render_width)
-    warnings.append(f"the world's nodes are not an Environment Texture dwivedi reads as it is: Cycles rendered the "
-                    f"world into a {out.width} x {out.height} equirectangular image, which is baked (World "
-                    "Resolution sets its width)")
+    what = (f"the world's image '{found[0].image.name}' is in colour space "
+            f"'{found[0].image.colorspace_settings.name}'") if found is not None else \
+        "the world's nodes are not an Environment Texture dwivedi reads as it is"
+    warnings.append(f"{what}: Cycles rendered the world into a {out.width} x {out.height} equirectangular image, "
+                    "which is baked (World Resolution sets its width)")
     return out
 
 

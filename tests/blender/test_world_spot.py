@@ -17,7 +17,8 @@ Each is rendered by Cycles and baked by the add-on with two seeds at 32 x 32, an
 mean per channel within 2%, and the noise ratio R = sum (ours - cycles)^2 / sum (var_ours +
 var_cycles) (the two-seed means' variances from the two seeds) below 1.5. Bad images: an
 Environment Texture whose file is missing, and one with a NaN texel, fail the bake with a message
-naming the image (or texel) and write no file. Figures: DWIVEDI_TEST_HOME/world_spot_figures.json.
+naming the image (or texel) and write no file; a float image tagged sRGB is rendered by Cycles
+(with a warning saying why). Figures: DWIVEDI_TEST_HOME/world_spot_figures.json.
 """
 import json
 import math
@@ -217,6 +218,22 @@ class WorldSpotTest(harness.unittest.TestCase):
         environment_world(scene, path)
         os.remove(path)
         self.refused(scene, "missing", "image 'gone.exr' has no pixels", "missing")
+
+    def test_float_image_in_srgb_space_is_rendered_by_cycles(self):
+        """A float image tagged sRGB (as Blender 5.2 tags an EXR it wrote through a view
+        transform) is decoded by Cycles 5.2 otherwise than Image.pixels holds it: the add-on has
+        Cycles render that world and says why."""
+        scene = scenes.sphere_scene(8, 4, shader='DIFFUSE')
+        pixels, w, h = hdri_pixels(16, 8)
+        image = bpy.data.images.new("tagged", w, h, float_buffer=True)
+        image.pixels.foreach_set(pixels)
+        image.colorspace_settings.name = 'sRGB'
+        environment_world(scene, image)
+        scene.dwivedi_bake.world_resolution = 16
+        result, error = harness.call_operator(samples=2, output_dir=str(WORK / "tagged_out"))
+        self.assertEqual(result, {'FINISHED'}, error)
+        self.assertIn("the world's image 'tagged' is in colour space 'sRGB': Cycles rendered the world into a "
+                      "16 x 8", scene.dwivedi_bake.last_warnings)
 
     def test_nan_texel(self):
         scene = scenes.sphere_scene(8, 4, shader='DIFFUSE')
