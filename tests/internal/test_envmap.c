@@ -212,7 +212,7 @@ static void test_sample_against_pdf(void)
             }
         CHECK(uncovered == 0, "interpolation %d: %d directions with radiance but pdf 0", interpolation, uncovered);
         double mismatch;
-        stats_chi_square_t chi = histogram_test(&map, 0, 1000000u, &mismatch);
+        stats_chi_square_t chi = histogram_test(&map, 0, 500000u, &mismatch);
         stats_print("sampled directions against the pdf (cells x 3 x 3)", chi);
         CHECK(chi.p > STATS_P_REJECT, "interpolation %d: chi2 %.1f dof %d p %.3g", interpolation, chi.x2, chi.dof, chi.p);
         /* Only samples within rounding of a cell boundary may read a neighbour's pdf. */
@@ -220,7 +220,7 @@ static void test_sample_against_pdf(void)
               mismatch);
         if (interpolation == DWV_ENVIRONMENT_LINEAR) {
             /* The harness catches a sampler with the sin theta Jacobian wrong inside the cells. */
-            stats_chi_square_t wrong = histogram_test(&map, 1, 1000000u, &mismatch);
+            stats_chi_square_t wrong = histogram_test(&map, 1, 500000u, &mismatch);
             stats_print("planted error: theta uniform within cells", wrong);
             CHECK(wrong.p < STATS_P_REJECT, "the planted error passed: chi2 %.1f p %.3g", wrong.x2, wrong.p);
         }
