@@ -631,7 +631,9 @@ DWV_API dwv_result_t dwv_scene_set_world(dwv_scene_t *scene, const double color[
  * Blender's "Smart" is cubic). Lights are sampled from a piecewise-constant distribution of the
  * texels' luminance (Rec. 709 Y, each taken as the largest over the texels its interpolation
  * reads) times their solid angle, combined with the surfaces' cosine sampling by multiple
- * importance sampling (balance heuristic); camera rays that miss see the world. */
+ * importance sampling (balance heuristic); camera rays that miss see the world. The scene holds
+ * 16 bytes a texel (the RGB copy and the distribution) and 8 a row; making it takes 4 more a
+ * texel for the call's duration. */
 typedef int32_t dwv_environment_interpolation_t;
 enum {
     DWV_ENVIRONMENT_LINEAR = 0,
