@@ -574,7 +574,9 @@ enum {
     DWV_LIGHT_SUN = 0,   /* direction, strength (irradiance, W/m^2), angle (angular diameter) */
     DWV_LIGHT_POINT = 1, /* position, power (W, Blender's convention), radius (a sphere light) */
     DWV_LIGHT_AREA_RECTANGLE = 2, /* transform, size_x x size_y in its local xy plane, power */
-    DWV_LIGHT_AREA_DISK = 3       /* transform, diameter size_x (size_y for an ellipse), power */
+    DWV_LIGHT_AREA_DISK = 3,      /* transform, diameter size_x (size_y for an ellipse), power */
+    DWV_LIGHT_SPOT = 4            /* position, direction (of its axis), power, radius, spot_size,
+                                     spot_blend, spot_falloff: a point light within a cone */
 };
 /* Lights in Blender's units and conventions; an area light emits along its local -z. */
 typedef struct dwv_light_desc_t {
@@ -588,15 +590,84 @@ typedef struct dwv_light_desc_t {
     double radius;        /* point: >= 0 */
     double transform[12]; /* area: row-major 3 x 4 light-to-world (no shear) */
     double size_x, size_y;/* area: > 0 */
+    /* Added after 0.2 (issue 18; a caller whose struct_size ends before them gets the defaults,
+     * which only spot lights read). Spot lights: `position`, `radius` and `strength` (power in W)
+     * as a point light's, `direction` the way its axis points (need not be unit; Blender's local
+     * -z), radiance P c / (4 pi) x 1 / (pi r^2) times the spot attenuation of the direction w from
+     * the light toward the shaded point: with c = cos(angle between w and the axis),
+     * c_h = cos(spot_size / 2) and the smoothstep s(t) = 3t^2 - 2t^3 on [0, 1] (0 below, 1 above),
+     *   DWV_SPOT_FALLOFF_CYCLES3: c x s((c - c_h) / ((1 - c_h) spot_blend)) for c > c_h, else 0
+     *     (Cycles 3.x spot_light_attenuation: the cosine of the axis stays in);
+     *   DWV_SPOT_FALLOFF_CYCLES4: s((c - c_h) / ((1 - c_h) spot_blend)) (Cycles 4.0 onward);
+     * spot_blend 0 is a hard edge (s is 1 inside the cone). */
+    double spot_size;     /* spot: the cone's full angle in radians, (0, pi] (Blender's Spot Size) */
+    double spot_blend;    /* spot: [0, 1] (Blender's Spot Blend) */
+    int32_t spot_falloff; /* spot: DWV_SPOT_FALLOFF_* */
+    uint32_t reserved;    /* 0 */
 } dwv_light_desc_t;
+typedef int32_t dwv_spot_falloff_t;
+enum {
+    DWV_SPOT_FALLOFF_CYCLES3 = 0, /* Blender 3.x: the axis cosine x the smoothstep */
+    DWV_SPOT_FALLOFF_CYCLES4 = 1  /* Blender 4.0 onward: the smoothstep alone */
+};
 #define DWV_LIGHT_DESC_INIT                                                                         \
     {sizeof(dwv_light_desc_t), DWV_LIGHT_SUN, {1.0, 1.0, 1.0}, 1.0, {0.0, 0.0, -1.0}, 0.0,          \
-     {0.0, 0.0, 0.0}, 0.0, {1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0}, 1.0, 1.0}
+     {0.0, 0.0, 0.0}, 0.0, {1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0}, 1.0, 1.0,   \
+     0.78539816339744830962, 0.15, DWV_SPOT_FALLOFF_CYCLES3, 0u}
 
 DWV_API dwv_result_t dwv_scene_add_light(dwv_scene_t *scene, const dwv_light_desc_t *light);
 
 /* A constant world: radiance color x strength from every direction (default black). */
 DWV_API dwv_result_t dwv_scene_set_world(dwv_scene_t *scene, const double color[3], double strength);
+
+/* ---- World environment (issue 18) ----------------------------------------------------------
+ * An equirectangular image world as Blender's Environment Texture node into a Background node:
+ * the radiance toward direction d (world space, unit) is strength x texture(u, v) with, for the
+ * looked-up direction b = rotation d (Cycles' direction_to_equirectangular),
+ *   u = 0.5 - atan2(b.y, b.x) / (2 pi),   v = 1 - acos(b.z) / pi,
+ * so +x is the image's centre column, +z (up) its top row. The texture is looked up as Cycles'
+ * image textures with periodic wrap: closest (texel floor(u w), floor(v h)), linear (bilinear
+ * between texel centres at (i + 0.5) / w) or cubic (the uniform cubic B-spline over 4 x 4 texels;
+ * Blender's "Smart" is cubic). Lights are sampled from a piecewise-constant distribution of the
+ * texels' luminance (Rec. 709 Y, each taken as the largest over the texels its interpolation
+ * reads) times their solid angle, combined with the surfaces' cosine sampling by multiple
+ * importance sampling (balance heuristic); camera rays that miss see the world. The scene holds
+ * 16 bytes a texel (the RGB copy and the distribution) and 8 a row; making it takes 4 more a
+ * texel for the call's duration. */
+typedef int32_t dwv_environment_interpolation_t;
+enum {
+    DWV_ENVIRONMENT_LINEAR = 0,
+    DWV_ENVIRONMENT_CLOSEST = 1,
+    DWV_ENVIRONMENT_CUBIC = 2
+};
+typedef struct dwv_environment_t {
+    uint32_t struct_size;  /* sizeof(dwv_environment_t): set by DWV_ENVIRONMENT_INIT */
+    uint32_t width;        /* texels per row, 1 to DWV_ENVIRONMENT_MAX_SIDE */
+    uint32_t height;       /* rows, 1 to DWV_ENVIRONMENT_MAX_SIDE; width x height <= DWV_ENVIRONMENT_MAX_TEXELS */
+    dwv_environment_interpolation_t interpolation; /* DWV_ENVIRONMENT_* */
+    /* 3 x width x height scene-linear Rec. 709 RGB, each finite and >= 0; row 0 at the bottom
+     * (v = 0, the nadir: the order of Blender's Image.pixels); copied by the call. */
+    const float *texels;
+    double strength;       /* >= 0, finite: the Background node's Strength */
+    /* Row-major 3 x 3 rotation (orthonormal, determinant +1) taking world directions to the
+     * directions the texture is looked up with: Blender's Mapping node (Point or Vector type)
+     * rotation on the Environment Texture's Vector, Euler XYZ as Blender composes it. */
+    double rotation[9];
+} dwv_environment_t;
+#define DWV_ENVIRONMENT_MAX_SIDE 131072u
+#define DWV_ENVIRONMENT_MAX_TEXELS (1u << 27)
+#define DWV_ENVIRONMENT_INIT                                                                        \
+    {sizeof(dwv_environment_t), 0u, 0u, DWV_ENVIRONMENT_LINEAR, NULL, 1.0,                          \
+     {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0}}
+
+/* Makes the world the environment (replacing a constant world or an earlier environment; a later
+ * dwv_scene_set_world replaces it in turn). Texels that are NaN, infinite or negative are refused
+ * with their place in the message. A 1 x 1 image is accepted: it is a constant world, which is
+ * what Blender renders for it, and is stored as exactly that (dwv_scene_set_world's colour x
+ * strength). Any other size within the limits is accepted too (a 100000 x 1 image is a world that
+ * varies with longitude only); an all-black image or strength 0 is a black world. */
+DWV_API dwv_result_t dwv_scene_set_world_environment(dwv_scene_t *scene, const dwv_environment_t *environment);
+/* ---- end of the world environment ---------------------------------------------------------- */
 
 typedef int32_t dwv_camera_kind_t;
 enum { DWV_CAMERA_PERSPECTIVE = 0, DWV_CAMERA_ORTHOGRAPHIC = 1 };

@@ -277,6 +277,9 @@ class DwivediBakeSettings(bpy.types.PropertyGroup):
                            "that texture filtering does not bleed in the background", default=16, min=0, max=64)
     load_result: BoolProperty(name="Show Result", default=True, description=(
         "Open the camera bake in an Image Editor when it is done, as F12 shows a render"))
+    world_resolution: IntProperty(name="World Resolution", default=1024, min=8, max=16384, description=(
+        "Width of the image Cycles renders the world into when its nodes are not an Environment Texture "
+        "(the height is half): larger keeps small bright lights sharp, and takes longer"))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -1075,6 +1078,7 @@ class DWIVEDI_PT_bake_advanced(_SubPanel, bpy.types.Panel):
         layout.prop(settings, "channel_walks")
         layout.prop(settings, "walk_event_cap")
         layout.prop(settings, "threads")
+        layout.prop(settings, "world_resolution")
 
 
 CLASSES = (DwivediBakePreferences, DwivediBakeSettings, DWIVEDI_OT_bake, DWIVEDI_OT_bake_cancel, DWIVEDI_PT_bake,

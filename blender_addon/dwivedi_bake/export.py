@@ -1,10 +1,11 @@
 """Blender scene -> dwivedi.Scene: the evaluated depsgraph's meshes, materials, lights, world and
 camera in Blender's units, which are dwivedi's (capi/dwivedi.h).
 
-Everything here reads Blender data and calls the shim; nothing changes the .blend. Problems that
-make a bake meaningless raise ExportError (the operator reports it); things dwivedi does not model
-(textures on material inputs, spot lights, camera shift...) are collected as warnings and the bake
-goes on with the nearest supported meaning.
+Everything here reads Blender data and calls the shim; nothing changes the .blend (a world that is
+not an Environment Texture is rendered by Cycles in a scene of its own, made and removed here).
+Problems that make a bake meaningless raise ExportError (the operator reports it); things dwivedi
+does not model (textures on material inputs, camera shift...) are collected as warnings and the
+bake goes on with the nearest supported meaning.
 """
 from __future__ import annotations
 
@@ -336,28 +337,64 @@ def _is_geometry(obj: Any) -> bool:
 # Lights, world, camera
 # ---------------------------------------------------------------------------------------------
 
+def _light_emission(obj: Any, warnings: List[str]) -> Tuple[Tuple[float, float, float], float]:
+    """The factors a light's node tree puts on its colour and power, as Cycles evaluates them
+    (the light's colour x power x its shader's emission): an Emission node into the active Light
+    Output with Color and Strength unlinked gives its colour and strength; no tree (or nodes off)
+    gives 1; an output with nothing linked gives 0 (Cycles' light then emits nothing); anything
+    else is not evaluated (warning: factor 1)."""
+    data = obj.data
+    tree = getattr(data, "node_tree", None)
+    if not getattr(data, "use_nodes", False) or tree is None:
+        return (1.0, 1.0, 1.0), 1.0
+    output = next((n for n in tree.nodes if n.type == 'OUTPUT_LIGHT' and n.is_active_output), None)
+    if output is None:
+        output = next((n for n in tree.nodes if n.type == 'OUTPUT_LIGHT'), None)
+    surface = output.inputs.get("Surface") if output is not None else None
+    if surface is None or not surface.is_linked:
+        return (0.0, 0.0, 0.0), 0.0
+    node = surface.links[0].from_node
+    if node.type == 'EMISSION':
+        color_in, strength_in = node.inputs["Color"], node.inputs["Strength"]
+        if not color_in.is_linked and not strength_in.is_linked:
+            return tuple(color_in.default_value)[:3], float(strength_in.default_value)
+    warnings.append(f"light '{obj.name}': its nodes are not a constant Emission (textures are not evaluated): "
+                    "its colour and power are used")
+    return (1.0, 1.0, 1.0), 1.0
+
+
+def spot_falloff(version: Tuple[int, ...]) -> str:
+    """dwivedi's spot attenuation for a Blender version: 3.x multiplies the smoothstep by the
+    cosine to the axis, 4.0's light rewrite dropped it (dwv_light_desc_t)."""
+    return "cycles3" if tuple(version) < (4, 0, 0) else "cycles4"
+
+
 def _light(obj: Any, matrix: Any, dwivedi: Any, warnings: List[str]) -> Any:
     data = obj.data
-    color = tuple(data.color)
-    if getattr(data, "use_nodes", False):
-        warnings.append(f"light '{obj.name}': light nodes are ignored (its colour and power are used)")
+    node_color, node_strength = _light_emission(obj, warnings)
+    color = tuple(c * f for c, f in zip(tuple(data.color), node_color))
+    energy = data.energy * node_strength
     location, rotation, scale = matrix.decompose()
     rot = rotation.to_matrix()
     if data.type == 'SUN':
         direction = rot @ _vector((0.0, 0.0, -1.0))
-        return dwivedi.SunLight(direction=tuple(direction), strength=data.energy, color=color, angle=data.angle)
-    if data.type in {'POINT', 'SPOT'}:
-        if data.type == 'SPOT':
-            warnings.append(f"light '{obj.name}': a spot light is baked as a point light of the same power "
-                            "(its cone is ignored)")
-        return dwivedi.PointLight(position=tuple(location), power=data.energy, color=color,
-                                  radius=data.shadow_soft_size)
+        return dwivedi.SunLight(direction=tuple(direction), strength=energy, color=color, angle=data.angle)
+    if data.type == 'POINT':
+        return dwivedi.PointLight(position=tuple(location), power=energy, color=color, radius=data.shadow_soft_size)
+    if data.type == 'SPOT':
+        if abs(scale[0] - scale[1]) > 1e-6 * max(abs(scale[0]), abs(scale[1]), 1e-30):
+            warnings.append(f"light '{obj.name}': the spot's cone is round in dwivedi (the object's unequal x and "
+                            "y scale, which makes Cycles 4.x's cone elliptic, is ignored)")
+        direction = rot @ _vector((0.0, 0.0, -1.0))
+        return dwivedi.SpotLight(position=tuple(location), direction=tuple(direction), power=energy, color=color,
+                                 radius=data.shadow_soft_size, spot_size=data.spot_size, spot_blend=data.spot_blend,
+                                 falloff=spot_falloff(bpy.app.version))
     if data.type == 'AREA':
         sx = data.size * abs(scale[0])
         sy = (data.size_y if data.shape in {'RECTANGLE', 'ELLIPSE'} else data.size) * abs(scale[1])
         shape = "disk" if data.shape in {'DISK', 'ELLIPSE'} else "rectangle"
         rigid = _rigid(location, rot)
-        return dwivedi.AreaLight(transform=rigid, size_x=sx, size_y=sy, power=data.energy, color=color, shape=shape)
+        return dwivedi.AreaLight(transform=rigid, size_x=sx, size_y=sy, power=energy, color=color, shape=shape)
     warnings.append(f"light '{obj.name}' of type {data.type} is not supported (left out)")
     return None
 
@@ -371,32 +408,232 @@ def _rigid(location: Any, rot3: Any) -> List[float]:
     return [float(rot3[r][c]) if c < 3 else float(location[r]) for r in range(3) for c in range(4)]
 
 
-def _world(scene: Any, warnings: List[str]) -> Tuple[Tuple[float, float, float], float]:
-    world = scene.world
-    if world is None:
-        return (0.0, 0.0, 0.0), 0.0
-    if not world.use_nodes or world.node_tree is None:
-        return tuple(world.color), 1.0
+class World:
+    """What the world exports as: a constant colour x strength, or an equirectangular map
+    (texels: 3 floats a texel, row 0 at the bottom; rotation: 9 numbers, world -> texture)."""
+
+    def __init__(self, color: Tuple[float, float, float] = (0.0, 0.0, 0.0), strength: float = 0.0) -> None:
+        self.color = tuple(color)
+        self.strength = strength
+        self.texels: Any = None
+        self.width = self.height = 0
+        self.rotation: List[float] = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
+        self.interpolation = "linear"
+
+    def apply(self, dw_scene: Any) -> None:
+        if self.texels is None:
+            dw_scene.set_world(self.color, self.strength)
+        else:
+            dw_scene.set_world_environment(self.texels, self.width, self.height, strength=self.strength,
+                                           rotation=self.rotation, interpolation=self.interpolation)
+
+
+# The Environment Texture node's interpolation as dwivedi's (Cycles treats Smart as Cubic).
+INTERPOLATIONS = {'Linear': "linear", 'Closest': "closest", 'Cubic': "cubic", 'Smart': "cubic"}
+# Image colour spaces whose pixels are scene-linear Rec.709 as Blender hands them over (a float
+# image's pixels are already converted to scene linear on load, whatever its colour space).
+LINEAR_SPACES = {'Linear', 'Linear Rec.709', 'Linear BT.709', 'Linear Rec.709 (sRGB)', 'Non-Color', 'Raw'}
+
+
+def _world_background(world: Any) -> Any:
+    """The Background node that feeds the world's active output, None for an unlinked output
+    (a black world), or the string "none" when there is no Background at all."""
     nodes = world.node_tree.nodes
-    background = None
     for node in nodes:
         if node.type == 'OUTPUT_WORLD' and node.is_active_output:
             surface = node.inputs.get("Surface")
             if surface is not None and surface.is_linked and surface.links[0].from_node.type == 'BACKGROUND':
-                background = surface.links[0].from_node
-            elif surface is not None and not surface.is_linked:
-                return (0.0, 0.0, 0.0), 0.0
+                return surface.links[0].from_node
+            if surface is not None and not surface.is_linked:
+                return None
             break
-    if background is None:
-        background = next((n for n in nodes if n.type == 'BACKGROUND'), None)
-    if background is None:
-        warnings.append("the world has no Background node: baked with a black world")
-        return (0.0, 0.0, 0.0), 0.0
+    background = next((n for n in nodes if n.type == 'BACKGROUND'), None)
+    return "none" if background is None else background
+
+
+def _mapping_rotation(node: Any) -> Optional[List[float]]:
+    """The rotation a Mapping node applies to a direction (world -> texture), row-major, or None
+    where it does more than rotate one (a location on a Point or Texture mapping, an unequal
+    scale, a linked input): such a world is rendered by Cycles instead."""
+    from mathutils import Euler
+    inputs = node.inputs
+    for name in ("Location", "Rotation", "Scale"):
+        socket = inputs.get(name)
+        if socket is not None and socket.is_linked:
+            return None
+    kind = node.vector_type
+    location = inputs.get("Location")
+    if kind in {'POINT', 'TEXTURE'} and location is not None and any(abs(v) > 0.0 for v in location.default_value):
+        return None
+    scale = tuple(inputs["Scale"].default_value)
+    if max(abs(scale[0] - scale[1]), abs(scale[1] - scale[2])) > 1e-6 * max(abs(v) for v in scale) or scale[0] <= 0.0:
+        return None
+    matrix = Euler(tuple(inputs["Rotation"].default_value), 'XYZ').to_matrix()
+    if kind == 'TEXTURE':  # the inverse mapping
+        matrix.transpose()
+    return [float(matrix[r][c]) for r in range(3) for c in range(3)]
+
+
+def _environment_texture(background: Any) -> Optional[Tuple[Any, List[float]]]:
+    """(the Environment Texture node, its rotation) where the Background is exactly that: its
+    Color from an equirectangular Environment Texture's Color, whose Vector is unlinked (the ray
+    direction), the Texture Coordinate's Generated (the same in a world), or a Mapping of either
+    that only rotates; Strength unlinked. Otherwise None."""
     color_in, strength_in = background.inputs["Color"], background.inputs["Strength"]
-    if color_in.is_linked or strength_in.is_linked:
-        warnings.append("the world's Background is linked (an environment texture?): its own colour and "
-                        "strength are used")
-    return tuple(color_in.default_value)[:3], float(strength_in.default_value)
+    if strength_in.is_linked or not color_in.is_linked:
+        return None
+    link = color_in.links[0]
+    node = link.from_node
+    if node.type != 'TEX_ENVIRONMENT' or link.from_socket.name != "Color" or node.projection != 'EQUIRECTANGULAR':
+        return None
+    def is_direction(link: Any) -> bool:  # the ray direction, as an unlinked Vector is
+        return link.from_node.type == 'TEX_COORD' and link.from_socket.name == "Generated"
+
+    rotation = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
+    vector = node.inputs["Vector"]
+    if vector.is_linked:
+        source = vector.links[0]
+        if source.from_node.type == 'MAPPING':
+            rotation = _mapping_rotation(source.from_node)
+            inner = source.from_node.inputs["Vector"]
+            # An unlinked Mapping input is the zero vector, not a direction.
+            if rotation is None or not inner.is_linked or not is_direction(inner.links[0]):
+                return None
+        elif not is_direction(source):
+            return None
+    return node, rotation
+
+
+def _rgb(image: Any, width: int, height: int) -> Any:
+    """An image's pixels without alpha: an array('f') of 3 x width x height, row 0 at the bottom
+    (standard library only: Debian's Blender has no numpy)."""
+    count = width * height
+    rgba = array.array("f", bytes(16 * count))
+    image.pixels.foreach_get(rgba)
+    rgb = array.array("f", bytes(12 * count))
+    for c in range(3):
+        rgb[c::3] = rgba[c::4]
+    return rgb
+
+
+def _srgb_to_linear(rgb: Any) -> Any:
+    """8-bit sRGB values (k / 255) to linear by the sRGB transfer function (IEC 61966-2-1), by a
+    table of the 256 values."""
+    table = [k / 255.0 / 12.92 if k / 255.0 <= 0.04045 else ((k / 255.0 + 0.055) / 1.055) ** 2.4
+             for k in range(256)]
+    return array.array("f", [table[min(255, max(0, int(round(v * 255.0))))] for v in rgb])
+
+
+def _image_texels(image: Any, what: str) -> Optional[Tuple[Any, int, int]]:
+    """An image's RGB texels as scene-linear floats (row 0 at the bottom), its width and height;
+    None where its colour space is neither linear nor sRGB (the world is rendered instead).
+    ExportError where the image has no pixels (a missing file)."""
+    width, height = int(image.size[0]), int(image.size[1])  # reading the size loads the file
+    if width == 0 or height == 0:
+        raise ExportError(f"{what}: image '{image.name}' has no pixels (is its file '{image.filepath}' missing?)")
+    space = image.colorspace_settings.name
+    # A float image in a colour space that is not linear (Blender 5.2 tags an EXR it wrote
+    # through a view transform "sRGB") is decoded by Cycles 5.2 otherwise than Image.pixels holds
+    # it above 1 (a 3000 hot spot lit 12% less in Cycles than from Image.pixels): such a world is
+    # rendered by Cycles instead, as is an 8-bit image in a space other than sRGB or linear.
+    if space not in LINEAR_SPACES and (image.is_float or space != 'sRGB'):
+        return None
+    rgb = _rgb(image, width, height)
+    if not image.is_float and space == 'sRGB':
+        rgb = _srgb_to_linear(rgb)
+    return rgb, width, height
+
+
+def _render_world(scene: Any, world: Any, width: int) -> Tuple[Any, int, int]:
+    """The world as Cycles renders it through an equirectangular panoramic camera at the origin
+    looking along +x (where Cycles' environment camera faces the centre of an environment
+    texture, blender/camera.cpp), width x width/2 pixels, in a scene of its own that is removed
+    afterwards: the texels of dwivedi's equirectangular map."""
+    import os
+    import tempfile
+    height = max(1, width // 2)
+    tmp = bpy.data.scenes.new("dwivedi world bake")
+    camera_data = bpy.data.cameras.new("dwivedi world bake")
+    camera = bpy.data.objects.new("dwivedi world bake", camera_data)
+    folder = tempfile.mkdtemp(prefix="dwivedi-world-")
+    path = os.path.join(folder, "world.exr")
+    image = None
+    try:
+        tmp.world = world
+        tmp.render.engine = 'CYCLES'
+        tmp.cycles.device = 'CPU'
+        tmp.cycles.samples = 16
+        tmp.cycles.use_denoising = False
+        tmp.cycles.use_adaptive_sampling = False
+        tmp.cycles.pixel_filter_type = 'BOX'
+        tmp.cycles.filter_width = 1.0
+        tmp.render.resolution_x, tmp.render.resolution_y = width, height
+        tmp.render.resolution_percentage = 100
+        tmp.render.film_transparent = False
+        tmp.render.image_settings.file_format = 'OPEN_EXR'
+        tmp.render.image_settings.color_depth = '32'
+        tmp.render.filepath = path
+        camera_data.type = 'PANO'
+        if hasattr(camera_data, "panorama_type"):  # Blender 4.x+
+            camera_data.panorama_type = 'EQUIRECTANGULAR'
+        else:
+            camera_data.cycles.panorama_type = 'EQUIRECTANGULAR'
+        camera.rotation_euler = (math.pi / 2.0, 0.0, -math.pi / 2.0)  # local -z to +x, +y up
+        tmp.collection.objects.link(camera)
+        tmp.camera = camera
+        bpy.ops.render.render(write_still=True, scene=tmp.name)
+        image = bpy.data.images.load(path)
+        return _rgb(image, width, height), width, height
+    finally:
+        if image is not None:
+            bpy.data.images.remove(image)
+        bpy.data.scenes.remove(tmp)
+        bpy.data.objects.remove(camera)
+        bpy.data.cameras.remove(camera_data)
+        if os.path.exists(path):
+            os.remove(path)
+        os.rmdir(folder)
+
+
+def world_from_blender(scene: Any, warnings: List[str], render_width: int = 1024) -> World:
+    """The scene's world: a constant Background; an Environment Texture passed as it is (image,
+    Mapping rotation, interpolation, Background strength); any other world tree rendered by
+    Cycles into a render_width x render_width/2 equirectangular image (with a warning)."""
+    world = scene.world
+    if world is None:
+        return World()
+    if not world.use_nodes or world.node_tree is None:
+        return World(tuple(world.color), 1.0)
+    background = _world_background(world)
+    if background is None:
+        return World()
+    if background == "none":
+        warnings.append("the world has no Background node: baked with a black world")
+        return World()
+    color_in, strength_in = background.inputs["Color"], background.inputs["Strength"]
+    if not color_in.is_linked and not strength_in.is_linked:
+        return World(tuple(color_in.default_value)[:3], float(strength_in.default_value))
+    out = World((1.0, 1.0, 1.0), 1.0)
+    found = _environment_texture(background)
+    if found is not None and found[0].image is not None:
+        node, rotation = found
+        texels = _image_texels(node.image, "the world's Environment Texture")
+        if texels is not None:
+            out.texels, out.width, out.height = texels
+            out.strength = float(strength_in.default_value)
+            out.rotation = rotation
+            out.interpolation = INTERPOLATIONS.get(node.interpolation, "linear")
+            return out
+    if found is not None and found[0].image is None:
+        warnings.append("the world's Environment Texture has no image: Cycles renders it black (so does dwivedi)")
+        return World()
+    out.texels, out.width, out.height = _render_world(scene, world, render_width)
+    what = (f"the world's image '{found[0].image.name}' is in colour space "
+            f"'{found[0].image.colorspace_settings.name}'") if found is not None else \
+        "the world's nodes are not an Environment Texture dwivedi reads as it is"
+    warnings.append(f"{what}: Cycles rendered the world into a {out.width} x {out.height} equirectangular image, "
+                    "which is baked (World Resolution sets its width)")
+    return out
 
 
 def render_size(scene: Any) -> Tuple[int, int]:
@@ -537,8 +774,7 @@ def export_scene(context: Any, settings: Any, dwivedi: Any) -> Exported:
             raise ExportError("the scene has no visible mesh objects to bake")
         if target == 'UV' and not uv_found:
             raise ExportError(f"'{uv_object.name}' is not rendered in this view layer (hidden or excluded)")
-        color, strength = _world(scene, warnings)
-        dw_scene.set_world(color, strength)
+        world_from_blender(scene, warnings, getattr(settings, "world_resolution", 1024)).apply(dw_scene)
         if target == 'CAMERA':
             dw_scene.set_camera(camera_from_blender(scene, out.width, out.height, dwivedi, warnings))
         elif scene.camera is not None and scene.camera.type == 'CAMERA' and scene.camera.data.type in {'PERSP', 'ORTHO'}:

@@ -42,7 +42,7 @@ from typing import NamedTuple, Tuple
 from . import _library
 from ._library import ABI_VERSION, LIBRARY_FUNCTIONS, Error, library_path, loaded_library_path, use_library
 from .baker import (AreaLight, Bake, BakeSettings, BakeStats, Camera, Cancelled, DisplaySettings, ErrorPoint, Image, merge_partials,
-                    Material, PointLight, Progress, Scene, SunLight, bake, feature_names, start_bake, techniques)
+                    Material, PointLight, Progress, Scene, SpotLight, SunLight, bake, feature_names, start_bake, techniques)
 
 __all__ = [
     "merge_partials",
@@ -58,6 +58,7 @@ __all__ = [
     "SunLight",
     "PointLight",
     "AreaLight",
+    "SpotLight",
     "Camera",
     "BakeSettings",
     "Bake",

@@ -181,6 +181,24 @@ class LightDesc(_SizedStructure):
         ("transform", _Transform),
         ("size_x", ctypes.c_double),
         ("size_y", ctypes.c_double),
+        ("spot_size", ctypes.c_double),
+        ("spot_blend", ctypes.c_double),
+        ("spot_falloff", ctypes.c_int32),
+        ("reserved", ctypes.c_uint32),
+    ]
+
+
+class EnvironmentDesc(_SizedStructure):
+    """dwv_environment_t."""
+
+    _fields_ = [
+        ("struct_size", ctypes.c_uint32),
+        ("width", ctypes.c_uint32),
+        ("height", ctypes.c_uint32),
+        ("interpolation", ctypes.c_int32),
+        ("texels", ctypes.c_void_p),
+        ("strength", ctypes.c_double),
+        ("rotation", ctypes.c_double * 9),
     ]
 
 
@@ -354,6 +372,7 @@ _BAKER_PROTOTYPES: Dict[str, Tuple[object, Sequence[object]]] = {
     "dwv_scene_add_mesh": (_result_t, (_handle_p, _p(Mesh), _p(ctypes.c_uint32))),
     "dwv_scene_add_light": (_result_t, (_handle_p, _p(LightDesc))),
     "dwv_scene_set_world": (_result_t, (_handle_p, _p(ctypes.c_double), ctypes.c_double)),
+    "dwv_scene_set_world_environment": (_result_t, (_handle_p, _p(EnvironmentDesc))),
     "dwv_scene_set_camera": (_result_t, (_handle_p, _p(CameraDesc))),
     "dwv_scene_commit": (_result_t, (_handle_p,)),
     "dwv_bake_start": (_result_t, (_handle_p, _p(BakeOptions), _handle_pp)),

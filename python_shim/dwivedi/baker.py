@@ -38,7 +38,7 @@ Vector = Tuple[float, float, float]
 PathLike = Union[str, "os.PathLike[str]"]
 
 __all__ = [
-    "Cancelled", "Material", "SunLight", "PointLight", "AreaLight", "Camera", "Scene", "BakeSettings",
+    "Cancelled", "Material", "SunLight", "PointLight", "AreaLight", "SpotLight", "Camera", "Scene", "BakeSettings",
     "Progress", "Bake", "bake", "start_bake", "Image", "BakeStats", "ErrorPoint", "DisplaySettings",
     "techniques", "feature_names",
 ]
@@ -287,19 +287,49 @@ class AreaLight:
         return out
 
 
+@dataclass
+class SpotLight:
+    """A spot light as Blender's: a point (sphere of `radius`) light of `power` watts within a cone
+    about `direction` (the way its axis points, Blender's local -z), of full angle `spot_size`
+    (radians, Blender's Spot Size) with a soft edge of `spot_blend` (0 to 1). `falloff` is the
+    attenuation's form: "cycles3" (Blender 3.x: the axis cosine x a smoothstep) or "cycles4"
+    (Blender 4.0 onward: the smoothstep alone); dwv_light_desc_t gives the formula."""
+
+    position: Vector = (0.0, 0.0, 0.0)
+    direction: Vector = (0.0, 0.0, -1.0)
+    power: float = 100.0
+    color: Color = (1.0, 1.0, 1.0)
+    radius: float = 0.0
+    spot_size: float = math.pi / 4.0
+    spot_blend: float = 0.15
+    falloff: str = "cycles3"
+
+    def _to_c(self) -> _library.LightDesc:
+        out = _light_base(4, self.color, _real("power", self.power))
+        out.position[:] = real_tuple(self.position, "position", 3)
+        out.direction[:] = real_tuple(self.direction, "direction", 3)
+        out.radius = _real("radius", self.radius)
+        out.spot_size = _real("spot_size", self.spot_size)
+        out.spot_blend = _real("spot_blend", self.spot_blend)
+        out.spot_falloff = _name_code("spot falloff", self.falloff, {"cycles3": 0, "cycles4": 1})
+        return out
+
+
 def _light_base(kind: int, color: Color, strength: float) -> _library.LightDesc:
     out = _library.LightDesc()
     # DWV_LIGHT_DESC_INIT's defaults for the fields another kind leaves alone.
     out.direction[:] = (0.0, 0.0, -1.0)
     out.transform[:] = transform12(None)
     out.size_x = out.size_y = 1.0
+    out.spot_size = math.pi / 4.0
+    out.spot_blend = 0.15
     out.kind = kind
     out.color[:] = real_tuple(color, "color", 3)
     out.strength = strength
     return out
 
 
-Light = Union[SunLight, PointLight, AreaLight]
+Light = Union[SunLight, PointLight, AreaLight, SpotLight]
 
 
 @dataclass
@@ -580,9 +610,9 @@ class Scene:
         return out.value
 
     def add_light(self, light: Light) -> None:
-        """Adds a SunLight, PointLight or AreaLight."""
-        if not isinstance(light, (SunLight, PointLight, AreaLight)):
-            raise TypeError(f"light must be a SunLight, PointLight or AreaLight, not {type(light).__name__}")
+        """Adds a SunLight, PointLight, AreaLight or SpotLight."""
+        if not isinstance(light, (SunLight, PointLight, AreaLight, SpotLight)):
+            raise TypeError(f"light must be a SunLight, PointLight, AreaLight or SpotLight, not {type(light).__name__}")
         c = light._to_c()
         _call("dwv_scene_add_light", self.handle, ctypes.byref(c))
 
@@ -590,6 +620,31 @@ class Scene:
         """A constant world: radiance color x strength from every direction."""
         c = (ctypes.c_double * 3)(*real_tuple(color, "color", 3))
         _call("dwv_scene_set_world", self.handle, c, _real("strength", strength))
+
+    def set_world_environment(self, texels: Any, width: int, height: int, *, strength: float = 1.0,
+                              rotation: Any = None, interpolation: str = "linear") -> None:
+        """An equirectangular image world, Blender's Environment Texture into a Background node
+        (dwv_scene_set_world_environment): texels are 3 floats (linear RGB) per texel, width x
+        height of them, row 0 at the bottom (Blender's Image.pixels order without alpha; any
+        buffer or sequence, a float32 C-contiguous buffer is passed without a copy); strength is
+        the Background's; rotation a 3 x 3 rotation (nested or 9 numbers, row-major) taking world
+        directions to the texture's (a Mapping node's), None for none; interpolation "linear",
+        "closest" or "cubic". A 1 x 1 image is the constant world of that colour."""
+        t = as_c_array(texels, "f", "texels", 3)
+        c = _library.EnvironmentDesc()
+        c.width = _uint("width", width)
+        c.height = _uint("height", height)
+        if t.count != 3 * c.width * c.height:
+            raise Error(f"texels hold {t.count} numbers: a {c.width} x {c.height} image needs {3 * c.width * c.height}",
+                        _library.DWV_ERROR_INVALID_ARGUMENT)
+        c.texels = t.address or None
+        c.strength = _real("strength", strength)
+        c.interpolation = _name_code("interpolation", interpolation, {"linear": 0, "closest": 1, "cubic": 2})
+        values = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0] if rotation is None else list(rotation)
+        if len(values) == 3:  # rows
+            values = [x for row in values for x in row]
+        c.rotation[:] = real_tuple(values, "rotation", 9)
+        _call("dwv_scene_set_world_environment", self.handle, ctypes.byref(c))
 
     def set_camera(self, camera: Camera) -> None:
         if not isinstance(camera, Camera):

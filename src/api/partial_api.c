@@ -112,8 +112,23 @@ uint64_t dwv_scene_hash(const dwvb_scene *s)
         fnv_add(&f, l->transform, sizeof l->transform);
         ADD(&f, l->size_x);
         ADD(&f, l->size_y);
+        if (l->kind == DWV_LIGHT_SPOT) { /* the fields after size_y, for spot lights only: other
+                                            scenes hash as before issue 18 */
+            ADD(&f, l->spot_size);
+            ADD(&f, l->spot_blend);
+            ADD(&f, l->spot_falloff);
+        }
     }
     fnv_add(&f, s->world, sizeof s->world);
+    if (s->envmap) {
+        const dwvl_envmap *e = s->envmap;
+        ADD(&f, e->width);
+        ADD(&f, e->height);
+        ADD(&f, e->interpolation);
+        ADD(&f, e->strength);
+        fnv_add(&f, e->rotation, sizeof e->rotation);
+        fnv_add(&f, e->texels, 3u * (size_t)e->width * e->height * sizeof(float));
+    }
     ADD(&f, s->have_camera);
     if (s->have_camera) {
         ADD(&f, s->camera.kind);

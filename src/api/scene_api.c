@@ -3,6 +3,7 @@
 #include <math.h>
 #include <stddef.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "bake/scene.h"
@@ -221,12 +222,19 @@ dwv_result_t dwv_scene_add_mesh(dwv_scene_t *scene, const dwv_mesh_t *mesh_in, u
     return DWV_SUCCESS;
 }
 
-dwv_result_t dwv_scene_add_light(dwv_scene_t *scene, const dwv_light_desc_t *light)
+dwv_result_t dwv_scene_add_light(dwv_scene_t *scene, const dwv_light_desc_t *light_in)
 {
     static const char fn[] = "dwv_scene_add_light";
     dwvb_scene *s;
     DWV_TRY(open_scene(fn, scene, &s));
-    DWV_TRY(dwv_check_struct(fn, "light", light, (uint32_t)sizeof(dwv_light_desc_t)));
+    /* The struct before issue 18 ended at size_y: such callers keep working, with the spot
+     * fields' defaults. Only the caller's struct_size bytes are read. */
+    DWV_TRY(dwv_check_struct(fn, "light", light_in, (uint32_t)offsetof(dwv_light_desc_t, spot_size)));
+    dwv_light_desc_t resolved = DWV_LIGHT_DESC_INIT;
+    size_t given = light_in->struct_size < sizeof resolved ? light_in->struct_size : sizeof resolved;
+    memcpy(&resolved, light_in, given);
+    resolved.struct_size = (uint32_t)sizeof resolved;
+    const dwv_light_desc_t *light = &resolved;
     DWV_TRY(check_array(fn, "color", light->color, 3, 0.0, HUGE_VAL));
     DWV_TRY(dwv_check_range(fn, "strength", light->strength, 0.0, HUGE_VAL));
     switch (light->kind) {
@@ -243,6 +251,24 @@ dwv_result_t dwv_scene_add_light(dwv_scene_t *scene, const dwv_light_desc_t *lig
         DWV_TRY(check_array(fn, "position", light->position, 3, -HUGE_VAL, HUGE_VAL));
         DWV_TRY(dwv_check_range(fn, "radius", light->radius, 0.0, HUGE_VAL));
         break;
+    case DWV_LIGHT_SPOT: {
+        DWV_TRY(check_array(fn, "position", light->position, 3, -HUGE_VAL, HUGE_VAL));
+        DWV_TRY(dwv_check_range(fn, "radius", light->radius, 0.0, HUGE_VAL));
+        DWV_TRY(check_array(fn, "direction", light->direction, 3, -HUGE_VAL, HUGE_VAL));
+        const double *d = light->direction;
+        double length = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        if (!(length > 0.0) || !isfinite(length))
+            return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: the spot light's direction has length %.6g", fn, length);
+        DWV_TRY(dwv_check_range(fn, "spot_size", light->spot_size, 0.0, 3.14159265358979323846));
+        if (!(light->spot_size > 0.0))
+            return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: spot_size (the cone's full angle) must be > 0", fn);
+        DWV_TRY(dwv_check_range(fn, "spot_blend", light->spot_blend, 0.0, 1.0));
+        if (light->spot_falloff != DWV_SPOT_FALLOFF_CYCLES3 && light->spot_falloff != DWV_SPOT_FALLOFF_CYCLES4)
+            return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
+                            "%s: spot_falloff %d is neither Cycles 3.x (0) nor Cycles 4.0 onward (1)", fn,
+                            (int)light->spot_falloff);
+        break;
+    }
     case DWV_LIGHT_AREA_RECTANGLE:
     case DWV_LIGHT_AREA_DISK:
         DWV_TRY(check_transform(fn, "transform", light->transform));
@@ -254,13 +280,13 @@ dwv_result_t dwv_scene_add_light(dwv_scene_t *scene, const dwv_light_desc_t *lig
                             light->size_x, light->size_y);
         break;
     default:
-        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: light kind %d is not sun (0), point (1), rectangle (2) or disk (3)",
-                        fn, (int)light->kind);
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
+                        "%s: light kind %d is not sun (0), point (1), rectangle (2), disk (3) or spot (4)", fn,
+                        (int)light->kind);
     }
     if (s->light_count >= DWVB_MAX_LIGHTS)
         return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: a scene holds at most %u lights", fn, DWVB_MAX_LIGHTS);
     if (dwvb_scene_push_light(s, light)) return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "%s: out of memory", fn);
-    s->lights[s->light_count - 1u].struct_size = (uint32_t)sizeof(dwv_light_desc_t);
     return DWV_SUCCESS;
 }
 
@@ -279,6 +305,80 @@ dwv_result_t dwv_scene_set_world(dwv_scene_t *scene, const double color[3], doub
             return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: color[%d] x strength overflows", fn, c);
     }
     memcpy(s->world, world, sizeof world);
+    dwvb_scene_set_envmap(s, NULL);
+    return DWV_SUCCESS;
+}
+
+dwv_result_t dwv_scene_set_world_environment(dwv_scene_t *scene, const dwv_environment_t *environment)
+{
+    static const char fn[] = "dwv_scene_set_world_environment";
+    dwvb_scene *s;
+    DWV_TRY(open_scene(fn, scene, &s));
+    DWV_TRY(dwv_check_struct(fn, "environment", environment, (uint32_t)sizeof(dwv_environment_t)));
+    const dwv_environment_t *e = environment;
+    uint32_t w = e->width, h = e->height;
+    if (w < 1u || h < 1u || w > DWV_ENVIRONMENT_MAX_SIDE || h > DWV_ENVIRONMENT_MAX_SIDE ||
+        (uint64_t)w * h > DWV_ENVIRONMENT_MAX_TEXELS)
+        return dwv_fail(DWV_ERROR_OUT_OF_RANGE,
+                        "%s: the image is %u x %u; each side must be 1 to %u and the texels at most %u", fn, w, h,
+                        DWV_ENVIRONMENT_MAX_SIDE, DWV_ENVIRONMENT_MAX_TEXELS);
+    DWV_TRY(dwv_check_pointer(fn, "environment->texels", e->texels));
+    if (e->interpolation != DWV_ENVIRONMENT_LINEAR && e->interpolation != DWV_ENVIRONMENT_CLOSEST &&
+        e->interpolation != DWV_ENVIRONMENT_CUBIC)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
+                        "%s: interpolation %d is not linear (0), closest (1) or cubic (2)", fn, (int)e->interpolation);
+    DWV_TRY(dwv_check_range(fn, "strength", e->strength, 0.0, HUGE_VAL));
+    DWV_TRY(check_array(fn, "rotation", e->rotation, 9, -HUGE_VAL, HUGE_VAL));
+    const double *m = e->rotation;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+            double dot = m[3 * i] * m[3 * j] + m[3 * i + 1] * m[3 * j + 1] + m[3 * i + 2] * m[3 * j + 2];
+            if (fabs(dot - (i == j ? 1.0 : 0.0)) > 1e-4)
+                return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
+                                "%s: rotation is not a rotation (rows %d and %d have dot product %.6g)", fn, i, j, dot);
+        }
+    double det = m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) + m[2] * (m[3] * m[7] - m[4] * m[6]);
+    if (!(det > 0.0))
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: rotation mirrors (determinant %.6g; a rotation has +1)", fn, det);
+    size_t n = (size_t)w * h;
+    double largest = 0.0;
+    for (size_t i = 0; i < 3u * n; ++i) {
+        float t = e->texels[i];
+        if (!isfinite(t) || t < 0.0f) {
+            size_t texel = i / 3u;
+            return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
+                            "%s: texel (%zu, %zu) (column, row from the bottom) has %s = %g: texels must be finite "
+                            "and >= 0", fn, texel % w, texel / w, i % 3u == 0 ? "red" : i % 3u == 1 ? "green" : "blue",
+                            (double)t);
+        }
+        largest = fmax(largest, (double)t);
+    }
+    if (!isfinite(largest * e->strength))
+        return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: a texel x strength overflows", fn);
+    /* A 1 x 1 image is a constant world, as Blender renders it (the periodic lookup reads that
+     * one texel for every direction): it is stored as one, exactly what dwv_scene_set_world
+     * gives. Refusing it would refuse a world that Blender accepts and renders; a black image or
+     * strength 0 is a black world for the same reason. */
+    double constant[3] = {0.0, 0.0, 0.0};
+    if (n == 1u || largest == 0.0 || e->strength == 0.0) {
+        if (n == 1u)
+            for (int c = 0; c < 3; ++c) constant[c] = (double)e->texels[c] * e->strength;
+        memcpy(s->world, constant, sizeof constant);
+        dwvb_scene_set_envmap(s, NULL);
+        return DWV_SUCCESS;
+    }
+    dwvl_envmap *map = malloc(sizeof *map);
+    int made = map ? dwvl_envmap_init(map, e) : -1;
+    if (made < 0) {
+        free(map);
+        return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "%s: no memory for a %u x %u environment", fn, w, h);
+    }
+    memcpy(s->world, constant, sizeof constant);
+    if (made > 0) {
+        free(map); /* no luminance above 0 in single precision: black */
+        map = NULL;
+    }
+    dwvb_scene_set_envmap(s, map);
     return DWV_SUCCESS;
 }
 

@@ -57,7 +57,8 @@ void dwvb_bake_sample(const dwvb_bake *bake, const dwvb_shader *shader, uint64_t
         dwvu_vec3 origin;
         camera_sample(bake, x, row, &sampler, &origin, &view);
         if (!(bake->scene->mesh_count > 0 && dwvg_intersect(&bake->scene->geometry, origin, view, 0.0, INFINITY, &hit))) {
-            for (int c = 0; c < 3; ++c) rgb[c] = bake->scene->world[c];
+            if (bake->scene->envmap) dwvl_envmap_radiance(bake->scene->envmap, view, rgb);
+            else for (int c = 0; c < 3; ++c) rgb[c] = bake->scene->world[c];
             *alpha = 0.0;
             return;
         }
@@ -380,6 +381,7 @@ dwv_result_t dwvb_bake_start(dwvb_scene *scene, const dwv_bake_options_t *option
     for (int c = 0; c < 3; ++c) bake->shader.env.world[c] = scene->world[c];
     bake->shader.env.world_lit = dwvb_scene_world_lit(scene);
     bake->shader.env.geometry = scene->mesh_count ? &scene->geometry : NULL;
+    bake->shader.env.envmap = scene->envmap;
     bake->shader.guides = bake->guides;
     bake->shader.channel_guides = bake->channel_guides;
     bake->shader.channel_walks = bake->channel_walks;

@@ -32,7 +32,17 @@ void dwvb_scene_free(dwvb_scene *scene)
     free(scene->terminator_offsets);
     free(scene->materials);
     free(scene->lights);
+    dwvb_scene_set_envmap(scene, NULL);
     free(scene);
+}
+
+void dwvb_scene_set_envmap(dwvb_scene *scene, dwvl_envmap *envmap)
+{
+    if (scene->envmap) {
+        dwvl_envmap_free(scene->envmap);
+        free(scene->envmap);
+    }
+    scene->envmap = envmap;
 }
 
 /* The array `items` of `size`-byte elements with room for one more (moved if it had to grow), or
@@ -80,7 +90,7 @@ int dwvb_scene_push_light(dwvb_scene *scene, const dwv_light_desc_t *light)
 
 int dwvb_scene_world_lit(const dwvb_scene *scene)
 {
-    return scene->world[0] > 0.0 || scene->world[1] > 0.0 || scene->world[2] > 0.0;
+    return scene->envmap || scene->world[0] > 0.0 || scene->world[1] > 0.0 || scene->world[2] > 0.0;
 }
 
 /* Surface points per subsurface mesh whose irradiance makes its lit patches. */
@@ -200,7 +210,7 @@ dwv_result_t dwvb_scene_commit(dwvb_scene *scene, char *message, size_t size)
         for (int c = 0; c < 3; ++c) lights_lit |= scene->emitters[i].emission[c] > 0.0;
     if (lights_lit) features |= DWV_FEATURE_DIRECT_LIGHTS;
     dwvl_environment env = {.lights = scene->emitters, .light_count = nl, .world_lit = world_lit,
-                            .geometry = nmesh > 0 ? &scene->geometry : NULL};
+                            .geometry = nmesh > 0 ? &scene->geometry : NULL, .envmap = scene->envmap};
     for (int c = 0; c < 3; ++c) env.world[c] = scene->world[c];
     uint64_t grid_cells = 0; /* of the clearance grids made so far */
     for (uint32_t m = 0; m < nmesh; ++m) {

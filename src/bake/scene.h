@@ -11,6 +11,7 @@
 #include <dwivedi.h>
 #include "geom/embree.h"
 #include "geom/mesh.h"
+#include "light/envmap.h"
 #include "light/light.h"
 #include "walk/walk.h"
 
@@ -35,7 +36,8 @@ typedef struct dwvb_scene {
     uint32_t terminator_capacity;
     dwv_light_desc_t *lights;
     uint32_t light_count, light_capacity;
-    double world[3];     /* constant world radiance: colour x strength */
+    double world[3];     /* constant world radiance: colour x strength (0 with an envmap) */
+    dwvl_envmap *envmap; /* the world's environment map, or NULL (dwv_scene_set_world_environment) */
     int have_camera;
     dwv_camera_t camera; /* validated; rotation columns orthonormal */
 
@@ -62,7 +64,10 @@ int dwvb_scene_push_light(dwvb_scene *scene, const dwv_light_desc_t *light);
  * returns the code with a message in `message` and leaves the scene uncommitted. */
 dwv_result_t dwvb_scene_commit(dwvb_scene *scene, char *message, size_t size);
 
-/* Whether the world (constant environment) gives light. */
+/* Replaces the world by an environment map (taken over; NULL: the constant `world`). */
+void dwvb_scene_set_envmap(dwvb_scene *scene, dwvl_envmap *envmap);
+
+/* Whether the world (constant or environment map) gives light. */
 int dwvb_scene_world_lit(const dwvb_scene *scene);
 
 #endif

@@ -59,6 +59,58 @@ static int shadow_ray_allowed(const shadow_origins *o, dwvu_vec3 light)
     return dwvu_dot(o->ng, light) > 0.0 || (o->terminator && o->terminator->cutoff > 0.0);
 }
 
+/* Whether the world is seen from the shading point along unit w (a shadow ray to infinity). */
+static int world_visible(const dwvl_environment *env, shadow_origins *origins, dwvu_vec3 w)
+{
+    if (!shadow_ray_allowed(origins, w)) return 0;
+    if (!env->geometry) return 1;
+    dwvu_vec3 origin = shadow_origin(origins, lift_amount(origins, w));
+    return clear_of(origins, origin, w) || !dwvg_occluded(env->geometry, origin, w, 0.0, INFINITY);
+}
+
+/* An environment map's share of direct_core: two strategies, the cosine-weighted direction about
+ * n (pdf p_c = cos / pi, pair `pair`) and the map's own (pdf p_e, pair `pair` + 1), each weighted
+ * by the balance heuristic p_s / (p_c + p_e). With L the map's radiance and f the lobe's factor,
+ * the estimator of (1/pi) integral L f cos is, per strategy,
+ *   cosine:  L f (cos/pi) / p_c x p_c / (p_c + p_e) = L f (cos/pi) / (p_c + p_e),
+ *   map:     L f (cos/pi) / p_e x p_e / (p_c + p_e) = the same expression at its direction,
+ * so both add L f (cos/pi) / (p_c + p_e) where the direction is above n and unshadowed. */
+static void envmap_light(const dwvl_environment *env, shadow_origins *origins, dwvu_vec3 n, const dwvk_sampler *sampler,
+                         uint32_t pair, dwvl_lobe_factor factor, dwvl_rgb_factor rgb, const void *context, double plain[3],
+                         double weighted[3])
+{
+    for (int strategy = 0; strategy < 2; ++strategy) {
+        double u[2];
+        dwvk_sampler_pair(sampler, pair + (uint32_t)strategy, u);
+        dwvu_vec3 w;
+        double p_e, cos_n;
+        if (strategy == 0) {
+            cos_n = sqrt(u[0]);
+            w = dwvk_direction_about(n, cos_n, 1.0 - cos_n, 1.0 + cos_n, u[1]);
+            p_e = dwvl_envmap_pdf(env->envmap, w);
+        } else {
+            dwvl_envmap_sample(env->envmap, u[0], u[1], &w, &p_e);
+            if (!(p_e > 0.0)) continue;
+            cos_n = dwvu_dot(n, w);
+        }
+        if (!(cos_n > 0.0)) continue;
+        double p_c = cos_n * INV_PI;
+        if (!(p_c + p_e > 0.0) || !isfinite(p_e)) continue;
+        double radiance[3];
+        dwvl_envmap_radiance(env->envmap, w, radiance);
+        if (!(radiance[0] > 0.0 || radiance[1] > 0.0 || radiance[2] > 0.0)) continue;
+        if (!world_visible(env, origins, w)) continue;
+        double scale = p_c / (p_c + p_e);
+        double f[3] = {0.0, 0.0, 0.0};
+        if (rgb) rgb(context, w, f);
+        else if (factor) f[0] = f[1] = f[2] = factor(context, w);
+        for (int c = 0; c < 3; ++c) {
+            plain[c] += radiance[c] * scale;
+            weighted[c] += radiance[c] * scale * f[c];
+        }
+    }
+}
+
 /* The estimator of dwvl_direct_lobe and dwvl_direct_rgb: a scalar factor (the same in every
  * channel) or a per-channel one (rgb, when not NULL). */
 static void direct_core(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, dwvu_vec3 ng,
@@ -110,7 +162,9 @@ static void direct_core(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, d
             weighted[c] += s.value[c] * cos_n * INV_PI * f[c];
         }
     }
-    if (env->world_lit) {
+    if (env->world_lit && env->envmap) {
+        envmap_light(env, &origins, n, sampler, pair + env->light_count, factor, rgb, context, plain, weighted);
+    } else if (env->world_lit) {
         /* Cosine-weighted direction about n (pdf cos / pi): the estimate is L_world x visibility
          * (x the factor for the lobe). */
         double u[2];

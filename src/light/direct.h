@@ -1,5 +1,7 @@
 /* Next-event estimation: the radiance a white Lambertian surface reflects at a point, from every
- * light (one shadow-tested sample each) and the constant world (one cosine-weighted shadow ray). */
+ * light (one shadow-tested sample each) and the world: a constant world by one cosine-weighted
+ * shadow ray; an environment map by that ray and one drawn from the map's own distribution,
+ * weighted by multiple importance sampling (balance heuristic, Veach 1997 Eq. 9.10). */
 #ifndef DWV_LIGHT_DIRECT_H
 #define DWV_LIGHT_DIRECT_H
 
@@ -7,21 +9,24 @@
 
 #include "geom/embree.h"
 #include "kernel/sampler.h"
+#include "envmap.h"
 #include "light.h"
 #include "terminator.h"
 
 typedef struct dwvl_environment {
     const dwvl_light *lights;
     uint32_t light_count;
-    double world[3];          /* constant world radiance */
+    double world[3];          /* constant world radiance (unused with an envmap) */
     int world_lit;            /* 0: the world is black and is not sampled */
     const dwvg_world *geometry;
+    const dwvl_envmap *envmap; /* NULL: the world is the constant `world` */
 } dwvl_environment;
 
-/* Pairs of random dimensions one call uses: one per light and one for the world. */
+/* Pairs of random dimensions one call uses: one per light and one for the world (the cosine
+ * ray), and one more for an environment map's own sample. */
 static inline uint32_t dwvl_direct_pairs(const dwvl_environment *env)
 {
-    return env->light_count + 1u;
+    return env->light_count + 1u + (env->envmap ? 1u : 0u);
 }
 
 /* (1/pi) integral of L_in cos over the hemisphere of the shading normal `n` at x, estimated with

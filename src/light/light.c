@@ -25,7 +25,9 @@ void dwvl_light_init(dwvl_light *light, const dwv_light_desc_t *desc)
     light->area = 0.0;
     light->one_minus_cos_half = 0.0;
     light->chord = 0.0;
-    light->position = light->direction = light->axis_x = light->axis_y = dwvu_v(0.0, 0.0, 0.0);
+    light->position = light->direction = light->axis_x = light->axis_y = light->spot_axis = dwvu_v(0.0, 0.0, 0.0);
+    light->spot_cos_half = light->spot_smooth = 0.0;
+    light->spot_axis_cosine = 0;
     for (int c = 0; c < 3; ++c) light->emission[c] = desc->color[c] * desc->strength;
     switch (desc->kind) {
     case DWV_LIGHT_SUN: {
@@ -37,7 +39,15 @@ void dwvl_light_init(dwvl_light *light, const dwv_light_desc_t *desc)
         light->chord = sqrt(2.0 * light->one_minus_cos_half);
         break;
     }
+    case DWV_LIGHT_SPOT: /* a point light with a cone */
     case DWV_LIGHT_POINT:
+        if (desc->kind == DWV_LIGHT_SPOT) {
+            dwvu_vec3 d = dwvu_v(desc->direction[0], desc->direction[1], desc->direction[2]);
+            light->spot_axis = dwvu_scale(d, 1.0 / dwvu_length(d));
+            light->spot_cos_half = cos(0.5 * desc->spot_size);
+            light->spot_smooth = (1.0 - light->spot_cos_half) * desc->spot_blend;
+            light->spot_axis_cosine = desc->spot_falloff == DWV_SPOT_FALLOFF_CYCLES3;
+        }
         light->position = dwvu_v(desc->position[0], desc->position[1], desc->position[2]);
         light->radius = desc->radius;
         for (int c = 0; c < 3; ++c) light->emission[c] *= INV_FOUR_PI;
@@ -57,6 +67,18 @@ void dwvl_light_init(dwvl_light *light, const dwv_light_desc_t *desc)
     }
 }
 
+double dwvl_spot_attenuation(const dwvl_light *light, double c)
+{
+    if (!(c > light->spot_cos_half)) return 0.0;
+    double a = light->spot_axis_cosine ? c : 1.0;
+    double t = c - light->spot_cos_half;
+    if (light->spot_smooth > 0.0 && t < light->spot_smooth) {
+        double s = t / light->spot_smooth;
+        a *= s * s * (3.0 - 2.0 * s);
+    }
+    return a;
+}
+
 void dwvl_light_sample(const dwvl_light *light, dwvu_vec3 x, double u1, double u2, dwvl_sample *sample)
 {
     double factor = 0.0;
@@ -70,9 +92,11 @@ void dwvl_light_sample(const dwvl_light *light, dwvu_vec3 x, double u1, double u
         factor = 2.0 / (2.0 - light->one_minus_cos_half);
         break;
     }
+    case DWV_LIGHT_SPOT:
     case DWV_LIGHT_POINT: {
         /* A disc of radius r about the centre, facing x, radiance I / (pi r^2): a uniform point q
-         * on it gives radiance / pdf = I cos_q / |q - x|^2 (r = 0: the point light I / d^2). */
+         * on it gives radiance / pdf = I cos_q / |q - x|^2 (r = 0: the point light I / d^2). A
+         * spot's radiance along the sampled direction carries its attenuation, as Cycles'. */
         dwvu_vec3 to_centre = dwvu_sub(light->position, x);
         double d = dwvu_length(to_centre);
         if (!(d > 0.0)) break;
@@ -89,6 +113,7 @@ void dwvl_light_sample(const dwvl_light *light, dwvu_vec3 x, double u1, double u
         sample->direction = dwvu_scale(to_q, 1.0 / dq);
         sample->distance = dq;
         factor = dwvu_dot(sample->direction, axis) / (dq * dq);
+        if (light->kind == DWV_LIGHT_SPOT) factor *= dwvl_spot_attenuation(light, -dwvu_dot(light->spot_axis, sample->direction));
         break;
     }
     default: {

@@ -7,6 +7,11 @@
  *   sun, strength S (W/m^2): irradiance S c on a surface facing it, from a cone of the angular
  *       diameter with constant radiance S c / (pi sin^2(angle/2)) (Cycles' own disc sampling
  *       gives S cos^2(angle/2) instead, which differs by less than 0.01% below 1 degree);
+ *   spot, power P: the point light's radiance times the spot attenuation a(w) of the direction w
+ *       from the light toward the shaded point (Cycles' spot_light_attenuation, with
+ *       spot_angle = cos(spot_size / 2) and spot_smooth = (1 - spot_angle) x spot_blend as
+ *       scene/light.cpp sets them): c = axis.w; 0 for c <= spot_angle; else c (Cycles 3.x) or 1
+ *       (4.0 onward), times smoothstep((c - spot_angle) / spot_smooth) where that is below 1;
  *   world: constant radiance colour x strength.
  * A sample returns the direction toward the light, the distance, and the radiance divided by the
  * solid-angle pdf: for a Lambertian surface of albedo rho, rho/pi x value x cos x visibility
@@ -28,7 +33,15 @@ typedef struct dwvl_light {
     double radius;             /* point */
     dwvu_vec3 axis_x, axis_y;  /* area: full extents in the world (size x the transform's axes) */
     double area;               /* area: of the rectangle or ellipse */
+    dwvu_vec3 spot_axis;       /* spot: unit, the way the cone opens */
+    double spot_cos_half;      /* spot: cos(spot_size / 2) */
+    double spot_smooth;        /* spot: (1 - spot_cos_half) x spot_blend */
+    int spot_axis_cosine;      /* spot: 1 for Cycles 3.x's extra factor c */
 } dwvl_light;
+
+/* The spot attenuation of a spot light for c, the cosine between its axis and the direction from
+ * the light toward the shaded point (see above). */
+double dwvl_spot_attenuation(const dwvl_light *light, double c);
 
 typedef struct dwvl_sample {
     dwvu_vec3 direction; /* unit, from the shaded point toward the light */

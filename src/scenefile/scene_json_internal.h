@@ -69,6 +69,9 @@ dwv_result_t dwvs_read_integer(const cJSON *item, const char *path, double lo, d
 dwv_result_t dwvs_read_u32(const cJSON *item, const char *path, uint32_t lo, uint32_t hi, uint32_t *out);
 /* An array of exactly n numbers. */
 dwv_result_t dwvs_read_vector(const cJSON *item, const char *path, size_t n, double *out);
+/* A non-empty array of numbers whose length is a multiple of `group`, as floats (each must fit
+ * one): *out is malloc'ed (the caller frees it), *count the numbers. */
+dwv_result_t dwvs_read_floats(const cJSON *item, const char *path, size_t group, size_t *count, float **out);
 /* A non-empty string (*out points into the parsed text). */
 dwv_result_t dwvs_read_string(const cJSON *item, const char *path, const char **out);
 /* One of `names` (in order of the values they stand for). */

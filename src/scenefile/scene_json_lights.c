@@ -2,28 +2,37 @@
 #include "scenefile/scene_json_internal.h"
 
 #include "util/error.h"
+#include "scenefile/transform.h"
+
+#include <stdlib.h>
 
 static dwv_result_t read_light(dwvs_parser *ps, const cJSON *item, const char *path)
 {
-    static const char *const kinds[] = {"sun", "point", "area"};
+    static const char *const kinds[] = {"sun", "point", "area", "spot"};
     static const char *const shapes[] = {"rectangle", "disk"};
     static const char *const sun_keys[] = {"kind", "color", "strength", "direction", "angle"};
     static const char *const point_keys[] = {"kind", "color", "strength", "position", "radius"};
     static const char *const area_keys[] = {"kind", "shape", "color", "strength", "transform", "size_x", "size_y"};
+    static const char *const spot_keys[] = {"kind",       "color",      "strength", "position",    "radius",
+                                            "direction",  "spot_size",  "spot_blend", "spot_falloff"};
+    static const char *const falloffs[] = {"cycles3", "cycles4"};
     if (!cJSON_IsObject(item))
         return dwvs_fail_at(DWV_ERROR_FORMAT, path, "expected an object, found %s", dwvs_type_name(item));
     const cJSON *kind_item = dwvs_member(item, "kind");
-    if (!kind_item) return dwvs_fail_at(DWV_ERROR_FORMAT, path, "missing key 'kind' ('sun', 'point' or 'area')");
+    if (!kind_item)
+        return dwvs_fail_at(DWV_ERROR_FORMAT, path, "missing key 'kind' ('sun', 'point', 'area' or 'spot')");
     char p[PATH_SIZE];
     size_t kind = 0;
     dwvs_path_key(p, path, "kind");
-    DWV_TRY(dwvs_read_choice(kind_item, p, kinds, 3, &kind));
+    DWV_TRY(dwvs_read_choice(kind_item, p, kinds, 4, &kind));
     if (kind == 0)
         DWV_TRY(dwvs_check_keys(item, path, sun_keys, sizeof sun_keys / sizeof sun_keys[0]));
     else if (kind == 1)
         DWV_TRY(dwvs_check_keys(item, path, point_keys, sizeof point_keys / sizeof point_keys[0]));
-    else
+    else if (kind == 2)
         DWV_TRY(dwvs_check_keys(item, path, area_keys, sizeof area_keys / sizeof area_keys[0]));
+    else
+        DWV_TRY(dwvs_check_keys(item, path, spot_keys, sizeof spot_keys / sizeof spot_keys[0]));
     dwv_light_desc_t light = DWV_LIGHT_DESC_INIT;
     DWV_TRY(dwvs_opt_vector(item, path, "color", 3, light.color));
     DWV_TRY(dwvs_opt_number(item, path, "strength", &light.strength));
@@ -37,6 +46,18 @@ static dwv_result_t read_light(dwvs_parser *ps, const cJSON *item, const char *p
         light.kind = DWV_LIGHT_POINT;
         DWV_TRY(dwvs_opt_vector(item, path, "position", 3, light.position));
         DWV_TRY(dwvs_opt_number(item, path, "radius", &light.radius));
+    } else if (kind == 3) {
+        light.kind = DWV_LIGHT_SPOT;
+        DWV_TRY(dwvs_opt_vector(item, path, "position", 3, light.position));
+        DWV_TRY(dwvs_opt_number(item, path, "radius", &light.radius));
+        DWV_TRY(dwvs_opt_vector(item, path, "direction", 3, light.direction));
+        double degrees = 45.0;
+        DWV_TRY(dwvs_opt_number(item, path, "spot_size", &degrees));
+        light.spot_size = degrees * (3.14159265358979323846 / 180.0);
+        DWV_TRY(dwvs_opt_number(item, path, "spot_blend", &light.spot_blend));
+        size_t falloff = 0;
+        DWV_TRY(dwvs_opt_choice(item, path, "spot_falloff", falloffs, 2, &falloff));
+        light.spot_falloff = falloff == 0 ? DWV_SPOT_FALLOFF_CYCLES3 : DWV_SPOT_FALLOFF_CYCLES4;
     } else {
         size_t shape = 0;
         DWV_TRY(dwvs_opt_choice(item, path, "shape", shapes, 2, &shape));
@@ -63,10 +84,57 @@ dwv_result_t dwvs_read_lights(dwvs_parser *ps, const cJSON *item)
     return DWV_SUCCESS;
 }
 
+/* "world": {"environment": {...}}: an equirectangular map with its texels inline. */
+static dwv_result_t read_environment(dwvs_parser *ps, const cJSON *item)
+{
+    static const char path[] = "world.environment";
+    static const char *const keys[] = {"width", "height", "texels", "interpolation", "strength", "rotate"};
+    static const char *const interpolations[] = {"linear", "closest", "cubic"};
+    if (!cJSON_IsObject(item))
+        return dwvs_fail_at(DWV_ERROR_FORMAT, path, "expected an object, found %s", dwvs_type_name(item));
+    DWV_TRY(dwvs_check_keys(item, path, keys, sizeof keys / sizeof keys[0]));
+    if (!dwvs_member(item, "width") || !dwvs_member(item, "height") || !dwvs_member(item, "texels"))
+        return dwvs_fail_at(DWV_ERROR_FORMAT, path, "needs 'width', 'height' and 'texels'");
+    dwv_environment_t e = DWV_ENVIRONMENT_INIT;
+    DWV_TRY(dwvs_opt_u32(item, path, "width", 1u, DWV_ENVIRONMENT_MAX_SIDE, &e.width));
+    DWV_TRY(dwvs_opt_u32(item, path, "height", 1u, DWV_ENVIRONMENT_MAX_SIDE, &e.height));
+    size_t interpolation = 0;
+    DWV_TRY(dwvs_opt_choice(item, path, "interpolation", interpolations, 3, &interpolation));
+    e.interpolation = (dwv_environment_interpolation_t)interpolation;
+    DWV_TRY(dwvs_opt_number(item, path, "strength", &e.strength));
+    /* The Mapping node's rotation (degrees, Euler XYZ): the rotation part of a T R S transform. */
+    double rotate[3] = {0.0, 0.0, 0.0}, zero[3] = {0.0, 0.0, 0.0}, one[3] = {1.0, 1.0, 1.0}, m[12];
+    DWV_TRY(dwvs_opt_vector(item, path, "rotate", 3, rotate));
+    dwvs_transform_trs(zero, rotate, one, m);
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) e.rotation[3 * r + c] = m[4 * r + c];
+    char p[PATH_SIZE];
+    dwvs_path_key(p, path, "texels");
+    size_t count = 0;
+    float *texels = NULL;
+    DWV_TRY(dwvs_read_floats(dwvs_member(item, "texels"), p, 3, &count, &texels));
+    if (count != 3u * (size_t)e.width * e.height) {
+        free(texels);
+        return dwvs_fail_at(DWV_ERROR_FORMAT, p, "%zu numbers: a %u x %u image needs %zu (RGB per texel)", count,
+                            e.width, e.height, 3u * (size_t)e.width * e.height);
+    }
+    e.texels = texels;
+    dwv_result_t r = dwv_scene_set_world_environment(ps->scene, &e);
+    free(texels);
+    return r == DWV_SUCCESS ? r : dwvs_prefix_capi(r, path);
+}
+
 dwv_result_t dwvs_read_world(dwvs_parser *ps, const cJSON *item)
 {
-    static const char *const keys[] = {"color", "strength"};
-    DWV_TRY(dwvs_check_keys(item, "world", keys, 2));
+    static const char *const keys[] = {"color", "strength", "environment"};
+    DWV_TRY(dwvs_check_keys(item, "world", keys, 3));
+    const cJSON *environment = dwvs_member(item, "environment");
+    if (environment) {
+        if (dwvs_member(item, "color") || dwvs_member(item, "strength"))
+            return dwvs_fail_at(DWV_ERROR_FORMAT, "world",
+                                "give either 'environment' (its own 'strength') or 'color'/'strength'");
+        return read_environment(ps, environment);
+    }
     double color[3] = {1.0, 1.0, 1.0}, strength = 1.0;
     DWV_TRY(dwvs_opt_vector(item, "world", "color", 3, color));
     DWV_TRY(dwvs_opt_number(item, "world", "strength", &strength));

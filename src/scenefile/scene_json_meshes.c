@@ -14,8 +14,7 @@
 
 static const double identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
 
-/* An array of numbers whose length is a multiple of `group`, as floats. */
-static dwv_result_t read_floats(const cJSON *item, const char *path, size_t group, size_t *count, float **out)
+dwv_result_t dwvs_read_floats(const cJSON *item, const char *path, size_t group, size_t *count, float **out)
 {
     if (!cJSON_IsArray(item))
         return dwvs_fail_at(DWV_ERROR_FORMAT, path, "expected an array of numbers, found %s", dwvs_type_name(item));
@@ -149,21 +148,21 @@ static dwv_result_t read_mesh(dwvs_parser *ps, const cJSON *item, const char *pa
         uint32_t *indices = NULL;
         size_t np = 0, ni = 0, nn = 0, nu = 0;
         dwvs_path_key(p, path, "positions");
-        r = read_floats(dwvs_member(item, "positions"), p, 3, &np, &positions);
+        r = dwvs_read_floats(dwvs_member(item, "positions"), p, 3, &np, &positions);
         if (r == DWV_SUCCESS) {
             dwvs_path_key(p, path, "indices");
             r = read_indices(dwvs_member(item, "indices"), p, &ni, &indices);
         }
         if (r == DWV_SUCCESS && dwvs_member(item, "normals")) {
             dwvs_path_key(p, path, "normals");
-            r = read_floats(dwvs_member(item, "normals"), p, 3, &nn, &normals);
+            r = dwvs_read_floats(dwvs_member(item, "normals"), p, 3, &nn, &normals);
             if (r == DWV_SUCCESS && nn != np)
                 r = dwvs_fail_at(DWV_ERROR_FORMAT, p, "%zu numbers for %zu positions: one normal per vertex", nn,
                                  np / 3u);
         }
         if (r == DWV_SUCCESS && dwvs_member(item, "uvs")) {
             dwvs_path_key(p, path, "uvs");
-            r = read_floats(dwvs_member(item, "uvs"), p, 2, &nu, &uvs);
+            r = dwvs_read_floats(dwvs_member(item, "uvs"), p, 2, &nu, &uvs);
             if (r == DWV_SUCCESS && nu != 2u * ni)
                 r = dwvs_fail_at(DWV_ERROR_FORMAT, p, "%zu numbers for %zu triangles: one (u, v) per triangle corner",
                                  nu, ni / 3u);

@@ -1,8 +1,9 @@
 #!/bin/bash
-# Runs tests/blender/test_fidelity.py in the Blender of a chroot made by scripts/blender-chroots.sh
+# Runs tests/blender/test_fidelity.py (or the test script DWIVEDI_CHROOT_TEST names, such as
+# test_world_spot.py) in the Blender of a chroot made by scripts/blender-chroots.sh
 # on branch `addon` (/var/cache/dwivedi/chroots/trixie: Blender 4.3, sid: Blender 5.2), against
 # that Blender's own Cycles. Usage (root: chroot and a private mount namespace):
-#   bash tests/blender/run_fidelity_chroot.sh trixie|sid BUILD_DIR [RESULTS_DIR]
+#   [DWIVEDI_CHROOT_TEST=test_world_spot.py] bash tests/blender/run_fidelity_chroot.sh trixie|sid BUILD_DIR [RESULTS_DIR]
 # The add-on is installed from BUILD_DIR/dwivedi_bake.zip. Where BUILD_DIR/libdwivedi.so.1 needs
 # libraries beyond glibc / libstdc++ / libgcc (today's Debian 12 build), the host's copies go in
 # the stage's deps/ and the test preloads them and the library (DWIVEDI_PRELOAD_DIR,
@@ -23,7 +24,9 @@ mkdir -p "$stage/deps" "$stage/home" "$results"
 trap 'rm -rf "$stage"' EXIT
 cp "$build/dwivedi_bake.zip" "$stage/"
 mkdir -p "$stage/lib" && cp -L "$build/libdwivedi.so.1" "$stage/lib/"
-cp "$here"/harness.py "$here"/scenes.py "$here"/test_fidelity.py "$stage/"
+script=${DWIVEDI_CHROOT_TEST:-test_fidelity.py}
+[ -f "$here/$script" ] || { echo "run_fidelity_chroot: no test script $here/$script" >&2; exit 1; }
+cp "$here"/harness.py "$here"/scenes.py "$here/$script" "$stage/"
 base='^(linux-vdso|libc\.so|libm\.so|libstdc\+\+|libgcc_s|ld-linux|libpthread|libdl\.so|librt\.so)'
 ldd "$build/libdwivedi.so.1" | awk '/=> \//{print $1, $3}' | while read -r name path; do
     if ! [[ $name =~ $base ]]; then cp -L "$path" "$stage/deps/$name"; fi
@@ -54,15 +57,16 @@ if [ "$n" -gt 0 ] && [ -n "${DWIVEDI_FIDELITY_OCIO_FROM:-}" ]; then
     env_vars+=(OCIO=$stage_rel/ocio/config.ocio)
     echo "run_fidelity_chroot: scratch set-up: OCIO=$DWIVEDI_FIDELITY_OCIO_FROM's Blender config (the host OpenColorIO is older)"
 fi
-for v in DWIVEDI_FIDELITY_EVENT_CAP DWIVEDI_FIDELITY_ONLY DWIVEDI_FIDELITY_RESOLUTION DWIVEDI_FIDELITY_CYCLES_SPP DWIVEDI_FIDELITY_DWIVEDI_SPP; do
+for v in DWIVEDI_FIDELITY_EVENT_CAP DWIVEDI_FIDELITY_ONLY DWIVEDI_FIDELITY_RESOLUTION DWIVEDI_FIDELITY_CYCLES_SPP DWIVEDI_FIDELITY_DWIVEDI_SPP \
+         DWIVEDI_WORLD_CYCLES_SPP DWIVEDI_WORLD_DWIVEDI_SPP; do
     [ -n "${!v:-}" ] && env_vars+=("$v=${!v}")
 done
 set +e
 unshare --mount --propagation private sh -c 'mount -t proc proc "$1/proc" && shift && exec chroot "$@"' sh "$root" \
-    "$root" env "${env_vars[@]}" nice blender -b --factory-startup --python-exit-code 1 --python "$stage_rel/test_fidelity.py"
+    "$root" env "${env_vars[@]}" nice blender -b --factory-startup --python-exit-code 1 --python "$stage_rel/$script"
 status=$?
 set -e
-cp "$stage/home/fidelity_figures.json" "$results/" 2>/dev/null || true
+cp "$stage"/home/*_figures.json "$results/" 2>/dev/null || true
 rm -rf "$results/work" && cp -r "$stage/home/work" "$results/work" 2>/dev/null || true
-echo "run_fidelity_chroot: $suite: exit $status; figures in $results/fidelity_figures.json"
+echo "run_fidelity_chroot: $suite ($script): exit $status; figures in $results/"
 exit $status

@@ -92,7 +92,9 @@ def sss_node_material(name, color, radius, scale=1.0):
     tree = material.node_tree
     tree.nodes.remove(tree.nodes["Principled BSDF"])
     node = tree.nodes.new("ShaderNodeSubsurfaceScattering")
-    node.falloff = 'RANDOM_WALK_FIXED_RADIUS'
+    # 4.0 renamed 3.x's Fixed Radius walk Random Walk (as for the Principled BSDF above).
+    falloffs = [item.identifier for item in node.bl_rna.properties["falloff"].enum_items]
+    node.falloff = 'RANDOM_WALK_FIXED_RADIUS' if 'RANDOM_WALK_FIXED_RADIUS' in falloffs else 'RANDOM_WALK'
     node.inputs["Color"].default_value = (color[0], color[1], color[2], 1.0)
     node.inputs["Scale"].default_value = scale
     node.inputs["Radius"].default_value = tuple(radius)

@@ -18,10 +18,8 @@ Runs in any Blender the add-on loads in (host 3.4; trixie 4.3 and sid 5.2 by
 tests/blender/run_fidelity_chroot.sh).
 """
 import json
-import math
 import os
 import sys
-import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -33,23 +31,7 @@ import scenes  # noqa: E402
 
 
 
-def preload_scratch_dependencies():
-    """run_fidelity_chroot.sh's scratch set-up for a library that is not self-contained
-    (DWIVEDI_PRELOAD: a wrapper needing this Blender's malloc, then the library; the host
-    dependencies beside it): one dlopen with RTLD_DEEPBIND, so that the library binds to its own
-    Embree 3 and OpenEXR rather than the Embree 4 / OpenEXR this Blender loaded under the same
-    symbol names (without it every ray misses). The add-on's shim then opens the same file
-    (DWIVEDI_LIBRARY): the same handle. Branch native's self-contained library needs none of it."""
-    wrapper = os.environ.get("DWIVEDI_PRELOAD")
-    if not wrapper or not Path(wrapper).is_file():
-        return
-    import ctypes
-    ctypes.CDLL(wrapper, mode=ctypes.RTLD_LOCAL | getattr(os, "RTLD_DEEPBIND", 8))
-    print(f"test_fidelity: scratch set-up: {wrapper} (the library and its host dependencies) loaded with "
-          "RTLD_DEEPBIND", flush=True)
-
-
-preload_scratch_dependencies()
+harness.preload_scratch_dependencies()
 WORK = harness.install_addon()
 RESOLUTION = int(os.environ.get("DWIVEDI_FIDELITY_RESOLUTION", "48"))
 CYCLES_SAMPLES = int(os.environ.get("DWIVEDI_FIDELITY_CYCLES_SPP", "512"))    # per seed; two seeds
@@ -61,34 +43,12 @@ FIGURES = {"blender_version": list(bpy.app.version)}
 
 
 def cycles_render(scene, seed, name):
-    scene.cycles.seed = seed
-    scene.cycles.samples = CYCLES_SAMPLES
-    scene.render.image_settings.file_format = 'OPEN_EXR'
-    scene.render.image_settings.color_depth = '32'
-    scene.render.filepath = str(WORK / f"{name}_cycles_{seed}.exr")
-    start = time.monotonic()
-    bpy.ops.render.render(write_still=True)
-    seconds = time.monotonic() - start
-    _, _, pixels = harness.read_pixels(WORK / f"{name}_cycles_{seed}.exr")
-    return pixels, seconds
+    return harness.cycles_render(scene, seed, WORK / f"{name}_cycles_{seed}.exr", CYCLES_SAMPLES)
 
 
 def dwivedi_bake(scene, seed, name, samples):
-    props = scene.dwivedi_bake
-    props.samples = samples
     # Cycles' own cap of 256 events per walk (BSSRDF_MAX_BOUNCES): at the same settings as its render.
-    props.walk_event_cap = CYCLES_EVENT_CAP
-    props.threads = 2
-    props.seed = seed
-    props.technique = 'AUTO'
-    props.output_dir = str(WORK / f"{name}_dwivedi_{seed}")
-    start = time.monotonic()
-    result, error = harness.call_operator()
-    seconds = time.monotonic() - start
-    if result != {'FINISHED'}:
-        raise AssertionError(f"the bake failed: {error}")
-    _, _, pixels = harness.image_pixels("Dwivedi Camera")
-    return pixels, seconds
+    return harness.dwivedi_bake(scene, seed, WORK / f"{name}_dwivedi_{seed}", samples, CYCLES_EVENT_CAP)
 
 
 def bake_warnings(scene):
@@ -110,21 +70,8 @@ def compare(name, scene, dwivedi_samples=None):
     c2, tc2 = cycles_render(scene, 2, name)
     o1, to1 = dwivedi_bake(scene, 1, name, dwivedi_samples)
     o2, to2 = dwivedi_bake(scene, 2, name, dwivedi_samples)
-    cycles = [(a + b) / 2 for a, b in zip(c1, c2)]
-    ours = [(a + b) / 2 for a, b in zip(o1, o2)]
-    n = len(ours) // 4
-    cm = [sum(cycles[c::4]) / n for c in range(3)]
-    om = [sum(ours[c::4]) / n for c in range(3)]
-    ratios = []
-    for c in range(3):
-        num = sum((ours[i] - cycles[i]) ** 2 for i in range(c, len(ours), 4))
-        den = sum(((o1[i] - o2[i]) ** 2 + (c1[i] - c2[i]) ** 2) / 4 for i in range(c, len(ours), 4))
-        ratios.append(num / den if den > 0 else (0.0 if num == 0 else math.inf))
     figures = {
-        "cycles_mean_rgb": cm, "dwivedi_mean_rgb": om,
-        "relative_difference_rgb": [(o - c) / c if c > 0 else None for o, c in zip(om, cm)],
-        "noise_ratio_rgb": ratios,
-        "nan_pixels": sum(1 for v in ours if v != v),
+        **harness.agreement(c1, c2, o1, o2),
         "cycles_seconds": tc1 + tc2, "cycles_samples": 2 * CYCLES_SAMPLES,
         "dwivedi_seconds": to1 + to2, "dwivedi_samples": 2 * dwivedi_samples,
         "walk_event_cap": CYCLES_EVENT_CAP,

@@ -169,7 +169,7 @@ static void test_direct_lobe(void)
     desc.strength = 3.0;
     dwvl_light sun;
     dwvl_light_init(&sun, &desc);
-    dwvl_environment env = {&sun, 1u, {0.0, 0.0, 0.0}, 0, NULL};
+    dwvl_environment env = {&sun, 1u, {0.0, 0.0, 0.0}, 0, NULL, NULL};
     dwvu_vec3 x = dwvu_v(0.0, 0.0, 0.0), n = dwvu_v(0.0, 0.0, 1.0);
     fixed_normal normal = {n};
     double plain[3], lambert[3], lobe[3];

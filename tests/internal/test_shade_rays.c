@@ -297,7 +297,7 @@ static void check_tops(const char *name, const dwvg_mesh *meshes, uint32_t count
         desc.angle = 10.0 * 3.14159265358979323846 / 180.0;
         dwvl_light sun;
         dwvl_light_init(&sun, &desc);
-        dwvl_environment env = {&sun, 1u, {0.2, 0.3, 0.4}, 1, &world};
+        dwvl_environment env = {&sun, 1u, {0.2, 0.3, 0.4}, 1, &world, NULL};
         dwvk_sampler sampler = {.key = state, .index = 0u, .stratified = 0};
         double with[3], without[3];
         dwvl_direct(&env, x, ng, ng, NULL, dwvg_world_top(&world, 0u, prim), &sampler, 0u, with);

@@ -239,7 +239,7 @@ static void test_sphere_terminator(void)
     desc.direction[2] = 0.0;
     dwvl_light sun;
     dwvl_light_init(&sun, &desc);
-    dwvl_environment env = {&sun, 1u, {0.0, 0.0, 0.0}, 0, &world};
+    dwvl_environment env = {&sun, 1u, {0.0, 0.0, 0.0}, 0, &world, NULL};
     dwvu_vec3 to_sun = dwvu_v(1.0, 0.0, 0.0);
     int below = 0, below_lit_flat = 0, below_lit_smooth = 0, lit = 0, lit_changed = 0;
     uint64_t state = 5u;

@@ -76,15 +76,16 @@ class StructLayoutTest(unittest.TestCase):
         "dwv_camera_t": _library.CameraDesc, "dwv_bake_progress_t": _library.BakeProgress,
         "dwv_bake_options_t": _library.BakeOptions, "dwv_image_info_t": _library.ImageInfo,
         "dwv_bake_stats_t": _library.BakeStats, "dwv_error_point_t": _library.ErrorPoint,
-        "dwv_display_options_t": _library.DisplayOptions,
+        "dwv_display_options_t": _library.DisplayOptions, "dwv_environment_t": _library.EnvironmentDesc,
     }
 
     def test_sizes_on_lp64(self):
         if ctypes.sizeof(ctypes.c_void_p) != 8:
             self.skipTest("the sizes below are those of an LP64 ABI")
-        sizes = {"dwv_material_t": 192, "dwv_mesh_t": 152, "dwv_light_desc_t": 216, "dwv_camera_t": 128,
+        sizes = {"dwv_material_t": 192, "dwv_mesh_t": 152, "dwv_light_desc_t": 240, "dwv_camera_t": 128,
                  "dwv_bake_progress_t": 48, "dwv_bake_options_t": 112, "dwv_image_info_t": 40,
-                 "dwv_bake_stats_t": 128, "dwv_error_point_t": 24, "dwv_display_options_t": 56}
+                 "dwv_bake_stats_t": 128, "dwv_error_point_t": 24, "dwv_display_options_t": 56,
+                 "dwv_environment_t": 104}
         for name, size in sizes.items():
             self.assertEqual(ctypes.sizeof(self.STRUCTS[name]), size, name)
 
@@ -281,6 +282,51 @@ class SceneTest(unittest.TestCase):
             with self.assertRaises(dwivedi.Error) as caught:
                 scene.add_material(dwivedi.Material(subsurface_exit="principled_v1", roughness=1.5))
             self.assertEqual(caught.exception.code, _library.DWV_ERROR_OUT_OF_RANGE)
+
+
+class WorldEnvironmentTest(unittest.TestCase):
+    """Scene.set_world_environment and SpotLight (issue 18)."""
+
+    def test_environment_and_spot_bake(self):
+        w, h = 16, 8
+        texels = array.array("f", [0.2] * (3 * w * h))
+        texels[3 * (6 * w + 3):3 * (6 * w + 3) + 3] = array.array("f", [50.0, 40.0, 30.0])  # a hot spot up high
+        scene = cube_scene(sun=0.0)
+        scene.set_world_environment(texels, w, h, strength=1.5, rotation=((0.0, -1.0, 0.0), (1.0, 0.0, 0.0),
+                                                                          (0.0, 0.0, 1.0)), interpolation="cubic")
+        scene.add_light(dwivedi.SpotLight(position=(0.0, -2.0, 1.0), direction=(0.0, 1.0, -0.5), power=200.0,
+                                          spot_size=math.radians(40.0), spot_blend=0.2, falloff="cycles4"))
+        scene.commit()
+        image = dwivedi.bake(scene, dwivedi.BakeSettings(width=16, height=16, samples=4, threads=2))
+        self.assertTrue(math.isfinite(luminance_sum(image)))
+        self.assertGreater(luminance_sum(image), 0.0)
+        self.assertIn("world_light", image.stats.features)
+
+    def test_bad_environments(self):
+        scene = dwivedi.Scene()
+        with self.assertRaises(dwivedi.Error) as caught:
+            scene.set_world_environment([0.5, -1.0, 0.5], 1, 1)
+        self.assertEqual(caught.exception.code, _library.DWV_ERROR_INVALID_ARGUMENT)
+        self.assertIn("texel (0, 0)", str(caught.exception))
+        with self.assertRaises(dwivedi.Error):
+            scene.set_world_environment([0.5] * 9, 2, 2)  # 3 texels for 4
+        with self.assertRaises(dwivedi.Error):
+            scene.set_world_environment([0.5] * 3, 1, 1, interpolation="smart")
+        with self.assertRaises(dwivedi.Error) as caught:
+            scene.set_world_environment([0.5] * 3, 1, 1, rotation=(2, 0, 0, 0, 1, 0, 0, 0, 1))
+        self.assertIn("not a rotation", str(caught.exception))
+        with self.assertRaises(dwivedi.Error):
+            scene.add_light(dwivedi.SpotLight(spot_blend=2.0))
+        with self.assertRaises(dwivedi.Error):
+            scene.add_light(dwivedi.SpotLight(falloff="cycles5"))
+        scene.close()
+
+    @unittest.skipIf(numpy is None, "numpy is not installed")
+    def test_numpy_texels(self):
+        scene = dwivedi.Scene()
+        scene.set_world_environment(numpy.full((4, 8, 3), 0.25, dtype=numpy.float32), 8, 4)
+        scene.set_world_environment(numpy.full((4, 8, 3), 0.25), 8, 4)  # float64: converted
+        scene.close()
 
 
 class ImageTest(unittest.TestCase):

@@ -222,7 +222,7 @@ static void test_lights(dwv_scene_t *scene)
     l.struct_size = 4;
     EXPECT(dwv_scene_add_light(scene, &l), DWV_ERROR_STRUCT_SIZE, "light");
     l = (dwv_light_desc_t)DWV_LIGHT_DESC_INIT;
-    l.kind = 4;
+    l.kind = 5; /* 4 is DWV_LIGHT_SPOT */
     EXPECT(dwv_scene_add_light(scene, &l), DWV_ERROR_INVALID_ARGUMENT, "kind");
     l = (dwv_light_desc_t)DWV_LIGHT_DESC_INIT;
     l.direction[0] = l.direction[1] = l.direction[2] = 0.0;

@@ -392,8 +392,8 @@ static void test_schema(void)
           "matrix and TRS transforms: %s", dwv_last_error_message());
 
     /* Lights */
-    expect_failure("light kind", "{\"version\": 1, \"meshes\": [], \"lights\": [{\"kind\": \"spot\"}]}",
-                   DWV_ERROR_UNKNOWN_NAME, "lights[0].kind", "'spot'");
+    expect_failure("light kind", "{\"version\": 1, \"meshes\": [], \"lights\": [{\"kind\": \"laser\"}]}",
+                   DWV_ERROR_UNKNOWN_NAME, "lights[0].kind", "'laser'");
     expect_failure("light without kind", "{\"version\": 1, \"meshes\": [], \"lights\": [{\"strength\": 1}]}",
                    DWV_ERROR_FORMAT, "lights[0]", "kind");
     expect_failure("position on a sun",
