@@ -779,10 +779,16 @@ typedef struct dwv_bake_options_t {
      * target_error. The image keeps its exact sums for dwv_image_write_partial. */
     uint64_t sample_first;
     uint64_t sample_count;
+    /* Added after 0.2 (issue 19; a caller whose struct_size ends before it gets 0). Camera bakes:
+     * 0, a camera ray that misses every surface sees the world (alpha 0 there); 1, it sees
+     * nothing (RGBA 0), as Cycles' Film > Transparent: each pixel is then coverage x surface,
+     * premultiplied by its alpha. The world lights the scene either way. */
+    int32_t transparent_background;
+    uint32_t reserved;        /* 0 */
 } dwv_bake_options_t;
 #define DWV_BAKE_OPTIONS_INIT                                                                       \
     {sizeof(dwv_bake_options_t), DWV_BAKE_CAMERA, 256u, 256u, 0u, 16u, DWV_TECHNIQUE_AUTO, 64u, 0.0,  \
-     0.0, 0u, 0u, 0u, 0u, 0u, NULL, NULL, 0u, 0u}
+     0.0, 0u, 0u, 0u, 0u, 0u, NULL, NULL, 0u, 0u, 0, 0u}
 
 typedef struct dwv_bake_s dwv_bake_t;
 typedef struct dwv_image_s dwv_image_t;

@@ -505,12 +505,17 @@ def readable(warning):
 
 
 class _ExportSettings:
-    """What export.export_scene reads: the target and, for a UV bake, the object and size."""
+    """What export.export_scene reads: the scene's bake settings (World Resolution...), with the
+    UV bake's object and size as the bake found them (the active object and its image)."""
 
-    def __init__(self, target, uv_object, uv_size):
-        self.target = target
+    def __init__(self, settings, uv_object, uv_size):
+        self._settings = settings
+        self.target = settings.target
         self.uv_object = uv_object
         self.uv_size = uv_size
+
+    def __getattr__(self, name):
+        return getattr(self._settings, name)
 
 
 class _Job:
@@ -529,7 +534,7 @@ class _Job:
         self.notes = []
         lost = lost_at_quit(self.folder)
         size = tuple(self.uv_image.size) if self.uv_image is not None else (0, 0)
-        self.exported = export.export_scene(context, _ExportSettings(settings.target, self.uv_object, size[0]),
+        self.exported = export.export_scene(context, _ExportSettings(settings, self.uv_object, size[0]),
                                             self.dwivedi)
         if self.uv_image is not None:
             self.exported.width, self.exported.height = size  # the image's own size, as Cycles bakes
@@ -543,7 +548,8 @@ class _Job:
             uv_mesh=self.exported.uv_mesh, uv_margin=settings.uv_margin, technique=settings.technique.lower(),
             channel_walks=settings.channel_walks.lower(), samples=settings.samples, time_limit=settings.time_limit,
             target_error=settings.target_error, threads=settings.threads, seed=settings.seed,
-            max_events=settings.walk_event_cap)
+            max_events=settings.walk_event_cap,
+            transparent_background=settings.target == 'CAMERA' and scene.render.film_transparent)
         self.display = display_settings(scene, self.dwivedi)
         self.bake = None
         self.result = None  # the Blender image that holds the result, once finished
@@ -605,32 +611,19 @@ class _Job:
 
 
 def film_alpha(image, scene):
-    """The camera bake's background as Cycles' Film > Transparent makes it: off, every pixel is
-    opaque (the world is the background); on, the world is taken out of the colour, which is then
-    premultiplied by coverage as Cycles' is. A pixel's colour is coverage x surface + (1 -
-    coverage) x world (the library adds the world where a camera ray misses), so subtracting
-    (1 - alpha) x world leaves exactly the surface's share."""
-    rgba = image.rgba.cast("B").cast("f")
-    if not scene.render.film_transparent:
-        try:
-            import numpy
-            numpy.asarray(rgba).reshape(-1, 4)[:, 3] = 1.0
-        except ImportError:
-            for i in range(3, len(rgba), 4):
-                rgba[i] = 1.0
+    """The camera bake's alpha as Cycles' Film > Transparent makes it. On, the library has already
+    left out the background (the bake's transparent_background: RGBA 0 where no surface is seen,
+    pixels premultiplied by coverage, the world still lighting the scene). Off, every pixel is
+    opaque: the world is the background."""
+    if scene.render.film_transparent:
         return
-    color, strength = export._world(scene, [])
-    world = [float(c) * strength for c in color[:3]]
+    rgba = image.rgba.cast("B").cast("f")
     try:
         import numpy
-        pixels = numpy.asarray(rgba).reshape(-1, 4)
-        pixels[:, :3] -= (1.0 - pixels[:, 3:4]) * numpy.asarray(world, dtype=numpy.float32)
-        numpy.maximum(pixels[:, :3], 0.0, out=pixels[:, :3])
+        numpy.asarray(rgba).reshape(-1, 4)[:, 3] = 1.0
     except ImportError:
-        for i in range(0, len(rgba), 4):
-            uncovered = 1.0 - rgba[i + 3]
-            for c in range(3):
-                rgba[i + c] = max(0.0, rgba[i + c] - uncovered * world[c])
+        for i in range(3, len(rgba), 4):
+            rgba[i] = 1.0
 
 
 def png_through_blender(image, scene, path):

@@ -258,6 +258,8 @@ class BakeOptions(_SizedStructure):
         ("progress_user", ctypes.c_void_p),
         ("sample_first", ctypes.c_uint64),
         ("sample_count", ctypes.c_uint64),
+        ("transparent_background", ctypes.c_int32),
+        ("reserved", ctypes.c_uint32),
     ]
 
     def __init__(self) -> None:

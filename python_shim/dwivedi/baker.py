@@ -413,6 +413,9 @@ class BakeSettings:
     # sample_count - 1 of `samples` in all; 0 (the default): the whole bake.
     sample_first: int = 0
     sample_count: int = 0
+    # Camera bakes: the background as Cycles' Film > Transparent (RGBA 0 where no surface is seen,
+    # pixels premultiplied by coverage); False: the world is seen there.
+    transparent_background: bool = False
 
     def _to_c(self) -> _library.BakeOptions:
         out = _library.BakeOptions()
@@ -432,6 +435,9 @@ class BakeSettings:
         out.channel_walks = _name_code("channel_walks", self.channel_walks, _CHANNEL_WALKS)
         out.sample_first = _uint("sample_first", self.sample_first, 64)
         out.sample_count = _uint("sample_count", self.sample_count, 64)
+        if not isinstance(self.transparent_background, bool):
+            raise TypeError(f"transparent_background must be True or False, not {type(self.transparent_background).__name__}")
+        out.transparent_background = int(self.transparent_background)
         return out
 
     @classmethod
@@ -440,6 +446,8 @@ class BakeSettings:
                    height=c.height, uv_mesh=c.uv_mesh, uv_margin=c.uv_margin, technique=_technique_name(c.technique),
                    samples=c.samples, time_limit=c.time_limit, target_error=c.target_error, threads=c.threads,
                    max_events=c.max_events, seed=c.seed, tile_size=c.tile_size,
+                   sample_first=c.sample_first, sample_count=c.sample_count,
+                   transparent_background=bool(c.transparent_background),
                    channel_walks={v: k for k, v in _CHANNEL_WALKS.items()}.get(c.channel_walks, str(c.channel_walks)))
 
 

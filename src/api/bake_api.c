@@ -82,6 +82,10 @@ static dwv_result_t check_options(const char *fn, const dwvb_scene *s, const dwv
         return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: sample_first = %llu needs sample_count > 0", fn,
                         (unsigned long long)o->sample_first);
     }
+    if (o->transparent_background != 0 && o->transparent_background != 1)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: transparent_background = %d is neither 0 nor 1", fn,
+                        (int)o->transparent_background);
+    if (o->reserved != 0u) return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: reserved = %u must be 0", fn, o->reserved);
     DWV_TRY(dwv_check_range(fn, "time_limit", o->time_limit, 0.0, HUGE_VAL));
     DWV_TRY(dwv_check_range(fn, "target_error", o->target_error, 0.0, HUGE_VAL));
     if (o->threads > MAX_THREADS)

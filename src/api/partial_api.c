@@ -55,9 +55,9 @@ static void fnv_add(fnv *f, const void *data, size_t size)
  * and not hashed lets chunks of two different scenes merge. These sizes (LP64) make such an
  * addition fail to compile here until the field is added below (or said to change no image). */
 _Static_assert(sizeof(dwv_material_t) == 192, "a new dwv_material_t field: hash it in dwv_scene_hash");
-_Static_assert(sizeof(dwv_light_desc_t) == 216, "a new dwv_light_desc_t field: hash it in dwv_scene_hash");
+_Static_assert(sizeof(dwv_light_desc_t) == 240, "a new dwv_light_desc_t field: hash it in dwv_scene_hash");
 _Static_assert(sizeof(dwv_camera_t) == 128, "a new dwv_camera_t field: hash it in dwv_scene_hash");
-_Static_assert(sizeof(dwvb_scene) == 408, "a new dwvb_scene field: hash it in dwv_scene_hash if it changes images");
+_Static_assert(sizeof(dwvb_scene) == 416, "a new dwvb_scene field: hash it in dwv_scene_hash if it changes images");
 
 uint64_t dwv_scene_hash(const dwvb_scene *s)
 {
@@ -154,6 +154,7 @@ uint64_t dwv_options_hash(const dwv_bake_options_t *o)
     ADD(&f, o->samples);
     ADD(&f, o->max_events);
     ADD(&f, o->channel_walks);
+    if (o->transparent_background) ADD(&f, o->transparent_background); /* other bakes hash as before it */
     return f.h;
 }
 

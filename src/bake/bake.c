@@ -57,7 +57,8 @@ void dwvb_bake_sample(const dwvb_bake *bake, const dwvb_shader *shader, uint64_t
         dwvu_vec3 origin;
         camera_sample(bake, x, row, &sampler, &origin, &view);
         if (!(bake->scene->mesh_count > 0 && dwvg_intersect(&bake->scene->geometry, origin, view, 0.0, INFINITY, &hit))) {
-            if (bake->scene->envmap) dwvl_envmap_radiance(bake->scene->envmap, view, rgb);
+            if (bake->options.transparent_background) rgb[0] = rgb[1] = rgb[2] = 0.0; /* Film > Transparent */
+            else if (bake->scene->envmap) dwvl_envmap_radiance(bake->scene->envmap, view, rgb);
             else for (int c = 0; c < 3; ++c) rgb[c] = bake->scene->world[c];
             *alpha = 0.0;
             return;

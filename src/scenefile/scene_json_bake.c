@@ -41,7 +41,8 @@ dwv_result_t dwvs_read_bake(dwvs_parser *ps, const cJSON *item)
 {
     static const char *const keys[] = {"target",  "width",       "height",  "samples",   "technique",
                                        "channel_walks", "time_limit", "target_error", "seed", "threads",
-                                       "max_events", "tile_size", "uv_mesh",     "uv_margin"};
+                                       "max_events", "tile_size", "uv_mesh",     "uv_margin",
+                                       "transparent_background"};
     static const char *const targets[] = {"camera", "uv"};
     DWV_TRY(dwvs_check_keys(item, "bake", keys, sizeof keys / sizeof keys[0]));
     dwv_bake_options_t *o = &ps->options;
@@ -85,6 +86,12 @@ dwv_result_t dwvs_read_bake(dwvs_parser *ps, const cJSON *item)
     DWV_TRY(dwvs_opt_u32(item, "bake", "threads", 0u, MAX_THREADS, &o->threads));
     DWV_TRY(dwvs_opt_u32(item, "bake", "max_events", 0u, UINT32_MAX, &o->max_events));
     DWV_TRY(dwvs_opt_u32(item, "bake", "tile_size", 0u, MAX_SIDE, &o->tile_size));
+    const cJSON *transparent = dwvs_member(item, "transparent_background");
+    if (transparent) {
+        if (!cJSON_IsBool(transparent))
+            return dwvs_fail_at(DWV_ERROR_FORMAT, "bake.transparent_background", "must be true or false");
+        o->transparent_background = cJSON_IsTrue(transparent) ? 1 : 0;
+    }
 
     const cJSON *uv_mesh = dwvs_member(item, "uv_mesh"), *uv_margin = dwvs_member(item, "uv_margin");
     if (o->target != DWV_BAKE_UV) {

@@ -83,7 +83,7 @@ class StructLayoutTest(unittest.TestCase):
         if ctypes.sizeof(ctypes.c_void_p) != 8:
             self.skipTest("the sizes below are those of an LP64 ABI")
         sizes = {"dwv_material_t": 192, "dwv_mesh_t": 152, "dwv_light_desc_t": 240, "dwv_camera_t": 128,
-                 "dwv_bake_progress_t": 48, "dwv_bake_options_t": 112, "dwv_image_info_t": 40,
+                 "dwv_bake_progress_t": 48, "dwv_bake_options_t": 120, "dwv_image_info_t": 40,
                  "dwv_bake_stats_t": 128, "dwv_error_point_t": 24, "dwv_display_options_t": 56,
                  "dwv_environment_t": 104}
         for name, size in sizes.items():
@@ -118,7 +118,7 @@ class StructLayoutTest(unittest.TestCase):
     def test_defaults_are_the_init_macros(self):
         options = _library.BakeOptions()
         self.assertEqual((options.struct_size, options.width, options.height, options.uv_margin, options.samples),
-                         (112, 256, 256, 16, 64))
+                         (120, 256, 256, 16, 64))
         settings = dwivedi.BakeSettings()
         self.assertEqual((settings.width, settings.height, settings.uv_margin, settings.samples, settings.technique),
                          (256, 256, 16, 64, "auto"))
@@ -326,6 +326,54 @@ class WorldEnvironmentTest(unittest.TestCase):
         scene = dwivedi.Scene()
         scene.set_world_environment(numpy.full((4, 8, 3), 0.25, dtype=numpy.float32), 8, 4)
         scene.set_world_environment(numpy.full((4, 8, 3), 0.25), 8, 4)  # float64: converted
+        scene.close()
+
+
+class TransparentBackgroundTest(unittest.TestCase):
+    """BakeSettings.transparent_background (Cycles' Film > Transparent): where the camera sees no
+    surface, RGBA 0 instead of the world; a pixel wholly on the surface is the same as in the
+    opaque bake (the world still lights it); a partly covered one is its surface share only."""
+
+    def test_background_left_out_and_surface_kept(self):
+        world = (0.3, 0.5, 0.7)
+        images = {}
+        for transparent in (False, True):
+            scene = cube_scene(world=world)
+            scene.commit()
+            images[transparent] = dwivedi.bake(scene, dwivedi.BakeSettings(
+                width=24, height=24, samples=8, threads=2, seed=3, transparent_background=transparent)).pixels()
+            scene.close()
+        opaque, transparent = images[False], images[True]
+        seen = {"background": 0, "surface": 0, "edge": 0}
+        for i in range(0, len(opaque), 4):
+            coverage = opaque[i + 3]
+            self.assertEqual(transparent[i + 3], coverage)
+            if coverage == 0.0:
+                seen["background"] += 1
+                for c in range(3):
+                    self.assertAlmostEqual(opaque[i + c], world[c], places=6)
+                    self.assertEqual(transparent[i + c], 0.0)
+            elif coverage == 1.0:
+                seen["surface"] += 1
+                self.assertEqual(transparent[i:i + 3], opaque[i:i + 3])
+            else:
+                seen["edge"] += 1
+                for c in range(3):  # the opaque pixel adds the world over the uncovered share
+                    self.assertAlmostEqual(opaque[i + c] - transparent[i + c], (1.0 - coverage) * world[c], places=4)
+        self.assertTrue(all(seen.values()), seen)
+
+    def test_bad_values(self):
+        with self.assertRaises(TypeError):
+            dwivedi.BakeSettings(transparent_background=1)._to_c()
+        scene = cube_scene()
+        scene.commit()
+        for field, value, message in (("transparent_background", 2, "neither 0 nor 1"), ("reserved", 1, "must be 0")):
+            bad = dwivedi.BakeSettings(width=4, height=4, samples=1)._to_c()
+            setattr(bad, field, value)
+            bake = ctypes.c_void_p()
+            code = _library.library().dwv_bake_start(scene._handle, ctypes.byref(bad), ctypes.byref(bake))
+            self.assertEqual(code, _library.DWV_ERROR_INVALID_ARGUMENT)
+            self.assertIn(message, _library.library().dwv_last_error_message().decode())
         scene.close()
 
 
