@@ -291,14 +291,14 @@ def default_sphere_scene(resolution, method, **material):
     return scene
 
 
-def backlit_slab_scene(resolution, method):
-    """The issue's back-lit slab: 0.2 m thick, 4 x 4 m, Subsurface 0.3 (4.x+: Scale 0.3),
-    colour (0.9, 0.7, 0.5), a sun from straight below, an orthographic camera above."""
+def backlit_slab_scene(resolution, method, thickness=0.2):
+    """The issue's back-lit slab: 0.2 m thick (or `thickness`), 4 x 4 m, Subsurface 0.3 (4.x+:
+    Scale 0.3), colour (0.9, 0.7, 0.5), a sun from straight below, an orthographic camera above."""
     scene = _reset()
     scene.render.resolution_x = resolution
     scene.render.resolution_y = resolution
     material = default_subsurface_material("Slab", method, color=(0.9, 0.7, 0.5), amount=0.3)
-    _box(scene, "Slab", (4.0, 4.0, 0.2), (0.0, 0.0, 0.0), material)
+    _box(scene, "Slab", (4.0, 4.0, thickness), (0.0, 0.0, 0.0), material)
     _camera(scene, (0.0, 0.0, 3.0), (0.0, 0.0, 0.0), ortho_scale=1.0)
     _sun(scene, (math.pi, 0.0, 0.0), 3.0)
     return scene

@@ -17,9 +17,7 @@ add-on twice with different seeds at 32 x 32 (nothing is cached between runs), t
 The figures are printed, and written to DWIVEDI_TEST_HOME/cycles_figures.json.
 """
 import json
-import math
 import sys
-import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -38,62 +36,16 @@ NOISE_RATIO_LIMIT = 1.5
 FIGURES = {}
 
 
-def cycles_render(scene, seed, name):
-    scene.cycles.seed = seed
-    scene.cycles.samples = CYCLES_SAMPLES
-    scene.render.image_settings.file_format = 'OPEN_EXR'
-    scene.render.image_settings.color_depth = '32'
-    scene.render.filepath = str(WORK / f"{name}_cycles_{seed}.exr")
-    start = time.monotonic()
-    bpy.ops.render.render(write_still=True)
-    seconds = time.monotonic() - start
-    _, _, pixels = harness.read_pixels(WORK / f"{name}_cycles_{seed}.exr")
-    return pixels, seconds
-
-
-def dwivedi_bake(scene, seed, name):
-    props = scene.dwivedi_bake
-    props.samples = DWIVEDI_SAMPLES
-    props.threads = 2
-    props.seed = seed
-    props.technique = 'AUTO'
-    props.output_dir = str(WORK / f"{name}_dwivedi_{seed}")
-    start = time.monotonic()
-    result, error = harness.call_operator()
-    seconds = time.monotonic() - start
-    if result != {'FINISHED'}:
-        raise AssertionError(f"the bake failed: {error}")
-    _, _, pixels = harness.image_pixels("Dwivedi Camera")
-    return pixels, seconds
-
-
-def channel_means(pixels):
-    n = len(pixels) // 4
-    return [sum(pixels[c::4]) / n for c in range(3)]
-
-
 def compare(name, build):
     scene = build(RESOLUTION, CYCLES_SAMPLES)
-    c1, tc1 = cycles_render(scene, 1, name)
-    c2, tc2 = cycles_render(scene, 2, name)
-    o1, to1 = dwivedi_bake(scene, 1, name)
-    o2, to2 = dwivedi_bake(scene, 2, name)
-    cycles = [(a + b) / 2 for a, b in zip(c1, c2)]
-    ours = [(a + b) / 2 for a, b in zip(o1, o2)]
-    cm, om = channel_means(cycles), channel_means(ours)
-    ratios = []
-    for c in range(3):
-        num = sum((ours[i] - cycles[i]) ** 2 for i in range(c, len(ours), 4))
-        den = sum(((o1[i] - o2[i]) ** 2 + (c1[i] - c2[i]) ** 2) / 4 for i in range(c, len(ours), 4))
-        ratios.append(num / den if den > 0 else (0.0 if num == 0 else math.inf))
-    figures = {
-        "cycles_mean_rgb": cm, "dwivedi_mean_rgb": om,
-        "relative_difference_rgb": [(o - c) / c if c > 0 else None for o, c in zip(om, cm)],
-        "noise_ratio_rgb": ratios,
-        "cycles_seconds": tc1 + tc2, "cycles_samples": 2 * CYCLES_SAMPLES,
-        "dwivedi_seconds": to1 + to2, "dwivedi_samples": 2 * DWIVEDI_SAMPLES,
+    cycles = [harness.cycles_render(scene, seed, CYCLES_SAMPLES, WORK / f"{name}_cycles_{seed}.exr") for seed in (1, 2)]
+    ours = [harness.dwivedi_bake(scene, seed, DWIVEDI_SAMPLES, WORK / f"{name}_dwivedi_{seed}") for seed in (1, 2)]
+    figures = harness.compare_two_seeds([p for p, _ in cycles], [p for p, _ in ours])
+    figures.update({
+        "cycles_seconds": sum(t for _, t in cycles), "cycles_samples": 2 * CYCLES_SAMPLES,
+        "dwivedi_seconds": sum(t for _, t in ours), "dwivedi_samples": 2 * DWIVEDI_SAMPLES,
         "resolution": RESOLUTION,
-    }
+    })
     FIGURES[name] = figures
     print(f"\n{name}: " + json.dumps(figures, indent=1), flush=True)
     (harness.HOME / "cycles_figures.json").write_text(json.dumps(FIGURES, indent=2))

@@ -40,6 +40,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import bpy  # noqa: E402
 
+import harness  # noqa: E402  (beside this file: run_package_tests.py copies it)
 import scenes  # noqa: E402
 
 HOME = Path(os.environ["DWIVEDI_TEST_HOME"])
@@ -80,39 +81,8 @@ def check_home():
     OUT.mkdir(parents=True)
 
 
-def preload_scratch_dependencies():
-    """Only for a bundled library that still links its dependencies dynamically (the scratch set-up
-    of run_package_tests.py, never the package): loads them first so the loader finds them."""
-    folder = os.environ.get("DWIVEDI_TEST_PRELOAD")
-    if not folder:
-        return
-    pending = sorted(str(p) for p in Path(folder).iterdir())
-    while pending:
-        left = []
-        for path in pending:
-            try:
-                ctypes.CDLL(path, mode=ctypes.RTLD_GLOBAL)
-            except OSError:
-                left.append(path)
-        if len(left) == len(pending):
-            raise SystemExit(f"test_package: cannot preload {left}")
-        pending = left
-
-
 def module():
     return sys.modules[MODULE]
-
-
-def operator(**settings):
-    """bpy.ops.dwivedi.bake() with scene.dwivedi_bake fields set: (result, error text or None). In
-    background mode an ERROR report raises RuntimeError carrying it."""
-    props = bpy.context.scene.dwivedi_bake
-    for key, value in settings.items():
-        setattr(props, key, value)
-    try:
-        return bpy.ops.dwivedi.bake(), None
-    except RuntimeError as error:
-        return {'CANCELLED'}, str(error)
 
 
 class RecordingLayout:
@@ -187,7 +157,7 @@ class PackageTest(unittest.TestCase):
         self.assertIn(fragment, shown.replace("  ", " "))
         self.assertIn(("operator", "dwivedi.bake", ""), labels, "the panel stays usable")
         before = snapshot(OUT)
-        result, error = operator()
+        result, error = harness.call_operator()
         self.assertEqual(result, {'CANCELLED'})
         self.assertIsNotNone(error, "the bake reports an error")
         self.assertIn("the dwivedi library cannot be used", error)
@@ -250,9 +220,9 @@ class PackageTest(unittest.TestCase):
     @timed("camera and UV bakes")
     def test_04_bakes(self):
         put(WORK / "good-libdwivedi.so.1", bundled_library())
-        preload_scratch_dependencies()
+        harness.preload_scratch_dependencies()
         scene = slab()
-        result, error = operator()
+        result, error = harness.call_operator()
         self.assertEqual(result, {'FINISHED'}, error)
         self.assertTrue(module().library_status().ok)
         shim = module().shim()
@@ -267,7 +237,8 @@ class PackageTest(unittest.TestCase):
         warnings = scene.dwivedi_bake.last_warnings
         # Every subsurface method of every version is mapped to its own Cycles model (test_fidelity).
         self.assertFalse([w for w in warnings.split("\n") if "not mapped" in w], warnings)
-        result, error = operator(target='UV', uv_object=bpy.data.objects["Slab"], uv_size=32, uv_margin=2)
+        result, error = harness.call_operator(target='UV', uv_object=bpy.data.objects["Slab"], uv_size=32,
+                                              uv_margin=2)
         self.assertEqual(result, {'FINISHED'}, error)
         self.assertTrue((OUT / f"{scene.name}_uv_Slab.exr").is_file())
         self.assertEqual(tuple(bpy.data.images["Dwivedi UV"].size), (32, 32))
@@ -286,7 +257,7 @@ class PackageTest(unittest.TestCase):
         try:
             start = time.monotonic()
             timer.start()
-            result, error = operator(samples=1 << 22)
+            result, error = harness.call_operator(samples=1 << 22)
             seconds = time.monotonic() - start
         finally:
             timer.cancel()
@@ -294,7 +265,7 @@ class PackageTest(unittest.TestCase):
         self.assertIsNone(error, "a cancel is a warning, not an error")
         self.assertLess(seconds, 30.0, "it stopped soon after the signal")
         self.assertEqual(os.listdir(OUT), [], "a cancelled bake writes nothing")
-        result, error = operator(samples=4)
+        result, error = harness.call_operator(samples=4)
         self.assertEqual(result, {'FINISHED'}, error)
         self.assertTrue((OUT / f"{scene.name}_camera.exr").is_file())
 
@@ -309,7 +280,7 @@ class PackageTest(unittest.TestCase):
         self.assertRefused("libdwivedi_test_missing.so.7")
         self.assertIn("the library named in the add-on preferences", module().library_status().message)
         prefs.library_path = ""
-        result, error = operator()
+        result, error = harness.call_operator()
         self.assertEqual(result, {'FINISHED'}, error)
         # The loaded file replaced under Blender (an update while it runs): restart, it says.
         library = bundled_library()
@@ -318,7 +289,7 @@ class PackageTest(unittest.TestCase):
         put(WORK / "good-libdwivedi.so.1", library)
         self.assertRefused("was replaced since Blender loaded it: restart Blender")
         os.replace(keep, library)
-        result, error = operator()
+        result, error = harness.call_operator()
         self.assertEqual(result, {'FINISHED'}, error)
 
     @timed("read-only folder")
@@ -333,10 +304,10 @@ class PackageTest(unittest.TestCase):
             self.assertEqual(bpy.ops.preferences.addon_enable(module=MODULE), {'FINISHED'})
             self.assertTrue(module().library_status().ok, module().library_status().message)
             scene = slab()
-            result, error = operator()
+            result, error = harness.call_operator()
             self.assertEqual(result, {'FINISHED'}, error)
             # An unsaved file's "//" folder: the extension's user folder on 4.2+, never the package.
-            result, error = operator(output_dir="//dwivedi_bake/")
+            result, error = harness.call_operator(output_dir="//dwivedi_bake/")
             self.assertEqual(result, {'FINISHED'}, error)
             written = Path(module().output_folder(scene.dwivedi_bake))
             self.assertTrue((written / f"{scene.name}_camera.exr").is_file())
@@ -368,7 +339,7 @@ class PackageTest(unittest.TestCase):
             self.assertNotIn(other, sys.modules)
             self.assertTrue(addon_utils.check(MODULE)[1], "the first copy still is")
             slab()
-            result, error = operator()
+            result, error = harness.call_operator()
             self.assertEqual(result, {'FINISHED'}, error)
             if EXTENSIONS:
                 # The other order: the legacy add-on enabled first, then the extension refused.
@@ -380,7 +351,7 @@ class PackageTest(unittest.TestCase):
                 self.assertTrue(addon_utils.check(other)[1])
                 self.assertEqual(bpy.ops.preferences.addon_disable(module=other), {'FINISHED'})
                 self.assertEqual(bpy.ops.preferences.addon_enable(module=MODULE), {'FINISHED'})
-                result, error = operator()
+                result, error = harness.call_operator()
                 self.assertEqual(result, {'FINISHED'}, error)
         finally:
             # (Not addon_remove: in background mode it fails in Blender's own code, on context.area.)
@@ -397,7 +368,7 @@ class PackageTest(unittest.TestCase):
         self.assertFalse(hasattr(bpy.types, "DWIVEDI_OT_bake"))
         self.assertEqual(bpy.ops.preferences.addon_enable(module=MODULE), {'FINISHED'})
         slab()
-        result, error = operator()
+        result, error = harness.call_operator()
         self.assertEqual(result, {'FINISHED'}, error)
 
 
