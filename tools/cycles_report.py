@@ -487,9 +487,11 @@ def markdown(data: Dict[str, Any], made: List[str]) -> str:
     if data.get("cycles"):
         first = next(iter(data["cycles"].values()))
         lines += ["## Against Cycles", "",
+                  f"dwivedi's bakes here use {data.get('cycles_library', data['library'])}. "
                   "Same Blender scene, same 2 threads, in each Blender named (the host's, and those of the "
                   "trixie and sid chroots: the same scene script, that Blender's Cycles and the add-on's "
-                  "export for that version). Each renderer's RMSE is measured against its own "
+                  "export for that version; 5.2's Principled and Subsurface Scattering nodes with its Legacy "
+                  "method, the medium of the other versions). Each renderer's RMSE is measured against its own "
                   "converged image (Cycles and dwivedi each at 4x their largest count, other seeds), so that "
                   "noise is compared with noise; how far the two converged images lie apart is its own column "
                   "(Cycles stops walks at 256 bounces and loses energy where dwivedi does not, "
@@ -606,6 +608,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             data["cycles_skipped"] = "Blender was not found"
         else:
             data["cycles"] = {}
+            data["cycles_library"] = args.library or dwivedi.library_path()
             cycles_size = args.size or (32 if args.quick else 48)
             for where in blenders:
                 print(f"Cycles ({where})", file=sys.stderr, flush=True)
