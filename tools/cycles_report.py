@@ -548,7 +548,9 @@ def markdown(data: Dict[str, Any], made: List[str]) -> str:
             for name in run["scenes"]:
                 if f"cycles_{where}_{name}.png" in made:
                     lines += ["", f"![{name} against Blender {run['blender']}'s Cycles](cycles_{where}_{name}.png)"]
-    elif data.get("cycles_skipped"):
+    for where, error in data.get("cycles_failed", {}).items():
+        lines += ["", f"Against Cycles in {where}: failed ({error.splitlines()[0]})."]
+    if data.get("cycles_skipped"):
         lines += ["", "## Against Cycles", "", f"Not run: {data['cycles_skipped']}"]
     return "\n".join(lines) + "\n"
 
@@ -612,8 +614,12 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             cycles_size = args.size or (32 if args.quick else 48)
             for where in blenders:
                 print(f"Cycles ({where})", file=sys.stderr, flush=True)
-                data["cycles"][where] = cycles_section(args.quick, args.blender, cycles_size, cycles_scenes, repeats,
-                                                       where, args.library)
+                try:
+                    data["cycles"][where] = cycles_section(args.quick, args.blender, cycles_size, cycles_scenes,
+                                                           repeats, where, args.library)
+                except RuntimeError as error:  # the other Blenders' figures are still written
+                    data.setdefault("cycles_failed", {})[where] = str(error)
+                    print(f"cycles_report: {error}", file=sys.stderr, flush=True)
         made = plots(args.out, data)
         text = markdown(data, made)
         (args.out / "report.md").write_text(text)
@@ -622,7 +628,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         print(f"cycles_report: {error}", file=sys.stderr)
         return 1
     print(f"cycles_report: wrote {args.out / 'report.md'} and {len(made)} plot(s)", file=sys.stderr)
-    return 0
+    return 1 if data.get("cycles_failed") else 0
 
 
 if __name__ == "__main__":

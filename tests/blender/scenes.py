@@ -92,7 +92,9 @@ def sss_node_material(name, color, radius, scale=1.0):
     tree = material.node_tree
     tree.nodes.remove(tree.nodes["Principled BSDF"])
     node = tree.nodes.new("ShaderNodeSubsurfaceScattering")
-    node.falloff = 'RANDOM_WALK_FIXED_RADIUS'
+    # 3.x's Fixed Radius walk; 4.0-5.1 store it as Random Walk, 5.2 calls it Random Walk (Legacy).
+    falloffs = [item.identifier for item in node.bl_rna.properties["falloff"].enum_items]
+    node.falloff = next(m for m in ('RANDOM_WALK_FIXED_RADIUS', 'RANDOM_WALK_LEGACY', 'RANDOM_WALK') if m in falloffs)
     node.inputs["Color"].default_value = (color[0], color[1], color[2], 1.0)
     node.inputs["Scale"].default_value = scale
     node.inputs["Radius"].default_value = tuple(radius)
