@@ -40,8 +40,6 @@ import bpy  # noqa: E402
 import harness  # noqa: E402
 import scenes  # noqa: E402
 
-
-
 WORK = harness.install_addon()
 RESOLUTION = int(os.environ.get("DWIVEDI_FIDELITY_RESOLUTION", "48"))
 SLAB_RESOLUTION = RESOLUTION * 2 // 3
@@ -65,7 +63,8 @@ def bake_warnings():
 
 
 def compare(name, scene, cycles_samples, dwivedi_samples):
-    cycles = [harness.cycles_render(scene, seed, cycles_samples, WORK / f"{name}_cycles_{seed}.exr") for seed in (1, 2)]
+    cycles = [harness.cycles_render(scene, seed, cycles_samples, WORK / f"{name}_cycles_{seed}.exr")
+              for seed in (1, 2)]
     # Cycles' own cap of 256 events per walk (BSSRDF_MAX_BOUNCES): at the same settings as its render.
     ours = [harness.dwivedi_bake(scene, seed, dwivedi_samples, WORK / f"{name}_dwivedi_{seed}", CYCLES_EVENT_CAP)
             for seed in (1, 2)]
