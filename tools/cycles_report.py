@@ -307,7 +307,7 @@ def cycles_section(quick: bool, blender: str, size: int, scenes: Sequence[str], 
     if not (scenes_dir / "scenes.py").is_file() or not (addon_dir / "dwivedi_bake").is_dir():
         raise RuntimeError(f"the Cycles comparison needs the source tree (tests/blender, blender_addon) at {SOURCE_DIR}")
     library = library or dwivedi.library_path()
-    if not os.path.isabs(library) or not os.path.isfile(library):
+    if library and not os.path.isfile(library) and (where != "host" or os.path.isabs(library)):
         raise RuntimeError(f"the dwivedi library {library!r} is not a file (--library)")
     chroot = None
     if where != "host":
@@ -357,7 +357,8 @@ def cycles_section(quick: bool, blender: str, size: int, scenes: Sequence[str], 
             completed = subprocess.run(command, capture_output=True, text=True)
         else:
             env = dict(os.environ)
-            env["DWIVEDI_LIBRARY"] = library_seen
+            # A bare name (the loader's search) stays with what the environment already says.
+            env["DWIVEDI_LIBRARY"] = library_seen if os.path.isabs(library_seen) else env.get("DWIVEDI_LIBRARY", "")
             completed = subprocess.run(command, env=env, capture_output=True, text=True)
         if completed.returncode != 0 or not result_path.is_file():
             tail = "\n".join((completed.stdout + completed.stderr).splitlines()[-15:])
