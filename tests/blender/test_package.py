@@ -50,8 +50,8 @@ FIXTURES = Path(os.environ["DWIVEDI_FIXTURES"])
 TIMES_FILE = os.environ.get("DWIVEDI_TEST_TIMES")
 WORK = HOME / "work"
 OUT = WORK / "out"
-EXTENSIONS = bpy.app.version >= (4, 2, 0)
-MODULE = "bl_ext.user_default.dwivedi_bake" if EXTENSIONS else "dwivedi_bake"
+EXTENSIONS = harness.EXTENSIONS  # 4.2+: the extension package, else the legacy zip
+MODULE = harness.MODULE
 TIMES = {}
 
 
