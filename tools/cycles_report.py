@@ -1,5 +1,6 @@
 """The error-against-run-time report: python3 tools/cycles_report.py --out DIR [--quick] [--no-cycles]
 [--sections v0,techniques,cycles] [--cycles-scenes slab,leaf,sphere] [--repeats N]
+[--cycles-blenders host,trixie,sid] [--library PATH]
 
 Runs benchmark scenes through the shim and writes DIR/report.md, DIR/report.json and plots
 (matplotlib, Debian python3-matplotlib; without it the report has tables only):
@@ -22,7 +23,11 @@ Runs benchmark scenes through the shim and writes DIR/report.md, DIR/report.json
    render time minus that of a 1-sample render (scene sync), dwivedi's the bake's own seconds.
    The two take turns over N timing rounds (--repeats, default 3) and each sample count keeps its
    fastest time; at the counts both ran, the variance ratio per sample is reported apart, since
-   it does not depend on the machine's load.
+   it does not depend on the machine's load. --cycles-blenders runs this in each Blender named:
+   the host's (3.4) and those of the trixie (4.3) and sid (5.2) chroots (root; the chroots as the
+   tests make and enter them, tests/blender/run_package_tests.py), with the same scene script and
+   the add-on's export for that version; --library names the library the bakes use (the chroots
+   need the self-contained one). One Blender per run is fine too (a report per version).
 
 Timings are measured on whatever else runs on the machine: ratios within one run are fair,
 absolute seconds are not. Exit status 1 with a message on failure.
@@ -129,6 +134,7 @@ def default_scene() -> dwivedi.Scene:
 SCENES = {"default": default_scene, "slab": slab_scene, "sphere": sphere_scene}
 SECTIONS = ("v0", "techniques", "cycles")
 CYCLES_SCENES = ("slab", "leaf", "sphere")
+BLENDERS = ("host", "trixie", "sid")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -226,6 +232,13 @@ for name in args["scenes_list"]:
                 # The Subsurface Scattering node: the plain walk, which Blender 3.x's Principled is not.
                 "sphere": lambda r, s: scenes.sphere_scene(r, s, shader='SSS')}
     scene = builders[name](args["size"], 16)
+    # The same media in every Blender: 5.2's new Random Walk reads the radius as the mean free path
+    # (4 pi longer than before); its Legacy method is the model the other versions' scenes use.
+    for material in bpy.data.materials:
+        for node in (material.node_tree.nodes if material.use_nodes else ()):
+            if getattr(node, "subsurface_method", None) == 'RANDOM_WALK' and 'RANDOM_WALK_LEGACY' in [
+                    item.identifier for item in node.bl_rna.properties["subsurface_method"].enum_items]:
+                node.subsurface_method = 'RANDOM_WALK_LEGACY'
     work = args["work"]
     overhead = cycles(scene, 1, 0, f"{work}/{name}_c1.exr")
     ref_spp = 4 * args["cycles_counts"][-1]
@@ -277,34 +290,82 @@ for name in args["scenes_list"]:
     out[name] = entry
     print("scene", name, "done", file=sys.stderr, flush=True)
 with open(args["result"], "w") as f:
-    json.dump(out, f)
+    json.dump({"blender": bpy.app.version_string, "scenes": out}, f)
 '''
 
 
-def cycles_section(quick: bool, blender: str, size: int, scenes: Sequence[str], repeats: int) -> Dict[str, Any]:
+def cycles_section(quick: bool, blender: str, size: int, scenes: Sequence[str], repeats: int,
+                   where: str = "host", library: Optional[str] = None) -> Dict[str, Any]:
+    """The Cycles comparison in one Blender: `blender` on the host (where = "host"), or the Blender
+    of the trixie / sid chroot (scripts/blender-chroots.sh, run the way the tests run it:
+    tests/blender/run_package_tests.py's make_chroot and blender_command; root). `library`: the
+    dwivedi library the bakes use (default the shim's; a chroot needs the self-contained one,
+    build/portable/libdwivedi.so.1). Returns {"blender": version, "scenes": {name: entry}}."""
     scenes_dir = SOURCE_DIR / "tests" / "blender"
     addon_dir = SOURCE_DIR / "blender_addon"
+    shim_dir = Path(dwivedi.__file__).resolve().parent.parent
     if not (scenes_dir / "scenes.py").is_file() or not (addon_dir / "dwivedi_bake").is_dir():
         raise RuntimeError(f"the Cycles comparison needs the source tree (tests/blender, blender_addon) at {SOURCE_DIR}")
-    with tempfile.TemporaryDirectory() as work:
-        result_path = Path(work) / "result.json"
-        args = {"shim": str(Path(dwivedi.__file__).resolve().parent.parent), "addon": str(addon_dir), "scenes": str(scenes_dir), "work": work,
-                "result": str(result_path), "size": size, "scenes_list": list(scenes), "repeats": repeats,
+    library = library or dwivedi.library_path()
+    if library and not os.path.isfile(library) and (where != "host" or os.path.isabs(library)):
+        raise RuntimeError(f"the dwivedi library {library!r} is not a file (--library)")
+    chroot = None
+    if where != "host":
+        sys.path.insert(0, str(scenes_dir))
+        import run_package_tests as runner  # the tests' chroot machinery, standard library only
+        chroot = runner.make_chroot(where)
+        blender = "/usr/bin/blender"
+        holder = tempfile.TemporaryDirectory(dir=chroot / "tmp", prefix="dwivedi-report-")
+    else:
+        holder = tempfile.TemporaryDirectory()
+    with holder as work:
+        stage = Path(work)
+
+        def inside(path: Path) -> str:
+            return "/" + str(Path(path).relative_to(chroot)) if chroot is not None else str(path)
+
+        if chroot is not None:
+            # Copies of the shim, the add-on's source, the scenes and the library inside the chroot.
+            shutil.copytree(shim_dir / "dwivedi", stage / "shim" / "dwivedi")
+            shutil.copytree(addon_dir / "dwivedi_bake", stage / "addon" / "dwivedi_bake")
+            (stage / "scenes").mkdir()
+            shutil.copy2(scenes_dir / "scenes.py", stage / "scenes" / "scenes.py")
+            shutil.copy2(library, stage / "libdwivedi.so.1")
+            paths = {"shim": stage / "shim", "addon": stage / "addon", "scenes": stage / "scenes"}
+            library_seen = inside(stage / "libdwivedi.so.1")
+        else:
+            paths = {"shim": shim_dir, "addon": addon_dir, "scenes": scenes_dir}
+            library_seen = library
+        result_path = stage / "result.json"
+        args = {**{key: inside(value) for key, value in paths.items()}, "work": inside(stage),
+                "result": inside(result_path), "size": size, "scenes_list": list(scenes), "repeats": repeats,
                 # Counts large enough that Cycles' render time, not its per-render overhead, is
                 # what is measured.
                 "cycles_counts": [32, 128, 512] if quick else [64, 256, 1024],
                 "dwivedi_counts": [8, 32, 128] if quick else [16, 64, 256, 1024]}
-        script = Path(work) / "bench.py"
+        script = stage / "bench.py"
         script.write_text(BLENDER_SCRIPT)
-        env = dict(os.environ)
-        library = dwivedi.library_path()
-        env["DWIVEDI_LIBRARY"] = library if os.path.isabs(library) else env.get("DWIVEDI_LIBRARY", "")
-        completed = subprocess.run([blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python",
-                                    str(script), "--", json.dumps(args)], env=env, capture_output=True, text=True)
+        command = [blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python", inside(script), "--",
+                   json.dumps(args)]
+        if chroot is not None:
+            home = stage / "home"
+            home.mkdir()
+            env = {"HOME": inside(home), "PATH": "/usr/local/bin:/usr/bin:/bin", "LANG": "C.UTF-8",
+                   "TMPDIR": inside(stage), "DWIVEDI_LIBRARY": library_seen, "PYTHONDONTWRITEBYTECODE": "1",
+                   "BLENDER_USER_SCRIPTS": inside(home / "scripts"), "BLENDER_USER_CONFIG": inside(home / "config")}
+            command = runner.blender_command(command, env, chroot)
+            completed = subprocess.run(command, capture_output=True, text=True)
+        else:
+            env = dict(os.environ)
+            # A bare name (the loader's search) stays with what the environment already says.
+            env["DWIVEDI_LIBRARY"] = library_seen if os.path.isabs(library_seen) else env.get("DWIVEDI_LIBRARY", "")
+            completed = subprocess.run(command, env=env, capture_output=True, text=True)
         if completed.returncode != 0 or not result_path.is_file():
             tail = "\n".join((completed.stdout + completed.stderr).splitlines()[-15:])
-            raise RuntimeError(f"the Blender benchmark failed:\n{tail}")
-        return json.loads(result_path.read_text())
+            raise RuntimeError(f"the Blender benchmark ({where}) failed:\n{tail}")
+        result = json.loads(result_path.read_text())
+        result["where"] = where
+        return result
 
 
 def noise_only(points: List[Dict[str, float]], reference_samples: int) -> List[Dict[str, float]]:
@@ -335,6 +396,12 @@ def time_to_rmse(points: List[Dict[str, float]], target: float) -> Optional[floa
 # ---------------------------------------------------------------------------------------------
 # Output
 # ---------------------------------------------------------------------------------------------
+
+def cycles_entries(data: Dict[str, Any]) -> List[Tuple[str, str, Dict[str, Any]]]:
+    """(where, scene, entry) of every Cycles comparison of the report, per Blender in run order."""
+    return [(where, name, entry) for where, run in data.get("cycles", {}).items()
+            for name, entry in run["scenes"].items()]
+
 
 def plots(out: Path, data: Dict[str, Any]) -> List[str]:
     try:
@@ -372,20 +439,20 @@ def plots(out: Path, data: Dict[str, Any]) -> List[str]:
         fig.savefig(out / f"rmse_{name}.png", dpi=100)
         pyplot.close(fig)
         made.append(f"rmse_{name}.png")
-    for name, entry in data.get("cycles", {}).items():
+    for where, name, entry in cycles_entries(data):
         fig, ax = pyplot.subplots(figsize=(6, 4))
         for who, reference in (("cycles", entry["reference_samples"]), ("dwivedi", entry["dwivedi_reference_samples"])):
             points = noise_only(entry[who], reference)
             ax.loglog([p["seconds"] for p in points], [p["rmse"] for p in points], marker="o", label=who)
         ax.set_xlabel("seconds (2 threads)")
         ax.set_ylabel("RMSE against the converged image (noise only)")
-        ax.set_title(f"{name}: dwivedi against Cycles")
+        ax.set_title(f"{name}: dwivedi against Cycles of Blender {data['cycles'][where]['blender']}")
         ax.legend()
         ax.grid(True, which="both", alpha=0.3)
         fig.tight_layout()
-        fig.savefig(out / f"cycles_{name}.png", dpi=100)
+        fig.savefig(out / f"cycles_{where}_{name}.png", dpi=100)
         pyplot.close(fig)
-        made.append(f"cycles_{name}.png")
+        made.append(f"cycles_{where}_{name}.png")
     return made
 
 
@@ -419,51 +486,72 @@ def markdown(data: Dict[str, Any], made: List[str]) -> str:
                 lines += ["", f"![{name}](rmse_{name}.png)"]
             lines.append("")
     if data.get("cycles"):
+        first = next(iter(data["cycles"].values()))
         lines += ["## Against Cycles", "",
-                  "Same Blender scene, same 2 threads. Each renderer's RMSE is measured against its own "
+                  f"dwivedi's bakes here use {data.get('cycles_library', data['library'])}. "
+                  "Same Blender scene, same 2 threads, in each Blender named (the host's, and those of the "
+                  "trixie and sid chroots: the same scene script, that Blender's Cycles and the add-on's "
+                  "export for that version; 5.2's Principled and Subsurface Scattering nodes with its Legacy "
+                  "method, the medium of the other versions). Each renderer's RMSE is measured against its own "
                   "converged image (Cycles and dwivedi each at 4x their largest count, other seeds), so that "
                   "noise is compared with noise; how far the two converged images lie apart is its own column "
                   "(Cycles stops walks at 256 bounces and loses energy where dwivedi does not, "
                   "docs/cycles_energy_loss.md). Cycles' seconds exclude its scene sync (a 1-sample render's "
                   "time), dwivedi's are the bake's own (its auto pilot included); both take turns over "
-                  f"{next(iter(data['cycles'].values())).get('repeats', 1)} timing round(s) and each count keeps "
-                  "its fastest time. RMSEs here are the noise alone: the reference's own noise, 1 / (4x) of a "
-                  "point's variance at its largest count, is taken out of each (noise_only). Speed-up = "
+                  f"{next(iter(first['scenes'].values())).get('repeats', 1)} timing round(s) and each count "
+                  "keeps its fastest time. RMSEs here are the noise alone: the reference's own noise, 1 / (4x) "
+                  "of a point's variance at its largest count, is taken out of each (noise_only). Speed-up = "
                   "Cycles' time / dwivedi's time to reach the RMSE of dwivedi's second-largest bake (log-log "
-                  "interpolation, and beyond the last point along RMSE ~ 1/sqrt(time)).",
-                  "",
-                  "| scene | converged Cycles mean RGB | converged dwivedi mean RGB | RMSE between converged | "
-                  "target RMSE | Cycles s | dwivedi s | speed-up |", "|---|---|---|---|---|---|---|---|"]
-        clean = {name: (noise_only(entry["cycles"], entry["reference_samples"]),
-                        noise_only(entry["dwivedi"], entry["dwivedi_reference_samples"]))
-                 for name, entry in data["cycles"].items()}
-        for name, entry in data["cycles"].items():
-            theirs_clean, ours_clean = clean[name]
+                  "interpolation, and beyond the last point along RMSE ~ 1/sqrt(time)): the ratio of the two "
+                  "efficiencies 1 / (RMSE^2 x seconds) at that RMSE.", ""]
+        clean = {(where, name): (noise_only(entry["cycles"], entry["reference_samples"]),
+                                 noise_only(entry["dwivedi"], entry["dwivedi_reference_samples"]))
+                 for where, name, entry in cycles_entries(data)}
+        for where, name, entry in cycles_entries(data):
+            theirs_clean, ours_clean = clean[where, name]
             target = ours_clean[-2]["rmse"]
-            tc = time_to_rmse(theirs_clean, target)
-            td = time_to_rmse(ours_clean, target)
-            speed = f"{tc / td:.2f}x" if tc and td else "n/a"
-            lines.append(f"| {name} | " + ", ".join(f"{v:.4f}" for v in entry["cycles_reference_mean_rgb"]) + " | "
-                         + ", ".join(f"{v:.4f}" for v in entry["dwivedi_reference_mean_rgb"]) +
-                         f" | {entry['converged_rmse']:.3g} | {target:.4g} | {tc or math.nan:.3g} | "
-                         f"{td or math.nan:.3g} | {speed} |")
-            entry["speedup_at_rmse"] = {"rmse": target, "cycles_seconds": tc, "dwivedi_seconds": td}
-        lines += ["", "At equal samples per pixel the speed-up splits into variance per sample (independent of "
-                  "the machine's load) and time per sample:", "",
-                  "| scene | spp | Cycles RMSE | dwivedi RMSE | variance ratio Cycles / dwivedi | Cycles s | "
-                  "dwivedi s |", "|---|---|---|---|---|---|---|"]
-        for name, entry in data["cycles"].items():
-            ours = {p["samples"]: p for p in clean[name][1]}
-            for theirs in clean[name][0]:
-                if theirs["samples"] in ours:
-                    mine = ours[theirs["samples"]]
-                    lines.append(f"| {name} | {theirs['samples']} | {theirs['rmse']:.4g} | {mine['rmse']:.4g} | "
-                                 f"{(theirs['rmse'] / mine['rmse']) ** 2:.3g} | {theirs['seconds']:.3g} | "
-                                 f"{mine['seconds']:.3g} |")
-        for name in data["cycles"]:
-            if f"cycles_{name}.png" in made:
-                lines += ["", f"![{name} against Cycles](cycles_{name}.png)"]
-    elif data.get("cycles_skipped"):
+            entry["speedup_at_rmse"] = {"rmse": target, "cycles_seconds": time_to_rmse(theirs_clean, target),
+                                        "dwivedi_seconds": time_to_rmse(ours_clean, target)}
+        names = list(dict.fromkeys(name for _, name, _ in cycles_entries(data)))
+        lines += ["| scene | " + " | ".join(f"Blender {run['blender']} ({where})" for where, run in
+                                             data["cycles"].items()) + " |",
+                  "|---|" + "---|" * len(data["cycles"])]
+        for name in names:
+            cells = []
+            for where, run in data["cycles"].items():
+                speed = run["scenes"].get(name, {}).get("speedup_at_rmse", {})
+                tc, td = speed.get("cycles_seconds"), speed.get("dwivedi_seconds")
+                cells.append(f"{tc / td:.2f}x" if tc and td else "n/a")
+            lines.append(f"| {name} | " + " | ".join(cells) + " |")
+        for where, run in data["cycles"].items():
+            lines += ["", f"### Blender {run['blender']} ({where})", "",
+                      "| scene | converged Cycles mean RGB | converged dwivedi mean RGB | RMSE between converged | "
+                      "target RMSE | Cycles s | dwivedi s | speed-up |", "|---|---|---|---|---|---|---|---|"]
+            for name, entry in run["scenes"].items():
+                speed = entry["speedup_at_rmse"]
+                tc, td = speed["cycles_seconds"], speed["dwivedi_seconds"]
+                lines.append(f"| {name} | " + ", ".join(f"{v:.4f}" for v in entry["cycles_reference_mean_rgb"])
+                             + " | " + ", ".join(f"{v:.4f}" for v in entry["dwivedi_reference_mean_rgb"]) +
+                             f" | {entry['converged_rmse']:.3g} | {speed['rmse']:.4g} | {tc or math.nan:.3g} | "
+                             f"{td or math.nan:.3g} | " + (f"{tc / td:.2f}x" if tc and td else "n/a") + " |")
+            lines += ["", "At equal samples per pixel the speed-up splits into variance per sample (independent of "
+                      "the machine's load) and time per sample:", "",
+                      "| scene | spp | Cycles RMSE | dwivedi RMSE | variance ratio Cycles / dwivedi | Cycles s | "
+                      "dwivedi s |", "|---|---|---|---|---|---|---|"]
+            for name in run["scenes"]:
+                ours = {p["samples"]: p for p in clean[where, name][1]}
+                for theirs in clean[where, name][0]:
+                    if theirs["samples"] in ours:
+                        mine = ours[theirs["samples"]]
+                        lines.append(f"| {name} | {theirs['samples']} | {theirs['rmse']:.4g} | {mine['rmse']:.4g} | "
+                                     f"{(theirs['rmse'] / mine['rmse']) ** 2:.3g} | {theirs['seconds']:.3g} | "
+                                     f"{mine['seconds']:.3g} |")
+            for name in run["scenes"]:
+                if f"cycles_{where}_{name}.png" in made:
+                    lines += ["", f"![{name} against Blender {run['blender']}'s Cycles](cycles_{where}_{name}.png)"]
+    for where, error in data.get("cycles_failed", {}).items():
+        lines += ["", f"Against Cycles in {where}: failed ({error.splitlines()[0]})."]
+    if data.get("cycles_skipped"):
         lines += ["", "## Against Cycles", "", f"Not run: {data['cycles_skipped']}"]
     return "\n".join(lines) + "\n"
 
@@ -482,17 +570,27 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
                         help=f"the scenes compared with Cycles, comma-separated (default: {','.join(CYCLES_SCENES)})")
     parser.add_argument("--repeats", type=int, default=None,
                         help="timing rounds against Cycles, each count keeping its fastest time (default 3, quick 1)")
+    parser.add_argument("--cycles-blenders", default="host",
+                        help="the Blenders whose Cycles is compared, comma-separated, in this order: host (--blender), "
+                             "trixie (4.3), sid (5.2) (the chroots of scripts/blender-chroots.sh; root). Default host")
+    parser.add_argument("--library", default=None,
+                        help="the dwivedi library the Cycles part bakes with (default the shim's; the chroots need "
+                             "the self-contained build/portable/libdwivedi.so.1)")
     args = parser.parse_args(argv)
+    blenders = [name for name in args.cycles_blenders.split(",") if name]
     size = args.size or (16 if args.quick else 32)
     sections = [part for part in args.sections.split(",") if part]
     cycles_scenes = [name for name in args.cycles_scenes.split(",") if name]
     repeats = args.repeats if args.repeats is not None else (1 if args.quick else 3)
-    unknown = [part for part in sections if part not in SECTIONS] + [n for n in cycles_scenes if n not in CYCLES_SCENES]
-    if unknown or not sections or not cycles_scenes or not 1 <= repeats <= 100:
-        problem = (f"unknown section or scene {unknown[0]!r}" if unknown else "no section or scene given"
-                   if not sections or not cycles_scenes else f"--repeats {repeats} is outside 1 to 100")
-        print(f"cycles_report: {problem} (sections: {', '.join(SECTIONS)}; scenes: {', '.join(CYCLES_SCENES)})",
-              file=sys.stderr)
+    unknown = ([part for part in sections if part not in SECTIONS]
+               + [n for n in cycles_scenes if n not in CYCLES_SCENES]
+               + [n for n in blenders if n not in BLENDERS])
+    if unknown or not sections or not cycles_scenes or not blenders or not 1 <= repeats <= 100:
+        problem = (f"unknown section, scene or Blender {unknown[0]!r}" if unknown else "no section, scene or Blender "
+                   "given" if not sections or not cycles_scenes or not blenders else
+                   f"--repeats {repeats} is outside 1 to 100")
+        print(f"cycles_report: {problem} (sections: {', '.join(SECTIONS)}; scenes: {', '.join(CYCLES_SCENES)}; "
+              f"Blenders: {', '.join(BLENDERS)})", file=sys.stderr)
         return 1
     try:
         args.out.mkdir(parents=True, exist_ok=True)
@@ -509,12 +607,20 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             pass
         elif args.no_cycles:
             data["cycles_skipped"] = "--no-cycles"
-        elif not args.blender:
+        elif not args.blender and "host" in blenders:
             data["cycles_skipped"] = "Blender was not found"
         else:
-            print("Cycles", file=sys.stderr, flush=True)
-            data["cycles"] = cycles_section(args.quick, args.blender, args.size or (32 if args.quick else 48),
-                                            cycles_scenes, repeats)
+            data["cycles"] = {}
+            data["cycles_library"] = args.library or dwivedi.library_path()
+            cycles_size = args.size or (32 if args.quick else 48)
+            for where in blenders:
+                print(f"Cycles ({where})", file=sys.stderr, flush=True)
+                try:
+                    data["cycles"][where] = cycles_section(args.quick, args.blender, cycles_size, cycles_scenes,
+                                                           repeats, where, args.library)
+                except RuntimeError as error:  # the other Blenders' figures are still written
+                    data.setdefault("cycles_failed", {})[where] = str(error)
+                    print(f"cycles_report: {error}", file=sys.stderr, flush=True)
         made = plots(args.out, data)
         text = markdown(data, made)
         (args.out / "report.md").write_text(text)
@@ -523,7 +629,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         print(f"cycles_report: {error}", file=sys.stderr)
         return 1
     print(f"cycles_report: wrote {args.out / 'report.md'} and {len(made)} plot(s)", file=sys.stderr)
-    return 0
+    return 1 if data.get("cycles_failed") else 0
 
 
 if __name__ == "__main__":

@@ -320,10 +320,12 @@ static void specular_init(dwvb_material *out, const dwv_material_t *in)
         double q = sqrt(fmin(fmax(f0, 0.0), 0.99));
         eta = (1.0 + q) / (1.0 - q);
     }
+    /* Kept when the layer vanishes too (f0 = 0, eta = 1: Specular IOR Level 0): the refraction
+     * entry still takes this eta (clamped to 1.01 there), not `ior`, as Cycles' bssrdf->ior. */
+    out->spec_eta = eta;
     if (!(eta != 1.0)) return;
     out->specular = DWV_SPECULAR_PRINCIPLED_V2;
     out->spec_multiscatter = in->specular_multiscatter;
-    out->spec_eta = eta;
     double rr = (eta - 1.0) / (eta + 1.0);
     out->spec_F0 = rr * rr;
     for (int c = 0; c < 3; ++c) out->spec_f0[c] = fmin(fmax(f0 * in->specular_tint[c], 0.0), 1.0);
@@ -364,7 +366,7 @@ void dwvb_material_init(dwvb_material *out, const dwv_material_t *in)
     }
     /* The refraction entry's IOR is the specular layer's eta (4.x+ Principled: IOR adjusted by
      * Specular IOR Level), else `ior` (the Subsurface Scattering node's IOR); clamped as Cycles. */
-    out->entry_ior = fmin(fmax(out->specular == DWV_SPECULAR_PRINCIPLED_V2 ? out->spec_eta : in->ior, 1.01), 3.8);
+    out->entry_ior = fmin(fmax(in->specular_model == DWV_SPECULAR_PRINCIPLED_V2 ? out->spec_eta : in->ior, 1.01), 3.8);
     for (int c = 0; c < 3; ++c) {
         out->diffuse_albedo[c] = in->base_color[c];
         out->walk_scale[c] = 0.0;

@@ -2,9 +2,12 @@
 
 Each test script starts Blender with --factory-startup and user folders of its own under
 DWIVEDI_TEST_HOME (emptied here first, so nothing is cached between runs), installs the add-on
-from the zip the build made (DWIVEDI_ADDON_ZIP), enables it, runs its unittest cases and exits
-with 0 only if all passed.
+from the package the build made for this Blender (3.x: the legacy zip DWIVEDI_ADDON_ZIP; 4.2+:
+the extension DWIVEDI_EXTENSION_ZIP), enables it, runs its unittest cases and exits with 0 only
+if all passed. The scripts run by tests/blender/run_package_tests.py (host or chroot) get this
+file beside them.
 """
+import ctypes
 import math
 import os
 import shutil
@@ -21,27 +24,35 @@ if str(HERE) not in sys.path:
 
 HOME = Path(os.environ.get("DWIVEDI_TEST_HOME", "/tmp/dwivedi-blender-test"))
 ZIP = Path(os.environ.get("DWIVEDI_ADDON_ZIP", HERE.parents[1] / "build" / "dwivedi_bake.zip"))
+EXTENSION_ZIP = os.environ.get("DWIVEDI_EXTENSION_ZIP")
+EXTENSIONS = bpy.app.version >= (4, 2, 0)
+MODULE = "bl_ext.user_default.dwivedi_bake" if EXTENSIONS else "dwivedi_bake"
 WORK = HOME / "work"
 
 
 def preload_scratch_dependencies():
-    """run_fidelity_chroot.sh's scratch set-up for a library that is not self-contained
-    (DWIVEDI_PRELOAD: a wrapper needing this Blender's malloc, then the library; the host
-    dependencies beside it): one dlopen with RTLD_DEEPBIND, so that the library binds to its own
-    Embree 3 and OpenEXR rather than the Embree 4 / OpenEXR this Blender loaded under the same
-    symbol names (without it every ray misses). The add-on's shim then opens the same file
-    (DWIVEDI_LIBRARY): the same handle. Branch native's self-contained library needs none of it."""
-    wrapper = os.environ.get("DWIVEDI_PRELOAD")
-    if not wrapper or not Path(wrapper).is_file():
+    """Only for a bundled library that still links its dependencies dynamically (the scratch set-up
+    of run_package_tests.py, DWIVEDI_TEST_PRELOAD, never the package): loads them first so the
+    loader finds them."""
+    folder = os.environ.get("DWIVEDI_TEST_PRELOAD")
+    if not folder:
         return
-    import ctypes
-    ctypes.CDLL(wrapper, mode=ctypes.RTLD_LOCAL | getattr(os, "RTLD_DEEPBIND", 8))
-    print(f"harness: scratch set-up: {wrapper} (the library and its host dependencies) loaded with "
-          "RTLD_DEEPBIND", flush=True)
+    pending = sorted(str(p) for p in Path(folder).iterdir())
+    while pending:
+        left = []
+        for path in pending:
+            try:
+                ctypes.CDLL(path, mode=ctypes.RTLD_GLOBAL)
+            except OSError:
+                left.append(path)
+        if len(left) == len(pending):
+            raise SystemExit(f"harness: cannot preload {left}")
+        pending = left
 
 
 def install_addon():
-    """A fresh home, the add-on installed from the zip and enabled; returns the work folder."""
+    """A fresh home, the add-on installed from this Blender's package and enabled; returns the
+    work folder."""
     scripts = os.environ.get("BLENDER_USER_SCRIPTS")
     if not scripts or not Path(scripts).resolve().is_relative_to(HOME.resolve()):
         raise SystemExit("harness: BLENDER_USER_SCRIPTS must point inside DWIVEDI_TEST_HOME (run these through "
@@ -49,13 +60,26 @@ def install_addon():
     if WORK.exists():
         shutil.rmtree(WORK)
     WORK.mkdir(parents=True)
-    if not ZIP.is_file():
-        raise SystemExit(f"harness: no add-on zip at {ZIP} (build the dwivedi_bake_addon target)")
-    result = bpy.ops.preferences.addon_install(filepath=str(ZIP), overwrite=True)
+    preload_scratch_dependencies()
+    if EXTENSIONS:
+        if not EXTENSION_ZIP or not Path(EXTENSION_ZIP).is_file():
+            raise SystemExit(f"harness: Blender {bpy.app.version_string} installs the extension package: "
+                             f"DWIVEDI_EXTENSION_ZIP={EXTENSION_ZIP} is not a file (run_package_tests.py sets it)")
+        result = bpy.ops.extensions.package_install_files(filepath=EXTENSION_ZIP, repo='user_default',
+                                                          enable_on_install=False)
+    else:
+        if not ZIP.is_file():
+            raise SystemExit(f"harness: no add-on zip at {ZIP} (build the dwivedi_bake_addon target)")
+        result = bpy.ops.preferences.addon_install(filepath=str(ZIP), overwrite=True)
     assert result == {'FINISHED'}, result
-    result = bpy.ops.preferences.addon_enable(module="dwivedi_bake")
+    result = bpy.ops.preferences.addon_enable(module=MODULE)
     assert result == {'FINISHED'}, result
     return WORK
+
+
+def addon_module(part=None):
+    """The loaded add-on package, or its submodule `part` ("export", "dwivedi")."""
+    return sys.modules[MODULE if part is None else f"{MODULE}.{part}"]
 
 
 def run(*cases):
@@ -104,9 +128,9 @@ def read_pixels(path):
         bpy.data.images.remove(image)
 
 
-def cycles_render(scene, seed, path, samples):
-    """The scene rendered by Cycles with `seed` and `samples` into the EXR `path`: its RGBA
-    pixels (rows from the bottom) and the seconds it took."""
+def cycles_render(scene, seed, samples, path):
+    """Cycles' render of `scene` with `seed` and `samples` into the 32-bit EXR `path`: (float
+    RGBA pixels, seconds)."""
     scene.cycles.seed = seed
     scene.cycles.samples = samples
     scene.render.image_settings.file_format = 'OPEN_EXR'
@@ -119,12 +143,13 @@ def cycles_render(scene, seed, path, samples):
     return pixels, seconds
 
 
-def dwivedi_bake(scene, seed, output_dir, samples, walk_event_cap=0):
-    """The add-on's camera bake of the scene (technique auto, 2 threads) into `output_dir`: its
-    RGBA pixels and the seconds it took; AssertionError if it failed."""
+def dwivedi_bake(scene, seed, samples, output_dir, event_cap=None):
+    """The add-on's camera bake of `scene` (technique auto, 2 threads) into `output_dir`: (float
+    RGBA pixels, seconds). `event_cap`: the Walk Event Cap (None: the add-on's default)."""
     props = scene.dwivedi_bake
     props.samples = samples
-    props.walk_event_cap = walk_event_cap
+    if event_cap is not None:
+        props.walk_event_cap = event_cap
     props.threads = 2
     props.seed = seed
     props.technique = 'AUTO'
@@ -138,22 +163,29 @@ def dwivedi_bake(scene, seed, output_dir, samples, walk_event_cap=0):
     return pixels, seconds
 
 
-def agreement(c1, c2, o1, o2):
-    """Cycles' two seeds c1, c2 against dwivedi's o1, o2 (RGBA pixel lists): the two-seed means'
-    channel means, their relative difference, and the noise ratio per channel
-    R = sum (ours - cycles)^2 / sum (var_ours + var_cycles), each side's per-pixel variance of
-    its two-seed mean estimated from its seeds as (a1 - a2)^2 / 4: 1 in expectation when both
-    estimate the same image."""
+def compare_two_seeds(cycles_pair, ours_pair):
+    """Cycles' and dwivedi's two-seed images of one scene (RGBA lists) compared: means per
+    channel of the two-seed means, their relative difference, and per channel the noise ratio
+    R = sum (ours - cycles)^2 / sum (var_ours + var_cycles), each side's per-pixel variance of its
+    two-seed mean estimated from the two seeds, (a1 - a2)^2 / 4: 1 in expectation when both
+    estimate the same image, larger with any bias; and the standard error of the difference of
+    the means from the same variances, sqrt(sum (var_ours + var_cycles)) / pixels, relative to
+    Cycles' mean (what the mean test's tolerance must stand well above)."""
+    (c1, c2), (o1, o2) = cycles_pair, ours_pair
     cycles = [(a + b) / 2 for a, b in zip(c1, c2)]
     ours = [(a + b) / 2 for a, b in zip(o1, o2)]
     n = len(ours) // 4
     cm = [sum(cycles[c::4]) / n for c in range(3)]
     om = [sum(ours[c::4]) / n for c in range(3)]
-    ratios = []
+    ratios, errors = [], []
     for c in range(3):
         num = sum((ours[i] - cycles[i]) ** 2 for i in range(c, len(ours), 4))
         den = sum(((o1[i] - o2[i]) ** 2 + (c1[i] - c2[i]) ** 2) / 4 for i in range(c, len(ours), 4))
         ratios.append(num / den if den > 0 else (0.0 if num == 0 else math.inf))
-    return {"cycles_mean_rgb": cm, "dwivedi_mean_rgb": om,
-            "relative_difference_rgb": [(o - c) / c if c > 0 else None for o, c in zip(om, cm)],
-            "noise_ratio_rgb": ratios, "nan_pixels": sum(1 for v in ours if v != v)}
+        errors.append(math.sqrt(den) / n / cm[c] if cm[c] > 0 else None)
+    return {
+        "cycles_mean_rgb": cm, "dwivedi_mean_rgb": om,
+        "relative_difference_rgb": [(o - c) / c if c > 0 else None for o, c in zip(om, cm)],
+        "noise_ratio_rgb": ratios, "relative_standard_error_rgb": errors,
+        "nan_pixels": sum(1 for v in ours if v != v),
+    }

@@ -1,21 +1,27 @@
 #!/usr/bin/env python3
-"""Runs tests/blender/test_package.py headless (or another script there: --script test_farm.py),
-or with --ui tests/blender/test_ui.py (Blender's real UI in a window on Xvfb), in one Blender: the
-host's, or the one in a clean Debian chroot made by scripts/blender-chroots.sh (trixie: Blender
-4.3, sid: Blender 5.2).
+"""Runs a test script of tests/blender in one Blender: the host's, or the one in a clean Debian
+chroot made by scripts/blender-chroots.sh (trixie: Blender 4.3, sid: Blender 5.2). The one way
+the tests and tools/cycles_report.py run Blender in a chroot (make_chroot, blender_command).
 
-    python3 tests/blender/run_package_tests.py --blender host|trixie|sid --build-dir build [--work DIR] [--ui]
+    python3 tests/blender/run_package_tests.py --blender host|trixie|sid --build-dir build
+            [--script test_package.py|test_fidelity.py|test_farm.py|...] [--ui] [--work DIR]
+
+--script (default test_package.py): the script, run with harness.py and scenes.py beside it; it
+installs the package the build made for that Blender (3.x: the legacy zip, 4.2+: the extension)
+itself. test_fidelity.py compares the bakes with that Blender's Cycles; its figures
+(fidelity_figures.json) are copied to WORK, pass or fail. --ui runs test_ui.py instead, in
+Blender's real UI in a window on Xvfb.
 
 Steps, each timed (printed at the end and written to WORK/times.json):
-1. the bad library files (tests/blender/fixtures.py) with the C compiler and clang + ld.lld (not
-   for --ui);
+1. test_package.py only: the bad library files (tests/blender/fixtures.py) with the C compiler
+   and clang + ld.lld;
 2. for a chroot: the chroot (made once and reused: scripts/blender-chroots.sh), and a scratch
    folder inside it, CHROOT/tmp/dwivedi-test-..., with copies of the two packages, the test
    scripts and the fixtures. If the packaged library still links libraries other than glibc,
    libstdc++ and libgcc (a library that is not yet self-contained), copies of the host's
    (Debian 12's) are put in that scratch folder's deps/ and loaded by the test before the bake:
    a scratch test set-up only, never in a package, said on stdout;
-3. Blender: `blender -b --factory-startup --python-exit-code 1 --python test_package.py` with its
+3. Blender: `blender -b --factory-startup --python-exit-code 1 --python SCRIPT` with its
    user folders and TMPDIR in the scratch folder; with --ui, `xvfb-run blender --factory-startup
    --enable-event-simulate --python test_ui.py` (xvfb and xauth: scripts/setup.sh on the host,
    the chroots' package list in scripts/blender-chroots.sh). As root it runs under `unshare --mount
@@ -47,6 +53,11 @@ import libcheck  # noqa: E402  (standard library only)
 BASE_LIBRARIES = {"libc.so.6", "libm.so.6", "libstdc++.so.6", "libgcc_s.so.1", "ld-linux-x86-64.so.2",
                   "libpthread.so.0", "libdl.so.2", "librt.so.1"}
 TIMES = {}
+# The headless test scripts of tests/blender this runner can run (test_ui.py: with --ui).
+SCRIPTS = tuple(sorted(p.name for p in Path(__file__).resolve().parent.glob("test_*.py") if p.name != "test_ui.py"))
+# Passed on to test_fidelity.py (its settings, for a diagnosis run; CI uses its defaults).
+FIDELITY_SETTINGS = ("DWIVEDI_FIDELITY_EVENT_CAP", "DWIVEDI_FIDELITY_ONLY", "DWIVEDI_FIDELITY_RESOLUTION",
+                     "DWIVEDI_FIDELITY_CYCLES_SPP", "DWIVEDI_FIDELITY_DWIVEDI_SPP")
 
 
 def fail(message):
@@ -71,13 +82,34 @@ def extension_zip(build_dir):
 
 
 def make_chroot(suite):
+    """The chroot of `suite` (trixie, sid) with its Blender, made once by scripts/blender-chroots.sh
+    and reused; RuntimeError with a message where it cannot be made (root and network once)."""
     done = subprocess.run(["bash", str(ROOT / "scripts" / "blender-chroots.sh"), suite], capture_output=True,
                           text=True)
     sys.stderr.write(done.stderr)
     if done.returncode != 0:
-        fail(f"the {suite} chroot could not be made (see above); these tests need root and network once. "
-             "DWV_TEST_QUICK=1 scripts/test.sh leaves them out")
-    return Path(done.stdout.split()[1])
+        raise RuntimeError(f"the {suite} chroot could not be made (see above); it needs root and network once. "
+                           "DWV_TEST_QUICK=1 scripts/test.sh leaves these tests out")
+    chroot = Path(done.stdout.split()[1])
+    if not (chroot / "usr" / "bin" / "blender").is_file():
+        raise RuntimeError(f"no Blender at {chroot}/usr/bin/blender (scripts/blender-chroots.sh {suite} should "
+                           "have installed it)")
+    return chroot
+
+
+def blender_command(command, env, chroot=None):
+    """`command` (its paths as the process sees them) with only `env`, inside `chroot` if given.
+    As root it runs in a mount namespace of its own (unshare --mount --propagation private):
+    /proc is mounted there for a chroot, and every mount the process makes goes away with it, on
+    failure too."""
+    environment = ["env", "-i"] + [f"{k}={v}" for k, v in env.items()]
+    if chroot is not None:
+        script = 'mount -t proc proc "$1/proc" && shift && exec chroot "$@"'
+        return ["unshare", "--mount", "--propagation", "private", "sh", "-c", script, "sh", str(chroot),
+                str(chroot), *environment, *command]
+    if os.geteuid() == 0:
+        return ["unshare", "--mount", "--propagation", "private", *environment, *command]
+    return environment + command
 
 
 def scratch_dependencies(library, deps):
@@ -113,12 +145,12 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--blender", required=True, help="host, trixie or sid")
     parser.add_argument("--build-dir", required=True, type=Path)
-    parser.add_argument("--work", type=Path, help="folder for the fixtures and results (default BUILD/tests/package-NAME)")
+    parser.add_argument("--script", default="test_package.py", choices=SCRIPTS)
+    parser.add_argument("--work", type=Path,
+                        help="folder for the results (default BUILD/tests/package-NAME, fidelity-NAME, ui-NAME...)")
     parser.add_argument("--cc", default=os.environ.get("CC", "cc"))
     parser.add_argument("--clang", default="clang-14" if shutil.which("clang-14") else "clang")
     parser.add_argument("--host-blender", default=shutil.which("blender") or "blender")
-    parser.add_argument("--script", default="test_package.py",
-                        help="the test script in tests/blender to run (test_package.py; test_farm.py)")
     parser.add_argument("--timeout", type=float, default=900.0)
     parser.add_argument("--ui", action="store_true",
                         help="run test_ui.py in Blender's UI under Xvfb instead of test_package.py headless")
@@ -131,9 +163,9 @@ def main(argv=None):
         if not path.is_file():
             fail(f"{path} is missing (build first)")
     test_script = "test_ui.py" if args.ui else args.script
-    suffix = "" if test_script in ("test_package.py", "test_ui.py") else "-" + Path(test_script).stem
-    kind = "ui" if args.ui else "package"
-    work = (args.work or build / "tests" / f"{kind}-{args.blender}{suffix}").resolve()
+    package = test_script == "test_package.py"
+    kind = "package" if package else Path(test_script).stem.replace("test_", "", 1)
+    work = (args.work or build / "tests" / f"{kind}-{args.blender}").resolve()
     if work.exists():
         shutil.rmtree(work)
     work.mkdir(parents=True)
@@ -146,7 +178,10 @@ def main(argv=None):
     elif args.blender in ("trixie", "sid"):
         if not root:
             fail(f"the {args.blender} chroot test needs root (chroot, mounts); DWV_TEST_QUICK=1 leaves it out")
-        chroot = step("chroot", make_chroot, args.blender)
+        try:
+            chroot = step("chroot", make_chroot, args.blender)
+        except RuntimeError as error:
+            fail(str(error))
         stage = chroot / "tmp" / f"dwivedi-{kind}-{args.blender}-{os.getpid()}"
         if stage.exists():
             shutil.rmtree(stage)
@@ -159,12 +194,12 @@ def main(argv=None):
 
     def stage_files():
         (stage / "scripts").mkdir(parents=True)
-        for name in sorted({test_script, "scenes.py", "harness.py"}):
+        for name in sorted({test_script, "harness.py", "scenes.py"}):
             shutil.copy2(HERE / name, stage / "scripts" / name)
         shutil.copy2(legacy, stage / legacy.name)
         shutil.copy2(extension, stage / extension.name)
         fixtures = stage / "fixtures"
-        if args.ui:  # the bad library files are test_package.py's
+        if not package:  # the bad library files are test_package.py's
             fixtures.mkdir()
         else:
             subprocess.run([sys.executable, str(HERE / "fixtures.py"), "--library", str(library), "--out",
@@ -194,6 +229,7 @@ def main(argv=None):
         "DWIVEDI_EXTENSION_ZIP": inside(stage / extension.name), "DWIVEDI_FIXTURES": inside(stage / "fixtures"),
         "DWIVEDI_TEST_TIMES": inside(times_file), "PYTHONDONTWRITEBYTECODE": "1", "PYTHONUNBUFFERED": "1",
     }
+    env.update({name: os.environ[name] for name in FIDELITY_SETTINGS if name in os.environ})
     if copied:
         env["DWIVEDI_TEST_PRELOAD"] = inside(stage / "deps")
         print(f"run_package_tests: SCRATCH SET-UP: the bundled library is not self-contained (it links "
@@ -213,19 +249,11 @@ def main(argv=None):
         # and the chroots, which do not see each other's lock files); -a moves on from it if taken.
         display = {"host": 90, "trixie": 100, "sid": 110}[args.blender]
         command = ["xvfb-run", "-a", "-n", str(display), "-s", "-screen 0 1280x800x24 -nolisten tcp", blender,
-                   "--factory-startup", "--enable-event-simulate", "--python", inside(stage / "scripts" / "test_ui.py")]
+                   "--factory-startup", "--enable-event-simulate", "--python", inside(stage / "scripts" / test_script)]
     else:
         command = [blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python",
                    inside(stage / "scripts" / test_script)]
-    environment = ["env", "-i"] + [f"{k}={v}" for k, v in env.items()]
-    if chroot is not None:
-        script = 'mount -t proc proc "$1/proc" && shift && exec chroot "$@"'
-        full = ["unshare", "--mount", "--propagation", "private", "sh", "-c", script, "sh", str(chroot), str(chroot),
-                *environment, *command]
-    elif root:
-        full = ["unshare", "--mount", "--propagation", "private", *environment, *command]
-    else:
-        full = environment + command
+    full = blender_command(command, env, chroot)
     watched = [tmp, Path("/tmp")] + ([chroot / "tmp"] if chroot is not None else [])
     before = crash_reports(watched)
     print("run_package_tests: " + " ".join(full[-len(command):]), flush=True)
@@ -251,7 +279,9 @@ def main(argv=None):
     TIMES["steps in Blender"] = steps
     TIMES["total"] = round(time.monotonic() - total, 1)
     (work / "times.json").write_text(json.dumps(TIMES, indent=1))
-    print(f"run_package_tests: {args.blender}: times (s): {json.dumps(TIMES)}")
+    for figures in home.glob("*_figures.json"):
+        shutil.copy2(figures, work / figures.name)
+    print(f"run_package_tests: {args.blender} {test_script}: times (s): {json.dumps(TIMES)}")
     problems = []
     if args.ui and passed is not True:
         problems.append("test_ui.py did not pass (see its output above)")
@@ -265,13 +295,13 @@ def main(argv=None):
     if "Segmentation fault" in output or "Writing: " in output and ".crash.txt" in output:
         problems.append("Blender reported a crash")
     if problems:
-        print(f"run_package_tests: {args.blender}: FAILED: {'; '.join(problems)} (scratch folder kept: {stage})",
-              file=sys.stderr)
+        print(f"run_package_tests: {args.blender} {test_script}: FAILED: {'; '.join(problems)} "
+              f"(scratch folder kept: {stage})", file=sys.stderr)
         return 1
     if (stage / "screenshot.png").is_file():
         shutil.copy2(stage / "screenshot.png", work / "screenshot.png")
     shutil.rmtree(stage)
-    print(f"run_package_tests: {args.blender}: passed")
+    print(f"run_package_tests: {args.blender} {test_script}: passed")
     return 0
 
 

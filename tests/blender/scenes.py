@@ -92,9 +92,9 @@ def sss_node_material(name, color, radius, scale=1.0):
     tree = material.node_tree
     tree.nodes.remove(tree.nodes["Principled BSDF"])
     node = tree.nodes.new("ShaderNodeSubsurfaceScattering")
-    # 4.0 renamed 3.x's Fixed Radius walk Random Walk (as for the Principled BSDF above).
+    # 3.x's Fixed Radius walk; 4.0-5.1 store it as Random Walk, 5.2 calls it Random Walk (Legacy).
     falloffs = [item.identifier for item in node.bl_rna.properties["falloff"].enum_items]
-    node.falloff = 'RANDOM_WALK_FIXED_RADIUS' if 'RANDOM_WALK_FIXED_RADIUS' in falloffs else 'RANDOM_WALK'
+    node.falloff = next(m for m in ('RANDOM_WALK_FIXED_RADIUS', 'RANDOM_WALK_LEGACY', 'RANDOM_WALK') if m in falloffs)
     node.inputs["Color"].default_value = (color[0], color[1], color[2], 1.0)
     node.inputs["Scale"].default_value = scale
     node.inputs["Radius"].default_value = tuple(radius)
@@ -293,14 +293,14 @@ def default_sphere_scene(resolution, method, **material):
     return scene
 
 
-def backlit_slab_scene(resolution, method):
-    """The issue's back-lit slab: 0.2 m thick, 4 x 4 m, Subsurface 0.3 (4.x+: Scale 0.3),
-    colour (0.9, 0.7, 0.5), a sun from straight below, an orthographic camera above."""
+def backlit_slab_scene(resolution, method, thickness=0.2):
+    """The issue's back-lit slab: 0.2 m thick (or `thickness`), 4 x 4 m, Subsurface 0.3 (4.x+:
+    Scale 0.3), colour (0.9, 0.7, 0.5), a sun from straight below, an orthographic camera above."""
     scene = _reset()
     scene.render.resolution_x = resolution
     scene.render.resolution_y = resolution
     material = default_subsurface_material("Slab", method, color=(0.9, 0.7, 0.5), amount=0.3)
-    _box(scene, "Slab", (4.0, 4.0, 0.2), (0.0, 0.0, 0.0), material)
+    _box(scene, "Slab", (4.0, 4.0, thickness), (0.0, 0.0, 0.0), material)
     _camera(scene, (0.0, 0.0, 3.0), (0.0, 0.0, 0.0), ortho_scale=1.0)
     _sun(scene, (math.pi, 0.0, 0.0), 3.0)
     return scene

@@ -36,26 +36,16 @@ NOISE_RATIO_LIMIT = 1.5
 FIGURES = {}
 
 
-def cycles_render(scene, seed, name):
-    return harness.cycles_render(scene, seed, WORK / f"{name}_cycles_{seed}.exr", CYCLES_SAMPLES)
-
-
-def dwivedi_bake(scene, seed, name):
-    return harness.dwivedi_bake(scene, seed, WORK / f"{name}_dwivedi_{seed}", DWIVEDI_SAMPLES)
-
-
 def compare(name, build):
     scene = build(RESOLUTION, CYCLES_SAMPLES)
-    c1, tc1 = cycles_render(scene, 1, name)
-    c2, tc2 = cycles_render(scene, 2, name)
-    o1, to1 = dwivedi_bake(scene, 1, name)
-    o2, to2 = dwivedi_bake(scene, 2, name)
-    figures = {
-        **harness.agreement(c1, c2, o1, o2),
-        "cycles_seconds": tc1 + tc2, "cycles_samples": 2 * CYCLES_SAMPLES,
-        "dwivedi_seconds": to1 + to2, "dwivedi_samples": 2 * DWIVEDI_SAMPLES,
+    cycles = [harness.cycles_render(scene, seed, CYCLES_SAMPLES, WORK / f"{name}_cycles_{seed}.exr") for seed in (1, 2)]
+    ours = [harness.dwivedi_bake(scene, seed, DWIVEDI_SAMPLES, WORK / f"{name}_dwivedi_{seed}") for seed in (1, 2)]
+    figures = harness.compare_two_seeds([p for p, _ in cycles], [p for p, _ in ours])
+    figures.update({
+        "cycles_seconds": sum(t for _, t in cycles), "cycles_samples": 2 * CYCLES_SAMPLES,
+        "dwivedi_seconds": sum(t for _, t in ours), "dwivedi_samples": 2 * DWIVEDI_SAMPLES,
         "resolution": RESOLUTION,
-    }
+    })
     FIGURES[name] = figures
     print(f"\n{name}: " + json.dumps(figures, indent=1), flush=True)
     (harness.HOME / "cycles_figures.json").write_text(json.dumps(FIGURES, indent=2))

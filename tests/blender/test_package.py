@@ -40,6 +40,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import bpy  # noqa: E402
 
+import harness  # noqa: E402  (beside this file: run_package_tests.py copies it)
 import scenes  # noqa: E402
 
 HOME = Path(os.environ["DWIVEDI_TEST_HOME"])
@@ -49,8 +50,8 @@ FIXTURES = Path(os.environ["DWIVEDI_FIXTURES"])
 TIMES_FILE = os.environ.get("DWIVEDI_TEST_TIMES")
 WORK = HOME / "work"
 OUT = WORK / "out"
-EXTENSIONS = bpy.app.version >= (4, 2, 0)
-MODULE = "bl_ext.user_default.dwivedi_bake" if EXTENSIONS else "dwivedi_bake"
+EXTENSIONS = harness.EXTENSIONS  # 4.2+: the extension package, else the legacy zip
+MODULE = harness.MODULE
 TIMES = {}
 
 
@@ -80,39 +81,8 @@ def check_home():
     OUT.mkdir(parents=True)
 
 
-def preload_scratch_dependencies():
-    """Only for a bundled library that still links its dependencies dynamically (the scratch set-up
-    of run_package_tests.py, never the package): loads them first so the loader finds them."""
-    folder = os.environ.get("DWIVEDI_TEST_PRELOAD")
-    if not folder:
-        return
-    pending = sorted(str(p) for p in Path(folder).iterdir())
-    while pending:
-        left = []
-        for path in pending:
-            try:
-                ctypes.CDLL(path, mode=ctypes.RTLD_GLOBAL)
-            except OSError:
-                left.append(path)
-        if len(left) == len(pending):
-            raise SystemExit(f"test_package: cannot preload {left}")
-        pending = left
-
-
 def module():
     return sys.modules[MODULE]
-
-
-def operator(**settings):
-    """bpy.ops.dwivedi.bake() with scene.dwivedi_bake fields set: (result, error text or None). In
-    background mode an ERROR report raises RuntimeError carrying it."""
-    props = bpy.context.scene.dwivedi_bake
-    for key, value in settings.items():
-        setattr(props, key, value)
-    try:
-        return bpy.ops.dwivedi.bake(), None
-    except RuntimeError as error:
-        return {'CANCELLED'}, str(error)
 
 
 class RecordingLayout:
@@ -186,7 +156,7 @@ class PackageTest(unittest.TestCase):
         self.assertIn(fragment, shown.replace("  ", " "))
         self.assertIn(("operator", "dwivedi.bake", ""), labels, "the panel stays usable")
         before = snapshot(OUT)
-        result, error = operator()
+        result, error = harness.call_operator()
         self.assertEqual(result, {'CANCELLED'})
         self.assertIsNotNone(error, "the bake reports an error")
         self.assertIn("the dwivedi library cannot be used", error)
@@ -249,9 +219,9 @@ class PackageTest(unittest.TestCase):
     @timed("camera and UV bakes")
     def test_04_bakes(self):
         put(WORK / "good-libdwivedi.so.1", bundled_library())
-        preload_scratch_dependencies()
+        harness.preload_scratch_dependencies()
         scene = slab()
-        result, error = operator()
+        result, error = harness.call_operator()
         self.assertEqual(result, {'FINISHED'}, error)
         self.assertTrue(module().library_status().ok)
         shim = module().shim()
@@ -269,7 +239,7 @@ class PackageTest(unittest.TestCase):
         # Nothing about the run is scene data (a .blend saved during a bake would keep it).
         self.assertFalse(set(scene.dwivedi_bake.keys()) & {"running", "progress", "last_result", "last_warnings"})
         target = scenes.bake_image(bpy.data.objects["Slab"], (32, 32))
-        result, error = operator(target='UV', uv_margin=2)
+        result, error = harness.call_operator(target='UV', uv_margin=2)
         self.assertEqual(result, {'FINISHED'}, error)
         self.assertTrue((OUT / f"{scene.name}_uv_Slab.exr").is_file())
         self.assertEqual(bpy.path.abspath(target.filepath), str(OUT / f"{scene.name}_uv_Slab.exr"))
@@ -291,7 +261,7 @@ class PackageTest(unittest.TestCase):
         try:
             start = time.monotonic()
             timer.start()
-            result, error = operator(samples=1 << 22)
+            result, error = harness.call_operator(samples=1 << 22)
             seconds = time.monotonic() - start
         finally:
             timer.cancel()
@@ -299,7 +269,7 @@ class PackageTest(unittest.TestCase):
         self.assertIsNone(error, "a cancel is a warning, not an error")
         self.assertLess(seconds, 30.0, "it stopped soon after the signal")
         self.assertEqual(os.listdir(OUT), [], "a cancelled bake writes nothing")
-        result, error = operator(samples=4)
+        result, error = harness.call_operator(samples=4)
         self.assertEqual(result, {'FINISHED'}, error)
         self.assertTrue((OUT / f"{scene.name}_camera.exr").is_file())
 
@@ -314,7 +284,7 @@ class PackageTest(unittest.TestCase):
         self.assertRefused("libdwivedi_test_missing.so.7")
         self.assertIn("the library named in the add-on preferences", module().library_status().message)
         prefs.library_path = ""
-        result, error = operator()
+        result, error = harness.call_operator()
         self.assertEqual(result, {'FINISHED'}, error)
         # The loaded file replaced under Blender (an update while it runs): restart, it says.
         library = bundled_library()
@@ -323,7 +293,7 @@ class PackageTest(unittest.TestCase):
         put(WORK / "good-libdwivedi.so.1", library)
         self.assertRefused("was replaced since Blender loaded it: restart Blender")
         os.replace(keep, library)
-        result, error = operator()
+        result, error = harness.call_operator()
         self.assertEqual(result, {'FINISHED'}, error)
 
     @timed("read-only folder")
@@ -338,11 +308,11 @@ class PackageTest(unittest.TestCase):
             self.assertEqual(bpy.ops.preferences.addon_enable(module=MODULE), {'FINISHED'})
             self.assertTrue(module().library_status().ok, module().library_status().message)
             scene = slab()
-            result, error = operator()
+            result, error = harness.call_operator()
             self.assertEqual(result, {'FINISHED'}, error)
             # An unsaved file's "//" is nowhere: a script is told to name a folder (the UI asks for
             # one), and nothing goes to the package folder or a temporary folder.
-            result, error = operator(output_dir="//dwivedi_bake/")
+            result, error = harness.call_operator(output_dir="//dwivedi_bake/")
             self.assertEqual(result, {'CANCELLED'})
             self.assertIn("the .blend is not saved", error or "")
             self.assertTrue((OUT / f"{scene.name}_camera.exr").is_file())
@@ -370,7 +340,7 @@ class PackageTest(unittest.TestCase):
             self.assertNotIn(other, sys.modules)
             self.assertTrue(addon_utils.check(MODULE)[1], "the first copy still is")
             slab()
-            result, error = operator()
+            result, error = harness.call_operator()
             self.assertEqual(result, {'FINISHED'}, error)
             if EXTENSIONS:
                 # The other order: the legacy add-on enabled first, then the extension refused.
@@ -382,7 +352,7 @@ class PackageTest(unittest.TestCase):
                 self.assertTrue(addon_utils.check(other)[1])
                 self.assertEqual(bpy.ops.preferences.addon_disable(module=other), {'FINISHED'})
                 self.assertEqual(bpy.ops.preferences.addon_enable(module=MODULE), {'FINISHED'})
-                result, error = operator()
+                result, error = harness.call_operator()
                 self.assertEqual(result, {'FINISHED'}, error)
         finally:
             # (Not addon_remove: in background mode it fails in Blender's own code, on context.area.)
@@ -399,7 +369,7 @@ class PackageTest(unittest.TestCase):
         self.assertFalse(hasattr(bpy.types, "DWIVEDI_OT_bake"))
         self.assertEqual(bpy.ops.preferences.addon_enable(module=MODULE), {'FINISHED'})
         slab()
-        result, error = operator()
+        result, error = harness.call_operator()
         self.assertEqual(result, {'FINISHED'}, error)
 
 

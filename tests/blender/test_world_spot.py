@@ -33,7 +33,7 @@ import bpy  # noqa: E402
 import harness  # noqa: E402
 import scenes  # noqa: E402
 
-harness.preload_scratch_dependencies()  # run_fidelity_chroot.sh's scratch set-up, if any
+harness.preload_scratch_dependencies()  # run_package_tests.py's scratch set-up, if any
 WORK = harness.install_addon()
 RESOLUTION = 32
 CYCLES_SAMPLES = int(os.environ.get("DWIVEDI_WORLD_CYCLES_SPP", "384"))    # per seed; two seeds
@@ -45,7 +45,7 @@ FIGURES = {"blender_version": list(bpy.app.version)}
 
 def last_warnings():
     """The last bake's warnings, one a line (the add-on keeps them in its session state)."""
-    return "\n".join(sys.modules["dwivedi_bake"]._RUN.warnings)
+    return "\n".join(harness.addon_module()._RUN.warnings)
 
 def hdri_pixels(width=128, height=64):
     """A generated HDRI (RGBA floats, row 0 at the bottom): sky above, ground below, and a hot
@@ -166,13 +166,13 @@ def procedural_scene(resolution, samples):
 
 def compare(name, build):
     scene = build(RESOLUTION, CYCLES_SAMPLES)
-    c1, tc1 = harness.cycles_render(scene, 1, WORK / f"{name}_cycles_1.exr", CYCLES_SAMPLES)
-    c2, tc2 = harness.cycles_render(scene, 2, WORK / f"{name}_cycles_2.exr", CYCLES_SAMPLES)
+    c1, tc1 = harness.cycles_render(scene, 1, CYCLES_SAMPLES, WORK / f"{name}_cycles_1.exr")
+    c2, tc2 = harness.cycles_render(scene, 2, CYCLES_SAMPLES, WORK / f"{name}_cycles_2.exr")
     # Cycles' own cap of 256 events per walk (BSSRDF_MAX_BOUNCES), as test_fidelity.py: without it
     # dwivedi keeps the light Cycles loses on the sphere's long red walks (about +1.3%).
-    o1, to1 = harness.dwivedi_bake(scene, 1, WORK / f"{name}_dwivedi_1", DWIVEDI_SAMPLES, 256)
-    o2, to2 = harness.dwivedi_bake(scene, 2, WORK / f"{name}_dwivedi_2", DWIVEDI_SAMPLES, 256)
-    figures = {**harness.agreement(c1, c2, o1, o2), "cycles_seconds": tc1 + tc2, "cycles_samples": 2 * CYCLES_SAMPLES,
+    o1, to1 = harness.dwivedi_bake(scene, 1, DWIVEDI_SAMPLES, WORK / f"{name}_dwivedi_1", 256)
+    o2, to2 = harness.dwivedi_bake(scene, 2, DWIVEDI_SAMPLES, WORK / f"{name}_dwivedi_2", 256)
+    figures = {**harness.compare_two_seeds((c1, c2), (o1, o2)), "cycles_seconds": tc1 + tc2, "cycles_samples": 2 * CYCLES_SAMPLES,
                "dwivedi_seconds": to1 + to2, "dwivedi_samples": 2 * DWIVEDI_SAMPLES, "resolution": RESOLUTION,
                "warnings": last_warnings()}
     FIGURES[name] = figures

@@ -286,6 +286,36 @@ static void test_specular(void)
     CHECK(fabs(f[0] - expect) < 1e-9 * expect, "v1 at normal incidence %g, expected %g", f[0], expect);
 }
 
+/* The 4.x+ refraction entry's IOR is the layer's eta (IOR through Specular IOR Level) clamped to
+ * [1.01, 3.8], also where the layer vanishes (level 0: f0 = 0, eta = 1, so 1.01), as Cycles'
+ * bssrdf->ior = eta; the Subsurface Scattering node (no layer) enters with its own IOR. */
+static void test_entry_ior(void)
+{
+    double levels[] = {0.0, 0.25, 0.5, 1.0}, expect[4];
+    for (int i = 0; i < 4; ++i) {
+        double r = (1.45 - 1.0) / 2.45, q = sqrt(fmin(r * r * 2.0 * levels[i], 0.99));
+        expect[i] = fmin(fmax((1.0 + q) / (1.0 - q), 1.01), 3.8);
+        dwv_material_t in = DWV_MATERIAL_INIT;
+        in.kind = DWV_MATERIAL_SUBSURFACE;
+        in.subsurface_model = DWV_SUBSURFACE_MODEL_BLENDER4_RANDOM_WALK;
+        in.specular_model = DWV_SPECULAR_PRINCIPLED_V2;
+        in.specular = levels[i];
+        in.ior = 1.45;
+        dwvb_material m;
+        dwvb_material_init(&m, &in);
+        CHECK(fabs(m.entry_ior - expect[i]) < 1e-12, "level %g: entry IOR %g, expected %g", levels[i], m.entry_ior,
+              expect[i]);
+    }
+    CHECK(expect[0] == 1.01 && fabs(expect[2] - 1.45) < 1e-12, "levels 0 and 0.5: %g, %g", expect[0], expect[2]);
+    dwv_material_t node = DWV_MATERIAL_INIT;
+    node.kind = DWV_MATERIAL_SUBSURFACE;
+    node.subsurface_model = DWV_SUBSURFACE_MODEL_BLENDER4_RANDOM_WALK;
+    node.ior = 1.3;
+    dwvb_material m;
+    dwvb_material_init(&m, &node);
+    CHECK(fabs(m.entry_ior - 1.3) < 1e-12, "the node's entry IOR %g", m.entry_ior);
+}
+
 static double dipole(double ap, double eta)
 {
     double inv = 1.0 / eta, fdr = inv * (-1.440 * inv + 0.710) + 0.668 + 0.0636 * eta;
@@ -385,6 +415,7 @@ int main(void)
     test_vndf();
     test_albedo();
     test_specular();
+    test_entry_ior();
     test_rescale();
     test_api();
     return check_report("test_surface_models");

@@ -64,9 +64,10 @@ class ReportTest(unittest.TestCase):
             self.assertIn("v0", data)
             self.assertNotIn("techniques", data)
             self.assertNotIn("## Walk techniques", (Path(tmp) / "report.md").read_text())
-            for bad, message in ((["--sections", "v0,walks"], "unknown section or scene 'walks'"),
-                                 (["--cycles-scenes", "cube"], "unknown section or scene 'cube'"),
-                                 (["--sections", ","], "no section or scene given"),
+            for bad, message in ((["--sections", "v0,walks"], "unknown section, scene or Blender 'walks'"),
+                                 (["--cycles-scenes", "cube"], "unknown section, scene or Blender 'cube'"),
+                                 (["--cycles-blenders", "bookworm"], "unknown section, scene or Blender 'bookworm'"),
+                                 (["--sections", ","], "no section, scene or Blender given"),
                                  (["--repeats", "0"], "--repeats 0 is outside 1 to 100")):
                 result = subprocess.run([sys.executable, str(REPORT), "--out", tmp] + bad,
                                         capture_output=True, text=True, env=env, timeout=60)
