@@ -23,6 +23,20 @@
  * ended takes the next walk of its thread's blocks. Results are added to their block in walk
  * order (lane_feed), so the totals equal the one-walk-at-a-time path's. */
 
+/* The lane steps' loops are written for a compiler to vectorise; on x86-64 each step is compiled
+ * twice, for the baseline (SSE2: two doubles a vector) and for x86-64-v3 (AVX2: four), and the
+ * first call picks the copy the processor runs (GCC's target_clones, an ifunc). Both copies do
+ * the same IEEE operations in the same order: this file is compiled with -ffp-contract=off (no
+ * fused multiply-add, which would round differently) and -fno-trapping-math (which lets the
+ * selects be computed on both sides, changing no value), so the walks are the same to the last
+ * bit on every processor (tests/internal/test_walk_fast_path.c compares them with the one-walk
+ * path, which is not cloned). */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && __GNUC__ >= 12
+#define DWVW_LANE_CLONES __attribute__((target_clones("default", "arch=x86-64-v3", "arch=x86-64-v4")))
+#else
+#define DWVW_LANE_CLONES
+#endif
+
 /* The lanes' state. p: position; d: the direction of the step being taken (for a lane at
  * events = 0, its entry direction). log_constants and exponent as in guided_walk_in, weight as in
  * mixture_walk_in. */
@@ -109,6 +123,10 @@ static DWVW_ALWAYS_INLINE int guided_lanes_step_in(lane_state *L, const dwvw_est
         udist[l] = dwvw_counter_uniform_f(L->counter[l] + to_distance);
         L->counter[l] += DWVW_EVENT_COUNTER_STEP;
     }
+    /* The unit free flights -log(1 - u) in a loop of their own: their table lookups are gathers,
+     * which would keep the step's main loop below from being vectorised. */
+    double unit_flight[DWVW_LANES];
+    for (int l = 0; l < DWVW_LANES; ++l) unit_flight[l] = dwvk_free_flight(udist[l]);
     for (int l = 0; l < DWVW_LANES; ++l) {
         dwvk_dwivedi_event_cosine_f s = dwvk_dwivedi_event_sample_select_f(d, ua[l]);
         dwvk_unit2_f azimuth = dwvk_azimuth_f(ub[l]); /* turned by its quarter turns */
@@ -135,7 +153,7 @@ static DWVW_ALWAYS_INLINE int guided_lanes_step_in(lane_state *L, const dwvw_est
         /* dwvk_dwivedi_stretch_d, its constants loaded before the loop and both sides formed. */
         double stretch_above = one_minus_kappa + kappa * (1.0 - mu), stretch_below = 1.0 - kappa * mu;
         double stretch = mu >= 0.0 ? stretch_above : stretch_below;
-        double t = dwvw_flight(sigma * stretch, udist[l]);
+        double t = dwvw_unit_flight_scaled(unit_flight[l], sigma * stretch);
         double hit;
         if (kind == DWVW_HALFSPACE) hit = lane_halfspace_exit(pz, wz);
         else if (kind == DWVW_SLAB) hit = lane_slab_exit(thickness, pz, wz);
@@ -171,17 +189,17 @@ static DWVW_ALWAYS_INLINE int guided_lanes_step_in(lane_state *L, const dwvw_est
 }
 
 /* guided_lanes_step_in for each shape, its exit test written out. */
-static int guided_lanes_step_halfspace(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
+DWVW_LANE_CLONES static int guided_lanes_step_halfspace(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
 {
     return guided_lanes_step_in(L, setup, plan, DWVW_HALFSPACE);
 }
 
-static int guided_lanes_step_slab(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
+DWVW_LANE_CLONES static int guided_lanes_step_slab(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
 {
     return guided_lanes_step_in(L, setup, plan, DWVW_SLAB);
 }
 
-static int guided_lanes_step_sphere(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
+DWVW_LANE_CLONES static int guided_lanes_step_sphere(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
 {
     return guided_lanes_step_in(L, setup, plan, DWVW_SPHERE);
 }
@@ -352,14 +370,15 @@ static DWVW_ALWAYS_INLINE int mixture_lanes_step_in(lane_state *L, const dwvw_es
     }
     /* Three loops, not one: each lane's chain from the flight's log through the exponential to
      * the weight is long, and short loops let the core run the lanes' chains side by side. */
-    double stretch_of[DWVW_LANES], t_of[DWVW_LANES], decay_of[DWVW_LANES];
+    double stretch_of[DWVW_LANES], t_of[DWVW_LANES], decay_of[DWVW_LANES], unit_flight[DWVW_LANES];
     int exited_of[DWVW_LANES];
+    for (int l = 0; l < DWVW_LANES; ++l) unit_flight[l] = dwvk_free_flight(udist[l]); /* gathers: apart */
     for (int l = 0; l < DWVW_LANES; ++l) {
         double pz = L->pz[l], z = wz[l];
         double mu = dwvw_clamp_cosine(axis_sign * z);
         double stretch_above = one_minus_kappa + kappa * (1.0 - mu), stretch_below = 1.0 - kappa * mu;
         double stretch = mu >= 0.0 ? stretch_above : stretch_below;
-        double t = dwvw_flight(sigma * (guided[l] ? stretch : 1.0), udist[l]);
+        double t = dwvw_unit_flight_scaled(unit_flight[l], sigma * (guided[l] ? stretch : 1.0));
         double hit;
         if (kind == DWVW_HALFSPACE) hit = lane_halfspace_exit(pz, z);
         else if (kind == DWVW_SLAB) hit = lane_slab_exit(thickness, pz, z);
@@ -404,17 +423,17 @@ static DWVW_ALWAYS_INLINE int mixture_lanes_step_in(lane_state *L, const dwvw_es
     return any;
 }
 
-static int mixture_lanes_step_halfspace(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
+DWVW_LANE_CLONES static int mixture_lanes_step_halfspace(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
 {
     return mixture_lanes_step_in(L, setup, plan, DWVW_HALFSPACE);
 }
 
-static int mixture_lanes_step_slab(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
+DWVW_LANE_CLONES static int mixture_lanes_step_slab(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
 {
     return mixture_lanes_step_in(L, setup, plan, DWVW_SLAB);
 }
 
-static int mixture_lanes_step_sphere(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
+DWVW_LANE_CLONES static int mixture_lanes_step_sphere(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
 {
     return mixture_lanes_step_in(L, setup, plan, DWVW_SPHERE);
 }
