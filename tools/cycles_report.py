@@ -51,6 +51,11 @@ if str(SHIM_DIR) not in sys.path:
 
 import dwivedi  # noqa: E402
 
+sys.path.append(str(SOURCE_DIR / "tools"))
+# The benchmark set of issue 20 (tools/benchmark_scenes.py): its scenes can be compared with Cycles
+# by name, or all of them as `--cycles-scenes benchmark`.
+from benchmark_scenes import NAMES as BENCHMARK_SCENES  # noqa: E402
+
 
 # ---------------------------------------------------------------------------------------------
 # Scenes built from triangles (no files, no Blender)
@@ -188,8 +193,8 @@ def technique_section(quick: bool, size: int) -> Dict[str, Any]:
 BLENDER_SCRIPT = r'''
 import json, sys, time, math
 args = json.loads(sys.argv[sys.argv.index("--") + 1])
-sys.path[:0] = [args["shim"], args["addon"], args["scenes"]]
-import bpy, dwivedi, scenes
+sys.path[:0] = [args["shim"], args["addon"], args["scenes"], args["tools"]]
+import bpy, dwivedi, scenes, benchmark_scenes
 import dwivedi_bake.export as export
 
 class Props:  # what export_scene reads of scene.dwivedi_bake
@@ -225,7 +230,7 @@ for name in args["scenes_list"]:
                                                        radius=(0.1, 0.1, 0.1)),
                 # The Subsurface Scattering node: the plain walk, which Blender 3.x's Principled is not.
                 "sphere": lambda r, s: scenes.sphere_scene(r, s, shader='SSS')}
-    scene = builders[name](args["size"], 16)
+    scene = builders[name](args["size"], 16) if name in builders else benchmark_scenes.build(name, args["size"], 16)
     work = args["work"]
     overhead = cycles(scene, 1, 0, f"{work}/{name}_c1.exr")
     ref_spp = 4 * args["cycles_counts"][-1]
@@ -288,7 +293,7 @@ def cycles_section(quick: bool, blender: str, size: int, scenes: Sequence[str], 
         raise RuntimeError(f"the Cycles comparison needs the source tree (tests/blender, blender_addon) at {SOURCE_DIR}")
     with tempfile.TemporaryDirectory() as work:
         result_path = Path(work) / "result.json"
-        args = {"shim": str(Path(dwivedi.__file__).resolve().parent.parent), "addon": str(addon_dir), "scenes": str(scenes_dir), "work": work,
+        args = {"shim": str(Path(dwivedi.__file__).resolve().parent.parent), "addon": str(addon_dir), "scenes": str(scenes_dir), "work": work, "tools": str(SOURCE_DIR / "tools"),
                 "result": str(result_path), "size": size, "scenes_list": list(scenes), "repeats": repeats,
                 # Counts large enough that Cycles' render time, not its per-render overhead, is
                 # what is measured.
@@ -479,15 +484,17 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     parser.add_argument("--sections", default=",".join(SECTIONS),
                         help=f"which parts to run, comma-separated (default: {','.join(SECTIONS)})")
     parser.add_argument("--cycles-scenes", default=",".join(CYCLES_SCENES),
-                        help=f"the scenes compared with Cycles, comma-separated (default: {','.join(CYCLES_SCENES)})")
+                        help=f"the scenes compared with Cycles, comma-separated (default: {','.join(CYCLES_SCENES)}; "
+                        f"also {','.join(BENCHMARK_SCENES)} of tools/benchmark_scenes.py, or `benchmark` for all of those)")
     parser.add_argument("--repeats", type=int, default=None,
                         help="timing rounds against Cycles, each count keeping its fastest time (default 3, quick 1)")
     args = parser.parse_args(argv)
     size = args.size or (16 if args.quick else 32)
     sections = [part for part in args.sections.split(",") if part]
-    cycles_scenes = [name for name in args.cycles_scenes.split(",") if name]
+    cycles_scenes = [part for name in args.cycles_scenes.split(",") if name
+                     for part in (BENCHMARK_SCENES if name == "benchmark" else (name,))]
     repeats = args.repeats if args.repeats is not None else (1 if args.quick else 3)
-    unknown = [part for part in sections if part not in SECTIONS] + [n for n in cycles_scenes if n not in CYCLES_SCENES]
+    unknown = [part for part in sections if part not in SECTIONS] + [n for n in cycles_scenes if n not in CYCLES_SCENES + BENCHMARK_SCENES]
     if unknown or not sections or not cycles_scenes or not 1 <= repeats <= 100:
         problem = (f"unknown section or scene {unknown[0]!r}" if unknown else "no section or scene given"
                    if not sections or not cycles_scenes else f"--repeats {repeats} is outside 1 to 100")
