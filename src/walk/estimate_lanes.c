@@ -80,6 +80,22 @@ static void lane_begin(lane_state *L, int l, const dwvw_estimate_setup *setup, c
     }
 }
 
+/* The lanes' unit free flights dwvk_free_flight(u) = -log(1 - u), bit for bit, in three loops: the
+ * logarithm's arithmetic before and after its table lookups (vectorised), and the lookups between
+ * (gathers, which keep a loop from being vectorised). Apart from the step's main loop for the same
+ * reason. */
+static inline void lanes_unit_flights(const float *u, double *unit_flight)
+{
+    int32_t index[DWVW_LANES], k[DWVW_LANES];
+    double z[DWVW_LANES], invc[DWVW_LANES], logc[DWVW_LANES];
+    for (int l = 0; l < DWVW_LANES; ++l) index[l] = dwvk_log_fast_split(1.0f - u[l], &k[l], &z[l]);
+    for (int l = 0; l < DWVW_LANES; ++l) {
+        invc[l] = DWVK_LOG_TABLE[index[l]][0];
+        logc[l] = DWVK_LOG_TABLE[index[l]][1];
+    }
+    for (int l = 0; l < DWVW_LANES; ++l) unit_flight[l] = -dwvk_log_fast_join(k[l], z[l], invc[l], logc[l]);
+}
+
 /* The distance along w from p to a plane face, as dwvw_shape_exit_inline gives it, with every
  * operation done whatever the sign (a lane's select, not a branch: the division's unused results
  * are discarded). */
@@ -123,10 +139,8 @@ static DWVW_ALWAYS_INLINE int guided_lanes_step_in(lane_state *L, const dwvw_est
         udist[l] = dwvw_counter_uniform_f(L->counter[l] + to_distance);
         L->counter[l] += DWVW_EVENT_COUNTER_STEP;
     }
-    /* The unit free flights -log(1 - u) in a loop of their own: their table lookups are gathers,
-     * which would keep the step's main loop below from being vectorised. */
     double unit_flight[DWVW_LANES];
-    for (int l = 0; l < DWVW_LANES; ++l) unit_flight[l] = dwvk_free_flight(udist[l]);
+    lanes_unit_flights(udist, unit_flight);
     for (int l = 0; l < DWVW_LANES; ++l) {
         dwvk_dwivedi_event_cosine_f s = dwvk_dwivedi_event_sample_select_f(d, ua[l]);
         dwvk_unit2_f azimuth = dwvk_azimuth_f(ub[l]); /* turned by its quarter turns */
@@ -372,7 +386,7 @@ static DWVW_ALWAYS_INLINE int mixture_lanes_step_in(lane_state *L, const dwvw_es
      * the weight is long, and short loops let the core run the lanes' chains side by side. */
     double stretch_of[DWVW_LANES], t_of[DWVW_LANES], decay_of[DWVW_LANES], unit_flight[DWVW_LANES];
     int exited_of[DWVW_LANES];
-    for (int l = 0; l < DWVW_LANES; ++l) unit_flight[l] = dwvk_free_flight(udist[l]); /* gathers: apart */
+    lanes_unit_flights(udist, unit_flight);
     for (int l = 0; l < DWVW_LANES; ++l) {
         double pz = L->pz[l], z = wz[l];
         double mu = dwvw_clamp_cosine(axis_sign * z);
