@@ -27,6 +27,9 @@ import os
 import sys
 from typing import Dict, List, Sequence, Tuple
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from make_example_meshes import icosphere  # noqa: E402  (a unit sphere: a subdivided icosahedron)
+
 Vec = Tuple[float, float, float]
 Tri = Tuple[int, int, int]
 
@@ -38,34 +41,6 @@ Tri = Tuple[int, int, int]
 def _normalise(v: Sequence[float]) -> Vec:
     n = math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
     return (v[0] / n, v[1] / n, v[2] / n)
-
-
-def icosphere(subdivisions: int) -> Tuple[List[Vec], List[Tri]]:
-    """A unit sphere made by subdividing an icosahedron `subdivisions` times (each triangle into
-    four, the new vertices pushed onto the sphere)."""
-    t = (1.0 + math.sqrt(5.0)) / 2.0
-    points = [_normalise(p) for p in ((-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t),
-                                      (0, -1, -t), (0, 1, -t), (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1))]
-    tris = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4), (11, 10, 2),
-            (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8), (3, 8, 9), (4, 9, 5), (2, 4, 11),
-            (6, 2, 10), (8, 6, 7), (9, 8, 1)]
-    for _ in range(subdivisions):
-        middle: Dict[Tuple[int, int], int] = {}
-
-        def mid(a: int, b: int) -> int:
-            key = (min(a, b), max(a, b))
-            if key not in middle:
-                pa, pb = points[a], points[b]
-                points.append(_normalise(((pa[0] + pb[0]) / 2, (pa[1] + pb[1]) / 2, (pa[2] + pb[2]) / 2)))
-                middle[key] = len(points) - 1
-            return middle[key]
-
-        finer = []
-        for a, b, c in tris:
-            ab, bc, ca = mid(a, b), mid(b, c), mid(c, a)
-            finer += [(a, ab, ca), (b, bc, ab), (c, ca, bc), (ab, bc, ca)]
-        tris = finer
-    return points, tris
 
 
 def _bump(p: Vec, centre: Vec, width: float) -> float:
