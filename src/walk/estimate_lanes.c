@@ -24,9 +24,9 @@
  * order (lane_feed), so the totals equal the one-walk-at-a-time path's. */
 
 /* The lane steps' loops are written for a compiler to vectorise; on x86-64 each step is compiled
- * twice, for the baseline (SSE2: two doubles a vector) and for x86-64-v3 (AVX2: four), and the
- * first call picks the copy the processor runs (GCC's target_clones, an ifunc). Both copies do
- * the same IEEE operations in the same order: this file is compiled with -ffp-contract=off (no
+ * three times, for the baseline (SSE2: two doubles a vector), x86-64-v3 (AVX2: four) and
+ * x86-64-v4 (AVX-512: eight), and the first call picks the copy the processor runs (GCC's
+ * target_clones, an ifunc). All copies do the same IEEE operations in the same order: this file is compiled with -ffp-contract=off (no
  * fused multiply-add, which would round differently) and -fno-trapping-math (which lets the
  * selects be computed on both sides, changing no value), so the walks are the same to the last
  * bit on every processor (tests/internal/test_walk_fast_path.c compares them with the one-walk
@@ -203,17 +203,20 @@ static DWVW_ALWAYS_INLINE int guided_lanes_step_in(lane_state *L, const dwvw_est
 }
 
 /* guided_lanes_step_in for each shape, its exit test written out. */
-DWVW_LANE_CLONES static int guided_lanes_step_halfspace(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
+DWVW_LANE_CLONES static int guided_lanes_step_halfspace(lane_state *L, const dwvw_estimate_setup *setup,
+                                                        const dwvw_fast_plan *plan)
 {
     return guided_lanes_step_in(L, setup, plan, DWVW_HALFSPACE);
 }
 
-DWVW_LANE_CLONES static int guided_lanes_step_slab(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
+DWVW_LANE_CLONES static int guided_lanes_step_slab(lane_state *L, const dwvw_estimate_setup *setup,
+                                                   const dwvw_fast_plan *plan)
 {
     return guided_lanes_step_in(L, setup, plan, DWVW_SLAB);
 }
 
-DWVW_LANE_CLONES static int guided_lanes_step_sphere(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
+DWVW_LANE_CLONES static int guided_lanes_step_sphere(lane_state *L, const dwvw_estimate_setup *setup,
+                                                     const dwvw_fast_plan *plan)
 {
     return guided_lanes_step_in(L, setup, plan, DWVW_SPHERE);
 }
@@ -437,17 +440,20 @@ static DWVW_ALWAYS_INLINE int mixture_lanes_step_in(lane_state *L, const dwvw_es
     return any;
 }
 
-DWVW_LANE_CLONES static int mixture_lanes_step_halfspace(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
+DWVW_LANE_CLONES static int mixture_lanes_step_halfspace(lane_state *L, const dwvw_estimate_setup *setup,
+                                                         const dwvw_fast_plan *plan)
 {
     return mixture_lanes_step_in(L, setup, plan, DWVW_HALFSPACE);
 }
 
-DWVW_LANE_CLONES static int mixture_lanes_step_slab(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
+DWVW_LANE_CLONES static int mixture_lanes_step_slab(lane_state *L, const dwvw_estimate_setup *setup,
+                                                    const dwvw_fast_plan *plan)
 {
     return mixture_lanes_step_in(L, setup, plan, DWVW_SLAB);
 }
 
-DWVW_LANE_CLONES static int mixture_lanes_step_sphere(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
+DWVW_LANE_CLONES static int mixture_lanes_step_sphere(lane_state *L, const dwvw_estimate_setup *setup,
+                                                      const dwvw_fast_plan *plan)
 {
     return mixture_lanes_step_in(L, setup, plan, DWVW_SPHERE);
 }
