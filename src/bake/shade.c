@@ -36,11 +36,13 @@ static uint64_t mixture_terms(const dwvw_walk *walk, uint64_t per_component, uin
  * large ball is possible: where the upper bound U = |p - a| + U_a on the distance to the surface
  * (a the last query's position, U_a the surface's distance from it or a bound on that; at first
  * the entry point, U_a = 0) reaches KEPT_BALL_REACH longest mean free paths, and the walk has left
- * its ball. Which steps are ray-free changes the cost only: the walk and the image are the same,
- * bit for bit (auto's pilot, which counts rays and queries, may choose otherwise). */
+ * its ball; and it looks no farther than U / 2 (below). Which steps are ray-free changes the cost
+ * only: the walk and the image are the same, bit for bit (auto's pilot, which counts rays and
+ * queries, may choose otherwise). */
 /* A kept ball's query is made where the surface may be this many longest mean free paths away (a
  * walk leaves a ball of R free paths after some R^2 / 2 steps; a query costs 15-40 rays: at 8 the
- * subdivided head's walks, near its surface, lost 2-6% to queries, docs/speed.md). */
+ * subdivided head's walks, which stay near its surface, lost 2% to queries, at 16 1%, while the
+ * marble and the torus gained about as much either way; docs/speed.md). */
 #define KEPT_BALL_REACH 16.0
 
 static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvw_medium *medium, const dwvw_guide *guide,
@@ -94,16 +96,18 @@ static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvw_medium 
         if (!first && kept_balls) {
             double away = dwvu_length(dwvu_sub(walk->position, anchor));
             ray_free = away + distance < kept_radius;
-            if (!ray_free && away + anchor_reach >= query_reach && away >= kept_radius) {
+            double reach = away + anchor_reach; /* the surface is at most this far */
+            if (!ray_free && reach >= query_reach && away >= kept_radius) {
+                /* The query looks no farther than half the reach: a triangle nearer than that it
+                 * finds (the nearest), and finding none costs little (the BVH's nodes that near);
+                 * then half the reach is clear. */
                 dwvg_hit closest;
-                double clearance_found = 0.0;
+                double bound = 0.0;
                 ++tally->point_queries;
                 anchor = walk->position;
-                anchor_reach = kept_radius = 0.0;
-                if (dwvg_closest_mesh_clearance(world, mesh, anchor, &closest, &clearance_found)) {
-                    anchor_reach = closest.t;
-                    kept_radius = dwvg_clear_radius(world, anchor, clearance_found);
-                }
+                anchor_reach = dwvg_closest_mesh_within(world, mesh, anchor, 0.5 * reach, &closest, &bound) ? closest.t
+                                                                                                          : reach;
+                kept_radius = dwvg_clear_radius(world, anchor, bound);
                 ray_free = distance < kept_radius;
             }
         }
