@@ -56,6 +56,11 @@ if str(SHIM_DIR) not in sys.path:
 
 import dwivedi  # noqa: E402
 
+sys.path.append(str(SOURCE_DIR / "tools"))
+# The benchmark set of issue 20 (tools/benchmark_scenes.py): its scenes can be compared with Cycles
+# by name, or all of them as `--cycles-scenes benchmark`.
+from benchmark_scenes import NAMES as BENCHMARK_SCENES  # noqa: E402
+
 
 # ---------------------------------------------------------------------------------------------
 # Scenes built from triangles (no files, no Blender)
@@ -194,8 +199,8 @@ def technique_section(quick: bool, size: int) -> Dict[str, Any]:
 BLENDER_SCRIPT = r'''
 import json, sys, time, math
 args = json.loads(sys.argv[sys.argv.index("--") + 1])
-sys.path[:0] = [args["shim"], args["addon"], args["scenes"]]
-import bpy, dwivedi, scenes
+sys.path[:0] = [args["shim"], args["addon"], args["scenes"], args["tools"]]
+import bpy, dwivedi, scenes, benchmark_scenes
 import dwivedi_bake.export as export
 
 class Props:  # what export_scene reads of scene.dwivedi_bake
@@ -231,7 +236,7 @@ for name in args["scenes_list"]:
                                                        radius=(0.1, 0.1, 0.1)),
                 # The Subsurface Scattering node: the plain walk, which Blender 3.x's Principled is not.
                 "sphere": lambda r, s: scenes.sphere_scene(r, s, shader='SSS')}
-    scene = builders[name](args["size"], 16)
+    scene = builders[name](args["size"], 16) if name in builders else benchmark_scenes.build(name, args["size"], 16)
     # The same media in every Blender: 5.2's new Random Walk reads the radius as the mean free path
     # (4 pi longer than before); its Legacy method is the model the other versions' scenes use.
     for material in bpy.data.materials:
@@ -330,11 +335,14 @@ def cycles_section(quick: bool, blender: str, size: int, scenes: Sequence[str], 
             shutil.copytree(addon_dir / "dwivedi_bake", stage / "addon" / "dwivedi_bake")
             (stage / "scenes").mkdir()
             shutil.copy2(scenes_dir / "scenes.py", stage / "scenes" / "scenes.py")
+            (stage / "tools").mkdir()
+            shutil.copy2(SOURCE_DIR / "tools" / "benchmark_scenes.py", stage / "tools" / "benchmark_scenes.py")
             shutil.copy2(library, stage / "libdwivedi.so.1")
-            paths = {"shim": stage / "shim", "addon": stage / "addon", "scenes": stage / "scenes"}
+            paths = {"shim": stage / "shim", "addon": stage / "addon", "scenes": stage / "scenes",
+                     "tools": stage / "tools"}
             library_seen = inside(stage / "libdwivedi.so.1")
         else:
-            paths = {"shim": shim_dir, "addon": addon_dir, "scenes": scenes_dir}
+            paths = {"shim": shim_dir, "addon": addon_dir, "scenes": scenes_dir, "tools": SOURCE_DIR / "tools"}
             library_seen = library
         result_path = stage / "result.json"
         args = {**{key: inside(value) for key, value in paths.items()}, "work": inside(stage),
@@ -567,7 +575,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     parser.add_argument("--sections", default=",".join(SECTIONS),
                         help=f"which parts to run, comma-separated (default: {','.join(SECTIONS)})")
     parser.add_argument("--cycles-scenes", default=",".join(CYCLES_SCENES),
-                        help=f"the scenes compared with Cycles, comma-separated (default: {','.join(CYCLES_SCENES)})")
+                        help=f"the scenes compared with Cycles, comma-separated (default: {','.join(CYCLES_SCENES)}; "
+                        f"also {','.join(BENCHMARK_SCENES)} of tools/benchmark_scenes.py, or `benchmark` for all of those)")
     parser.add_argument("--repeats", type=int, default=None,
                         help="timing rounds against Cycles, each count keeping its fastest time (default 3, quick 1)")
     parser.add_argument("--cycles-blenders", default="host",
@@ -580,10 +589,11 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     blenders = [name for name in args.cycles_blenders.split(",") if name]
     size = args.size or (16 if args.quick else 32)
     sections = [part for part in args.sections.split(",") if part]
-    cycles_scenes = [name for name in args.cycles_scenes.split(",") if name]
+    cycles_scenes = [part for name in args.cycles_scenes.split(",") if name
+                     for part in (BENCHMARK_SCENES if name == "benchmark" else (name,))]
     repeats = args.repeats if args.repeats is not None else (1 if args.quick else 3)
     unknown = ([part for part in sections if part not in SECTIONS]
-               + [n for n in cycles_scenes if n not in CYCLES_SCENES]
+               + [n for n in cycles_scenes if n not in CYCLES_SCENES + BENCHMARK_SCENES]
                + [n for n in blenders if n not in BLENDERS])
     if unknown or not sections or not cycles_scenes or not blenders or not 1 <= repeats <= 100:
         problem = (f"unknown section, scene or Blender {unknown[0]!r}" if unknown else "no section, scene or Blender "

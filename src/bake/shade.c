@@ -26,7 +26,25 @@ static uint64_t mixture_terms(const dwvw_walk *walk, uint64_t per_component, uin
  * length t < that radius stays in the ball: the walk scatters at its end without a ray, exactly as
  * after a ray that met nothing (the same walk and image, bit for bit). Walks meet only their own
  * mesh, so this holds for open meshes too. The first step (the probe, which the backward
- * technique needs in full) is always a ray (its origin is on the surface: no ball there). */
+ * technique needs in full) is always a ray (its origin is on the surface: no ball there).
+ *
+ * Kept balls: a mesh with neither a grid nor planes (its medium too thin against its size for the
+ * grid's cells: a thick curved object of a realistic mean free path) gets its bound from a
+ * closest-point query at the walk's position c, and keeps that ball: any later step from p of
+ * length t with |p - c| + t below its clear radius stays inside it (the segment lies in
+ * B(c, |p - c| + t)), ray-free as above. A query costs some 15-40 rays, so it is made only where a
+ * large ball is possible: where the upper bound U = |p - a| + U_a on the distance to the surface
+ * (a the last query's position, U_a the surface's distance from it or a bound on that; at first
+ * the entry point, U_a = 0) reaches KEPT_BALL_REACH longest mean free paths, and the walk has left
+ * its ball; and it looks no farther than U / 2 (below). Which steps are ray-free changes the cost
+ * only: the walk and the image are the same, bit for bit (auto's pilot, which counts rays and
+ * queries, may choose otherwise). */
+/* A kept ball's query is made where the surface may be this many longest mean free paths away (a
+ * walk leaves a ball of R free paths after some R^2 / 2 steps; a query costs 15-40 rays: at 8 the
+ * subdivided head's walks, which stay near its surface, lost 2% to queries, at 16 1%, while the
+ * marble and the torus gained about as much either way; docs/speed.md). */
+#define KEPT_BALL_REACH 16.0
+
 static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvw_medium *medium, const dwvw_guide *guide,
                     uint32_t entry_prim, dwvu_vec3 x, dwvu_vec3 direction, dwvu_vec3 entry_normal, uint64_t key,
                     const dwvk_sampler *sampler, uint32_t walk_pair, dwvw_pair_cache *pairs, dwvw_walk *walk,
@@ -47,6 +65,14 @@ static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvw_medium 
      * dwvg_mesh_closed). A hit beyond that changes no walk (it is no exit and no opposite
      * interface), and a shorter ray is cheaper to trace. */
     int full_probe = !world->closed[mesh];
+    /* Kept balls (above): where neither a grid nor planes bound the clearance, and the technique
+     * does not find the closest point at every event anyway. */
+    int kept_balls = !needs_closest && ball_mode != DWVB_BALL_OFF && !(grid->largest > 0.0);
+    double longest_path = 0.0;
+    for (int c = 0; c < medium->channels; ++c) longest_path = fmax(longest_path, 1.0 / medium->sigma_t[c]);
+    double query_reach = KEPT_BALL_REACH * longest_path;
+    dwvu_vec3 anchor = x;                     /* the last query's position, or the entry point */
+    double anchor_reach = 0.0, kept_radius = 0.0; /* the surface's distance from it (0: none found); its ball */
     uint64_t terms_per_component = (uint64_t)walk->medium->channels * (uint64_t)walk->medium->channels;
     uint64_t patches = walk->guide->q_incident > 0.0 && walk->guide->patch_count > 1 ? (uint64_t)walk->guide->patch_count : 0u;
     while (walk->status == DWVW_RUNNING) {
@@ -66,6 +92,24 @@ static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvw_medium 
         if (!first && ball_mode != DWVB_BALL_OFF && (needs_closest || distance < grid->largest)) {
             if (!needs_closest) clearance = dwvg_clearance_above(grid, walk->position, distance);
             ray_free = distance < clearance && distance < dwvg_clear_radius(world, walk->position, clearance);
+        }
+        if (!first && kept_balls) {
+            double away = dwvu_length(dwvu_sub(walk->position, anchor));
+            ray_free = away + distance < kept_radius;
+            double reach = away + anchor_reach; /* the surface is at most this far */
+            if (!ray_free && reach >= query_reach && away >= kept_radius) {
+                /* The query looks no farther than half the reach: a triangle nearer than that it
+                 * finds (the nearest), and finding none costs little (the BVH's nodes that near);
+                 * then half the reach is clear. */
+                dwvg_hit closest;
+                double bound = 0.0;
+                ++tally->point_queries;
+                anchor = walk->position;
+                anchor_reach = dwvg_closest_mesh_within(world, mesh, anchor, 0.5 * reach, &closest, &bound) ? closest.t
+                                                                                                          : reach;
+                kept_radius = dwvg_clear_radius(world, anchor, bound);
+                ray_free = distance < kept_radius;
+            }
         }
         dwvg_hit hit;
         int found = 0;

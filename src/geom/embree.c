@@ -543,6 +543,7 @@ typedef struct closest_query {
     dwvu_vec3 p;
     dwvg_hit best;
     int found;
+    int bounded;       /* the query began with a finite radius: nothing beyond it is taken */
     double degenerate; /* the distance to the nearest zero-area triangle seen */
 } closest_query;
 
@@ -560,7 +561,10 @@ static bool closest_callback(struct RTCPointQueryFunctionArguments *args)
     dwvg_closest_on_triangle(q->p, a, b, c, &u, &v);
     dwvu_vec3 x = dwvg_point(q->mesh, prim, u, v);
     double distance = dwvu_length(dwvu_sub(x, q->p));
-    if (!(distance < args->query->radius) && q->found) return false;
+    /* A triangle beyond the radius is no answer once one is found, nor ever in a bounded query:
+     * taking it would widen the radius after nodes within the old one were passed over, and a
+     * nearer triangle in a node culled before could be missed. */
+    if (!(distance < args->query->radius) && (q->found || q->bounded)) return false;
     q->best.prim = prim;
     q->best.u = u;
     q->best.v = v;
@@ -572,6 +576,12 @@ static bool closest_callback(struct RTCPointQueryFunctionArguments *args)
 
 int dwvg_closest_mesh_clearance(const dwvg_world *world, uint32_t mesh, dwvu_vec3 p, dwvg_hit *hit, double *clearance)
 {
+    return dwvg_closest_mesh_within(world, mesh, p, INFINITY, hit, clearance);
+}
+
+int dwvg_closest_mesh_within(const dwvg_world *world, uint32_t mesh, dwvu_vec3 p, double within, dwvg_hit *hit,
+                             double *clearance)
+{
     *clearance = 0.0;
     struct RTCPointQuery query;
     if (!in_embree_range((float)p.x, (float)p.y, (float)p.z)) return 0;
@@ -579,12 +589,21 @@ int dwvg_closest_mesh_clearance(const dwvg_world *world, uint32_t mesh, dwvu_vec
     query.y = (float)p.y;
     query.z = (float)p.z;
     query.time = 0.0f;
-    query.radius = INFINITY;
+    /* Embree calls back for every triangle whose bounds meet the query's sphere, so a finite radius
+     * spares the nodes farther away. It is rounded up past the double one, and past the float
+     * centre's own rounding (at most 2^-24 of its largest coordinate). */
+    int bounded = within < INFINITY;
+    double largest = fmax(fabs(p.x), fmax(fabs(p.y), fabs(p.z)));
+    query.radius = bounded ? (float)(within * 1.0001 + largest * 0x1p-22) : INFINITY;
     struct RTCPointQueryContext context;
     rtcInitPointQueryContext(&context);
-    closest_query q = {.mesh = &world->meshes[mesh], .p = p, .found = 0, .degenerate = INFINITY};
+    closest_query q = {.mesh = &world->meshes[mesh], .p = p, .found = 0, .bounded = bounded, .degenerate = INFINITY};
     rtcPointQuery(world->mesh_scenes[mesh], &query, &context, closest_callback, &q);
-    if (!q.found) return 0;
+    if (!q.found) {
+        /* Nothing within `within`: that far is clear (but for a zero-area triangle seen nearer). */
+        if (bounded) *clearance = fmin(within, q.degenerate);
+        return 0;
+    }
     *hit = q.best;
     hit->mesh = mesh;
     *clearance = fmin(q.best.t, q.degenerate);

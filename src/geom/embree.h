@@ -96,6 +96,12 @@ int dwvg_closest_mesh(const dwvg_world *world, uint32_t mesh, dwvu_vec3 p, dwvg_
 /* The same, with the distance from p to the nearest triangle a ray could hit (zero-area ones
  * included) in *clearance (0 if none found). */
 int dwvg_closest_mesh_clearance(const dwvg_world *world, uint32_t mesh, dwvu_vec3 p, dwvg_hit *hit, double *clearance);
+/* dwvg_closest_mesh_clearance within distance `within` (> 0) of p: the query visits only that
+ * far. Returns 1 with the nearest triangle if one lies within it; else 0 with *clearance =
+ * `within` (nothing a ray could hit is nearer: a lower bound), or less for a zero-area triangle
+ * nearer, or 0 where p is outside Embree's range. */
+int dwvg_closest_mesh_within(const dwvg_world *world, uint32_t mesh, dwvu_vec3 p, double within, dwvg_hit *hit,
+                             double *clearance);
 /* Builds the clearance grid of one mesh (clearance.h, dwvg_clearance_build) with cells of at least
  * `cell_size` and at most `largest_cell`: for the meshes whose walks may take ray-free steps. 0 on
  * success or where no grid is made (its lookups then give 0), -1 out of memory. */

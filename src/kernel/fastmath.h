@@ -110,6 +110,29 @@ static inline double dwvk_exp_fast(double x)
     return p * scale;
 }
 
+/* dwvk_log_fast (below) in two parts, for loops over lanes that vectorise its arithmetic and read
+ * the table in a loop of their own (its lookups are gathers): the table index of x, with k and z
+ * of x = 2^k z. */
+static inline int32_t dwvk_log_fast_split(float x, int32_t *k, double *z)
+{
+    uint32_t bits = dwvk_float_bits(x);
+    uint32_t offset = bits - DWVK_LOG_TABLE_OFF;
+    /* k = floor(offset / 2^23) as a signed number, biased by 128 so that the shift is unsigned
+     * (x positive normal: no wrap-around). */
+    *k = (int32_t)((offset + 0x40000000u) >> 23) - 128;
+    *z = (double)dwvk_bits_float(bits - ((uint32_t)*k << 23));
+    return (int32_t)((offset >> DWVK_LOG_TABLE_SHIFT) % DWVK_LOG_TABLE_SIZE);
+}
+
+/* ... and log x from k, z and the index's table row {1/c, log c}. */
+static inline double dwvk_log_fast_join(int32_t k, double z, double invc, double logc)
+{
+    double r = z * invc - 1.0;
+    double r2 = r * r;
+    double log1p_r = r + r2 * (-0.5 + r * (0.33333333333333333 - 0.25 * r));
+    return (double)k * 0.69314718055994531 + logc + log1p_r;
+}
+
 /* log(x) for positive normal float x, in double: absolute error below 1e-9 for x in [1/2, 2],
  * relative error below 1e-9 elsewhere, and for x in [0.984375, 1) (log(1 - u), u small) relative
  * error below 2e-8 (measured 1.9e-10, 2.7e-10 and 1.2e-8: tests/internal/test_fastmath.c). Table-driven (as
@@ -120,17 +143,10 @@ static inline double dwvk_exp_fast(double x)
  * 1 has invc = 1 (log c = 0), so log(1 - u) = log1p(-u) there keeps its relative accuracy. */
 static inline double dwvk_log_fast(float x)
 {
-    uint32_t bits = dwvk_float_bits(x);
-    uint32_t offset = bits - DWVK_LOG_TABLE_OFF;
-    uint32_t i = (offset >> DWVK_LOG_TABLE_SHIFT) % DWVK_LOG_TABLE_SIZE;
-    /* k = floor(offset / 2^23) as a signed number, biased by 128 so that the shift is unsigned
-     * (x positive normal: no wrap-around). */
-    int32_t k = (int32_t)((offset + 0x40000000u) >> 23) - 128;
-    double z = (double)dwvk_bits_float(bits - ((uint32_t)k << 23));
-    double r = z * DWVK_LOG_TABLE[i][0] - 1.0;
-    double r2 = r * r;
-    double log1p_r = r + r2 * (-0.5 + r * (0.33333333333333333 - 0.25 * r));
-    return (double)k * 0.69314718055994531 + DWVK_LOG_TABLE[i][1] + log1p_r;
+    int32_t k;
+    double z;
+    int32_t i = dwvk_log_fast_split(x, &k, &z);
+    return dwvk_log_fast_join(k, z, DWVK_LOG_TABLE[i][0], DWVK_LOG_TABLE[i][1]);
 }
 
 /* An exponential free flight in units of 1/sigma: -log(1 - u) for u = i 2^-24, i in [0, 2^24)

@@ -23,6 +23,20 @@
  * ended takes the next walk of its thread's blocks. Results are added to their block in walk
  * order (lane_feed), so the totals equal the one-walk-at-a-time path's. */
 
+/* The lane steps' loops are written for a compiler to vectorise; on x86-64 each step is compiled
+ * three times, for the baseline (SSE2: two doubles a vector), x86-64-v3 (AVX2: four) and
+ * x86-64-v4 (AVX-512: eight), and the first call picks the copy the processor runs (GCC's
+ * target_clones, an ifunc). All copies do the same IEEE operations in the same order: this file is compiled with -ffp-contract=off (no
+ * fused multiply-add, which would round differently) and -fno-trapping-math (which lets the
+ * selects be computed on both sides, changing no value), so the walks are the same to the last
+ * bit on every processor (tests/internal/test_walk_fast_path.c compares them with the one-walk
+ * path, which is not cloned). */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && __GNUC__ >= 12
+#define DWVW_LANE_CLONES __attribute__((target_clones("default", "arch=x86-64-v3", "arch=x86-64-v4")))
+#else
+#define DWVW_LANE_CLONES
+#endif
+
 /* The lanes' state. p: position; d: the direction of the step being taken (for a lane at
  * events = 0, its entry direction). log_constants and exponent as in guided_walk_in, weight as in
  * mixture_walk_in. */
@@ -64,6 +78,22 @@ static void lane_begin(lane_state *L, int l, const dwvw_estimate_setup *setup, c
         double stretch = dwvk_dwivedi_stretch_d(&setup->medium.dwivedi, dwvw_aligned_cosine(plan, direction));
         L->first_constant[l] = log(setup->medium.albedo[0] / stretch);
     }
+}
+
+/* The lanes' unit free flights dwvk_free_flight(u) = -log(1 - u), bit for bit, in three loops: the
+ * logarithm's arithmetic before and after its table lookups (vectorised), and the lookups between
+ * (gathers, which keep a loop from being vectorised). Apart from the step's main loop for the same
+ * reason. */
+static inline void lanes_unit_flights(const float *u, double *unit_flight)
+{
+    int32_t index[DWVW_LANES], k[DWVW_LANES];
+    double z[DWVW_LANES], invc[DWVW_LANES], logc[DWVW_LANES];
+    for (int l = 0; l < DWVW_LANES; ++l) index[l] = dwvk_log_fast_split(1.0f - u[l], &k[l], &z[l]);
+    for (int l = 0; l < DWVW_LANES; ++l) {
+        invc[l] = DWVK_LOG_TABLE[index[l]][0];
+        logc[l] = DWVK_LOG_TABLE[index[l]][1];
+    }
+    for (int l = 0; l < DWVW_LANES; ++l) unit_flight[l] = -dwvk_log_fast_join(k[l], z[l], invc[l], logc[l]);
 }
 
 /* The distance along w from p to a plane face, as dwvw_shape_exit_inline gives it, with every
@@ -109,6 +139,8 @@ static DWVW_ALWAYS_INLINE int guided_lanes_step_in(lane_state *L, const dwvw_est
         udist[l] = dwvw_counter_uniform_f(L->counter[l] + to_distance);
         L->counter[l] += DWVW_EVENT_COUNTER_STEP;
     }
+    double unit_flight[DWVW_LANES];
+    lanes_unit_flights(udist, unit_flight);
     for (int l = 0; l < DWVW_LANES; ++l) {
         dwvk_dwivedi_event_cosine_f s = dwvk_dwivedi_event_sample_select_f(d, ua[l]);
         dwvk_unit2_f azimuth = dwvk_azimuth_f(ub[l]); /* turned by its quarter turns */
@@ -135,7 +167,7 @@ static DWVW_ALWAYS_INLINE int guided_lanes_step_in(lane_state *L, const dwvw_est
         /* dwvk_dwivedi_stretch_d, its constants loaded before the loop and both sides formed. */
         double stretch_above = one_minus_kappa + kappa * (1.0 - mu), stretch_below = 1.0 - kappa * mu;
         double stretch = mu >= 0.0 ? stretch_above : stretch_below;
-        double t = dwvw_flight(sigma * stretch, udist[l]);
+        double t = dwvw_unit_flight_scaled(unit_flight[l], sigma * stretch);
         double hit;
         if (kind == DWVW_HALFSPACE) hit = lane_halfspace_exit(pz, wz);
         else if (kind == DWVW_SLAB) hit = lane_slab_exit(thickness, pz, wz);
@@ -171,17 +203,20 @@ static DWVW_ALWAYS_INLINE int guided_lanes_step_in(lane_state *L, const dwvw_est
 }
 
 /* guided_lanes_step_in for each shape, its exit test written out. */
-static int guided_lanes_step_halfspace(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
+DWVW_LANE_CLONES static int guided_lanes_step_halfspace(lane_state *L, const dwvw_estimate_setup *setup,
+                                                        const dwvw_fast_plan *plan)
 {
     return guided_lanes_step_in(L, setup, plan, DWVW_HALFSPACE);
 }
 
-static int guided_lanes_step_slab(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
+DWVW_LANE_CLONES static int guided_lanes_step_slab(lane_state *L, const dwvw_estimate_setup *setup,
+                                                   const dwvw_fast_plan *plan)
 {
     return guided_lanes_step_in(L, setup, plan, DWVW_SLAB);
 }
 
-static int guided_lanes_step_sphere(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
+DWVW_LANE_CLONES static int guided_lanes_step_sphere(lane_state *L, const dwvw_estimate_setup *setup,
+                                                     const dwvw_fast_plan *plan)
 {
     return guided_lanes_step_in(L, setup, plan, DWVW_SPHERE);
 }
@@ -352,14 +387,15 @@ static DWVW_ALWAYS_INLINE int mixture_lanes_step_in(lane_state *L, const dwvw_es
     }
     /* Three loops, not one: each lane's chain from the flight's log through the exponential to
      * the weight is long, and short loops let the core run the lanes' chains side by side. */
-    double stretch_of[DWVW_LANES], t_of[DWVW_LANES], decay_of[DWVW_LANES];
+    double stretch_of[DWVW_LANES], t_of[DWVW_LANES], decay_of[DWVW_LANES], unit_flight[DWVW_LANES];
     int exited_of[DWVW_LANES];
+    lanes_unit_flights(udist, unit_flight);
     for (int l = 0; l < DWVW_LANES; ++l) {
         double pz = L->pz[l], z = wz[l];
         double mu = dwvw_clamp_cosine(axis_sign * z);
         double stretch_above = one_minus_kappa + kappa * (1.0 - mu), stretch_below = 1.0 - kappa * mu;
         double stretch = mu >= 0.0 ? stretch_above : stretch_below;
-        double t = dwvw_flight(sigma * (guided[l] ? stretch : 1.0), udist[l]);
+        double t = dwvw_unit_flight_scaled(unit_flight[l], sigma * (guided[l] ? stretch : 1.0));
         double hit;
         if (kind == DWVW_HALFSPACE) hit = lane_halfspace_exit(pz, z);
         else if (kind == DWVW_SLAB) hit = lane_slab_exit(thickness, pz, z);
@@ -404,17 +440,20 @@ static DWVW_ALWAYS_INLINE int mixture_lanes_step_in(lane_state *L, const dwvw_es
     return any;
 }
 
-static int mixture_lanes_step_halfspace(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
+DWVW_LANE_CLONES static int mixture_lanes_step_halfspace(lane_state *L, const dwvw_estimate_setup *setup,
+                                                         const dwvw_fast_plan *plan)
 {
     return mixture_lanes_step_in(L, setup, plan, DWVW_HALFSPACE);
 }
 
-static int mixture_lanes_step_slab(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
+DWVW_LANE_CLONES static int mixture_lanes_step_slab(lane_state *L, const dwvw_estimate_setup *setup,
+                                                    const dwvw_fast_plan *plan)
 {
     return mixture_lanes_step_in(L, setup, plan, DWVW_SLAB);
 }
 
-static int mixture_lanes_step_sphere(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
+DWVW_LANE_CLONES static int mixture_lanes_step_sphere(lane_state *L, const dwvw_estimate_setup *setup,
+                                                      const dwvw_fast_plan *plan)
 {
     return mixture_lanes_step_in(L, setup, plan, DWVW_SPHERE);
 }

@@ -118,6 +118,13 @@ static inline double dwvw_flight(double sigma, float u)
     return dwvk_free_flight(u) / sigma;
 }
 
+/* dwvw_flight from its unit flight dwvk_free_flight(u), drawn apart (the lanes draw theirs in a
+ * loop of their own): the same division, the same bits. */
+static inline double dwvw_unit_flight_scaled(double unit_flight, double sigma)
+{
+    return unit_flight / sigma;
+}
+
 /* The exit test: the ray along the step meets the surface at distance `hit` (+INFINITY for none)
  * within the sampled `flight`, and the walk leaves there. */
 static inline int dwvw_leaves(double hit, double flight)
