@@ -2,6 +2,8 @@
 
 #include <math.h>
 
+#include "bake/textured.h"
+
 
 /* The mixture terms of the step just sampled (see dwvb_tally): `per_component` (the channels
  * squared) for each component of weight > 0, of which a walk with a single one (the classical
@@ -171,6 +173,10 @@ static void exit_light(const dwvb_shader *shader, uint32_t mesh_id, const dwvb_m
     const dwvg_mesh *mesh = &scene->meshes[mesh_id];
     dwvu_vec3 exit_ng = walk->exit_normal;
     dwvu_vec3 exit_n = dwvg_shading_normal(mesh, exit->prim, exit->u, exit->v, exit_ng);
+    /* Cycles evaluates the exit's shader for its normal (SD_HAS_BSSRDF_BUMP): the normal map and
+     * bump there, the rest of the material being the entry's. */
+    if (dwvb_textured_normal_bound(scene, mesh_id))
+        exit_n = dwvb_textured_normal(scene, mesh_id, exit->prim, exit->u, exit->v, exit_n, exit_ng);
     /* Cycles shades the exit as a surface point of its triangle: the same terminator offset. */
     double cutoff = scene->terminator_offsets[mesh_id];
     dwvl_terminator exit_terminator = {mesh, exit->prim, exit->u, exit->v, cutoff};
@@ -202,6 +208,13 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
     const dwvg_mesh *mesh = &scene->meshes[hit->mesh];
     uint32_t material_id = mesh->material_id;
     const dwvb_material *material = &scene->shading[material_id];
+    /* Textured inputs: the material as the textures make it here, once, for the surface lobes and
+     * for the whole walk from here (Cycles' homogeneous medium from the entry's closure). */
+    dwvb_material textured;
+    if (dwvb_textured_inputs(scene, hit->mesh)) {
+        dwvb_textured_material(scene, hit->mesh, hit->prim, hit->u, hit->v, &textured);
+        material = &textured;
+    }
     rgb[0] = rgb[1] = rgb[2] = 0.0;
     dwvu_vec3 ng = dwvg_geometric_normal(mesh, hit->prim);
     if (ng.x == 0.0 && ng.y == 0.0 && ng.z == 0.0) {
@@ -221,6 +234,7 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
     }
     dwvu_vec3 x = dwvg_point(mesh, hit->prim, hit->u, hit->v);
     dwvu_vec3 n = dwvg_shading_normal(mesh, hit->prim, hit->u, hit->v, ng);
+    if (dwvb_textured_normal_bound(scene, hit->mesh)) n = dwvb_textured_normal(scene, hit->mesh, hit->prim, hit->u, hit->v, n, ng);
     uint32_t light_pairs = dwvl_direct_pairs(&shader->env);
     /* Cycles 4.0-4.4: channels whose radius is below a quarter of the camera ray's footprint are
      * Lambertian at this hit (bssrdf_setup); their walks' results are not used. */
