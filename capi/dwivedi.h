@@ -706,6 +706,13 @@ typedef struct dwv_texture_desc_t {
 DWV_API dwv_result_t dwv_scene_add_texture(dwv_scene_t *scene, const dwv_texture_desc_t *texture,
                                            uint32_t *texture_id);
 
+/* A texture from a PNG file (8 bits per channel; 16-bit files are reduced to 8): its size and
+ * channels (1 grey, 3 colour, 4 with alpha) come from the file, extension and interpolation from
+ * `settings`, whose format says what the bytes are (DWV_TEXEL_SRGB8 or DWV_TEXEL_LINEAR8; other
+ * fields ignored). A missing file: DWV_ERROR_IO; not a PNG: DWV_ERROR_FORMAT; the message names it. */
+DWV_API dwv_result_t dwv_scene_add_texture_file(dwv_scene_t *scene, const char *path,
+                                                const dwv_texture_desc_t *settings, uint32_t *texture_id);
+
 /* The material inputs a texture can drive (dwv_material_t's fields of those names). */
 typedef int32_t dwv_material_input_t;
 enum {

@@ -10,6 +10,7 @@
 #include <dwivedi.h>
 #include "util/error.h"
 #include "geom/mesh.h"
+#include "output/png_reader.h"
 #include "scene_handle.h"
 
 dwv_result_t dwv_scene_create(dwv_scene_t **scene)
@@ -511,6 +512,31 @@ dwv_result_t dwv_scene_add_texture(dwv_scene_t *scene, const dwv_texture_desc_t 
     }
     *texture_id = s->texture_count - 1u;
     return DWV_SUCCESS;
+}
+
+dwv_result_t dwv_scene_add_texture_file(dwv_scene_t *scene, const char *path, const dwv_texture_desc_t *settings,
+                                        uint32_t *texture_id)
+{
+    static const char fn[] = "dwv_scene_add_texture_file";
+    dwvb_scene *s;
+    DWV_TRY(open_scene(fn, scene, &s));
+    DWV_TRY(dwv_check_pointer(fn, "path", path));
+    DWV_TRY(dwv_check_struct(fn, "settings", settings, (uint32_t)sizeof(dwv_texture_desc_t)));
+    DWV_TRY(dwv_check_pointer(fn, "texture_id", texture_id));
+    if (settings->format != DWV_TEXEL_SRGB8 && settings->format != DWV_TEXEL_LINEAR8)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
+                        "%s: a PNG holds 8-bit values: format must be sRGB 8-bit (1) or linear 8-bit (2), not %d", fn,
+                        (int)settings->format);
+    dwv_texture_desc_t desc = *settings;
+    uint8_t *pixels = NULL;
+    char message[512];
+    dwv_result_t r = dwvo_read_png8(path, &desc.width, &desc.height, &desc.channels, &pixels, message, sizeof message);
+    if (r != DWV_SUCCESS) return dwv_fail(r, "%s: %s", fn, message);
+    desc.struct_size = (uint32_t)sizeof desc;
+    desc.texels = pixels;
+    r = dwv_scene_add_texture(scene, &desc, texture_id);
+    free(pixels);
+    return r;
 }
 
 dwv_result_t dwv_scene_bind_texture(dwv_scene_t *scene, uint32_t material_id, const dwv_texture_binding_t *binding)

@@ -10,7 +10,7 @@ static dwv_result_t read_material(dwvs_parser *ps, const cJSON *item, const char
 {
     static const char *const keys[] = {"kind", "base_color", "subsurface_weight", "subsurface_color",
                                        "subsurface_radius", "subsurface_scale", "subsurface_anisotropy",
-                                       "subsurface_ior", "subsurface_exit", "roughness"};
+                                       "subsurface_ior", "subsurface_exit", "roughness", "textures"};
     static const char *const kinds[] = {"subsurface", "diffuse"};
     static const char *const exits[] = {"lambert", "principled_v1"};
     DWV_TRY(dwvs_check_keys(item, path, keys, sizeof keys / sizeof keys[0]));
@@ -31,6 +31,8 @@ static dwv_result_t read_material(dwvs_parser *ps, const cJSON *item, const char
     uint32_t id;
     dwv_result_t r = dwv_scene_add_material(ps->scene, &m, &id);
     if (r != DWV_SUCCESS) return dwvs_prefix_capi(r, path);
+    const cJSON *textures = dwvs_member(item, "textures");
+    if (textures) DWV_TRY(dwvs_read_material_textures(ps, textures, path, id));
     ps->materials[ps->material_count].name = item->string;
     ps->materials[ps->material_count].id = id;
     ++ps->material_count;
