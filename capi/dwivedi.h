@@ -741,6 +741,17 @@ enum {
  * grad h) with grad h the height's gradient along the surface, negated by `invert`, then
  * normalize(strength N' + (1 - strength) N) (Cycles' svm_node_set_bump in the limit of small
  * differentials). At most one normal map and one bump per material. */
+/* How diffuse lobes are shadowed where a normal map or bump tilts the shading normal
+ * (dwv_texture_binding_t.bump_shadowing of the normal map or bump). */
+typedef int32_t dwv_bump_shadowing_t;
+enum {
+    DWV_BUMP_SHADOWING_NONE = 0,
+    /* Chiang, Li and Burley 2019, "Taming the Shadow Terminator", as Cycles 3.x applies it to its
+     * diffuse closures (bsdf.h bump_shadowing_term): the diffuse BRDF times
+     * G = -g^3 + g^2 + g, g = (N_s . L) / ((N . L)(N_s . N)) clamped (1 from g >= 1, 0 below 0),
+     * N the mapped normal, N_s the smooth one; at the entry point and at a walk's exit. */
+    DWV_BUMP_SHADOWING_CHIANG2019 = 1
+};
 typedef struct dwv_texture_binding_t {
     uint32_t struct_size;        /* sizeof(dwv_texture_binding_t): set by DWV_TEXTURE_BINDING_INIT */
     dwv_material_input_t input;  /* DWV_INPUT_* */
@@ -751,9 +762,12 @@ typedef struct dwv_texture_binding_t {
     double blend;                /* in [0, 1], 1 by default */
     double strength;             /* normal map: >= 0 (1 by default); bump: in [0, 1] */
     double distance;             /* bump: finite, in scene units (Blender's Distance, 1 by default) */
+    dwv_bump_shadowing_t bump_shadowing; /* normal map, bump: DWV_BUMP_SHADOWING_* (Chiang 2019 by default) */
+    uint32_t reserved;           /* 0 */
 } dwv_texture_binding_t;
 #define DWV_TEXTURE_BINDING_INIT                                                                    \
-    {sizeof(dwv_texture_binding_t), DWV_INPUT_BASE_COLOR, 0u, 0, NULL, 1.0, 1.0, 1.0}
+    {sizeof(dwv_texture_binding_t), DWV_INPUT_BASE_COLOR, 0u, 0, NULL, 1.0, 1.0, 1.0,              \
+     DWV_BUMP_SHADOWING_CHIANG2019, 0u}
 DWV_API dwv_result_t dwv_scene_bind_texture(dwv_scene_t *scene, uint32_t material_id,
                                             const dwv_texture_binding_t *binding);
 /* The bytes the scene's textures hold in memory, and their texels (width x height summed): the

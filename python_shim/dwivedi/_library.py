@@ -199,6 +199,8 @@ class TextureBinding(_SizedStructure):
         ("blend", ctypes.c_double),
         ("strength", ctypes.c_double),
         ("distance", ctypes.c_double),
+        ("bump_shadowing", ctypes.c_int32),
+        ("reserved", ctypes.c_uint32),
     ]
 
 

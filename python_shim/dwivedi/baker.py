@@ -462,6 +462,7 @@ class BakeStats:
 TEXEL_FORMATS = ("float32", "srgb8", "linear8")
 TEXTURE_EXTENSIONS = ("repeat", "extend", "clip", "mirror")
 TEXTURE_INTERPOLATIONS = ("linear", "closest", "cubic")
+BUMP_SHADOWINGS = ("none", "chiang2019")
 MATERIAL_INPUTS = ("base_color", "subsurface_color", "subsurface_weight", "subsurface_radius", "subsurface_scale",
                    "subsurface_anisotropy", "roughness", "specular", "specular_tint", "normal_map", "bump")
 
@@ -673,10 +674,13 @@ class Scene:
         return out.value
 
     def bind_texture(self, material: int, input: str, texture: int, *, uv_layer: Optional[str] = None,
-                     blend: float = 1.0, strength: float = 1.0, distance: float = 1.0, invert: bool = False) -> None:
+                     blend: float = 1.0, strength: float = 1.0, distance: float = 1.0, invert: bool = False,
+                     bump_shadowing: str = "chiang2019") -> None:
         """Binds texture `texture` to input `input` of material `material` (dwv_texture_binding_t):
         one of MATERIAL_INPUTS ("base_color", "subsurface_color", ..., "normal_map", "bump"),
-        through the mesh's UV layer `uv_layer` (a name given to add_mesh; None: its first)."""
+        through the mesh's UV layer `uv_layer` (a name given to add_mesh; None: its first).
+        bump_shadowing (normal map, bump): "chiang2019" (Cycles 3.x's diffuse shadowing of tilted
+        normals) or "none"."""
         binding = _library.TextureBinding()
         binding.input = _choice("input", input, MATERIAL_INPUTS)
         binding.texture_id = _uint("texture", texture)
@@ -685,6 +689,7 @@ class Scene:
         binding.blend = _real("blend", blend)
         binding.strength = _real("strength", strength)
         binding.distance = _real("distance", distance)
+        binding.bump_shadowing = _choice("bump_shadowing", bump_shadowing, BUMP_SHADOWINGS)
         _call("dwv_scene_bind_texture", self.handle, _uint("material", material), ctypes.byref(binding))
 
     def texture_memory(self) -> Tuple[int, int]:

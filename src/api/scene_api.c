@@ -566,6 +566,10 @@ dwv_result_t dwv_scene_bind_texture(dwv_scene_t *scene, uint32_t material_id, co
     DWV_TRY(dwv_check_range(fn, "distance", binding->distance, -1e30, 1e30));
     if (binding->invert != 0 && binding->invert != 1)
         return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: invert = %d is neither 0 nor 1", fn, (int)binding->invert);
+    if (binding->bump_shadowing != DWV_BUMP_SHADOWING_NONE && binding->bump_shadowing != DWV_BUMP_SHADOWING_CHIANG2019)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: bump_shadowing %d is neither none (0) nor Chiang 2019 (1)", fn,
+                        (int)binding->bump_shadowing);
+    if (binding->reserved != 0u) return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: reserved must be 0", fn);
     if (binding->uv_layer && strlen(binding->uv_layer) > MAX_LAYER_NAME)
         return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: uv_layer is longer than %u bytes", fn, MAX_LAYER_NAME);
     const dwv_material_t *material = &s->materials[material_id];
@@ -582,7 +586,7 @@ dwv_result_t dwv_scene_bind_texture(dwv_scene_t *scene, uint32_t material_id, co
     if (s->binding_count >= DWVB_MAX_BINDINGS)
         return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: a scene holds at most %u bindings", fn, DWVB_MAX_BINDINGS);
     dwvb_binding made = {material_id, input, binding->texture_id, binding->invert, NULL,
-                         binding->blend, binding->strength, binding->distance};
+                         binding->blend, binding->strength, binding->distance, binding->bump_shadowing};
     if (binding->uv_layer && *binding->uv_layer) {
         made.uv_layer = malloc(strlen(binding->uv_layer) + 1u);
         if (!made.uv_layer) return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "%s: out of memory", fn);

@@ -257,6 +257,8 @@ static dwv_result_t commit_bindings(dwvb_scene *scene, char *message, size_t siz
         if (binding->input == DWV_INPUT_NORMAL_MAP) t->normal_map = (int32_t)b;
         else if (binding->input == DWV_INPUT_BUMP) t->bump = (int32_t)b;
         else t->inputs = 1;
+        if (binding->input == DWV_INPUT_NORMAL_MAP || binding->input == DWV_INPUT_BUMP)
+            if (binding->bump_shadowing) t->bump_shadowing = binding->bump_shadowing;
     }
     for (uint32_t m = 0; m < nmesh; ++m) {
         const dwvg_mesh *mesh = &scene->meshes[m];

@@ -33,6 +33,7 @@ typedef struct dwvb_binding {
     int invert;
     char *uv_layer;           /* NULL: layer 0 */
     double blend, strength, distance;
+    int bump_shadowing;       /* DWV_BUMP_SHADOWING_* */
 } dwvb_binding;
 
 /* A mesh's UV layers beyond the first (dwv_mesh_t.uv_layers), their names and tangents, in the
@@ -50,6 +51,7 @@ typedef struct dwvb_material_textures {
     uint32_t first, count;    /* its bindings: scene->binding_order[first .. first + count - 1] */
     int32_t normal_map, bump; /* binding index (in the scene), or -1 */
     int inputs;               /* 1 where a binding drives an input other than the normal */
+    int bump_shadowing;       /* the normal map's or bump's DWV_BUMP_SHADOWING_* (either's, if on) */
 } dwvb_material_textures;
 
 typedef struct dwvb_scene {

@@ -29,6 +29,59 @@ int dwvb_textured_normal_bound(const dwvb_scene *scene, uint32_t mesh_id)
     return t && (t->normal_map >= 0 || t->bump >= 0);
 }
 
+int dwvb_textured_bump_shadowing(const dwvb_scene *scene, uint32_t mesh_id)
+{
+    const dwvb_material_textures *t = textures_of(scene, mesh_id);
+    return t && (t->normal_map >= 0 || t->bump >= 0) ? t->bump_shadowing : DWV_BUMP_SHADOWING_NONE;
+}
+
+double dwvb_bump_shadowing(dwvu_vec3 n_s, dwvu_vec3 n, dwvu_vec3 light)
+{
+    double denominator = dwvu_dot(n, light) * dwvu_dot(n_s, n);
+    double g = denominator != 0.0 ? dwvu_dot(n_s, light) / denominator : 0.0;
+    if (g >= 1.0) return 1.0;
+    if (!(g >= 0.0)) return 0.0;
+    return g * (1.0 + g * (1.0 - g));
+}
+
+dwvu_vec3 dwvb_valid_reflection(dwvu_vec3 ng, dwvu_vec3 to_view, dwvu_vec3 n)
+{
+    double iz = dwvu_dot(to_view, ng);
+    double t = fmin(0.9 * iz, 0.01);
+    dwvu_vec3 r = dwvu_sub(dwvu_scale(n, 2.0 * dwvu_dot(n, to_view)), to_view);
+    if (dwvu_dot(r, ng) >= t) return n;
+    dwvu_vec3 across = dwvu_madd(n, ng, -dwvu_dot(n, ng));
+    double length = dwvu_length(across);
+    if (!(length > 0.0)) return ng;
+    dwvu_vec3 x_axis = dwvu_scale(across, 1.0 / length);
+    double ix = dwvu_dot(to_view, x_axis), ix2 = ix * ix;
+    double a = ix2 + iz * iz;
+    if (!(a > 0.0)) return ng;
+    double root = sqrt(fmax(ix2 * (a - t * t), 0.0)), c = a + iz * t;
+    double w[2] = {(c + root) / (2.0 * a), (c - root) / (2.0 * a)};
+    double reflection[2];
+    int valid[2];
+    double xs[2], zs[2];
+    for (int k = 0; k < 2; ++k) {
+        valid[k] = w[k] > 1e-5 && w[k] <= 1.0 + 1e-5;
+        zs[k] = sqrt(fmin(fmax(w[k], 0.0), 1.0));
+        xs[k] = sqrt(fmax(1.0 - w[k], 0.0));
+        /* R' . ng for the candidate: 2 (n' . I) z - Iz (squaring admitted roots below the surface). */
+        reflection[k] = 2.0 * (xs[k] * ix + zs[k] * iz) * zs[k] - iz;
+    }
+    int pick;
+    if (valid[0] && valid[1]) {
+        int above0 = reflection[0] >= 1e-5, above1 = reflection[1] >= 1e-5;
+        if (above0 && above1) pick = reflection[0] < reflection[1] ? 0 : 1;
+        else pick = reflection[0] > reflection[1] ? 0 : 1;
+    } else if (valid[0] || valid[1]) {
+        pick = valid[0] ? 0 : 1;
+    } else {
+        return ng;
+    }
+    return dwvu_add(dwvu_scale(x_axis, xs[pick]), dwvu_scale(ng, zs[pick]));
+}
+
 /* The corner UVs of triangle `prim` in UV layer `layer` of the mesh (NULL if it has none). */
 static const float *layer_uvs(const dwvb_scene *scene, uint32_t mesh_id, uint32_t layer, uint32_t prim)
 {

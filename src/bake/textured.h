@@ -12,6 +12,21 @@
  * normal. */
 int dwvb_textured_inputs(const dwvb_scene *scene, uint32_t mesh_id);
 int dwvb_textured_normal_bound(const dwvb_scene *scene, uint32_t mesh_id);
+/* The DWV_BUMP_SHADOWING_* of the material of mesh `mesh_id` (0 without a normal binding). */
+int dwvb_textured_bump_shadowing(const dwvb_scene *scene, uint32_t mesh_id);
+/* Chiang et al. 2019's shadowing of a diffuse lobe whose normal n was tilted from the smooth
+ * normal n_s (Cycles 3.x bump_shadowing_term): g = (n_s . L) / ((n . L)(n_s . n)); 1 for
+ * g >= 1, 0 for g < 0, else -g^3 + g^2 + g (a smooth step that is 1 with slope 0 at g = 1). */
+double dwvb_bump_shadowing(dwvu_vec3 n_s, dwvu_vec3 n, dwvu_vec3 light);
+/* Cycles' ensure_valid_reflection for a mapped normal n (unit) at a point of geometric normal ng
+ * seen from unit direction `to_view` (ng . to_view > 0): n itself where the mirror reflection of
+ * to_view about n leaves at least t = min(0.9 ng . to_view, 0.01) above the surface (R . ng >= t),
+ * else the normal n' = x X + z ng (X: n's part across ng, normalised) closest to n for which
+ * R' . ng = t. With w = z^2, Ix = to_view . X, Iz = to_view . ng, a = Ix^2 + Iz^2: squaring
+ * 2 (x Ix + z Iz) z - Iz = t gives w = (a + Iz t +- sqrt(Ix^2 (a - t^2))) / (2 a); roots with w
+ * in (1e-5, 1 + 1e-5] whose reflection is really above the surface are kept, the shallower if
+ * both are; ng if none is. */
+dwvu_vec3 dwvb_valid_reflection(dwvu_vec3 ng, dwvu_vec3 to_view, dwvu_vec3 n);
 /* The material of the mesh at point (prim, u, v), textures looked up there. */
 void dwvb_textured_material(const dwvb_scene *scene, uint32_t mesh_id, uint32_t prim, double u, double v,
                             dwvb_material *out);
