@@ -256,6 +256,9 @@ class DwivediBakeSettings(bpy.types.PropertyGroup):
                            min=0, max=64)
     load_result: BoolProperty(name="Load Result", description="Load the baked EXR as a Blender image",
                               default=True)
+    texture_bake_size: IntProperty(name="Texture Bake Size", default=256, min=8, max=8192, description=(
+        "Width and height of the images into which Blender evaluates material inputs driven by node trees "
+        "other than an Image Texture (procedural textures, Mapping...)"))
     # Runtime state shown in the panel while a bake runs.
     running: BoolProperty(default=False, options={'SKIP_SAVE'})
     progress: FloatProperty(name="Progress", default=0.0, min=0.0, max=100.0, subtype='PERCENTAGE',
@@ -598,6 +601,7 @@ class DWIVEDI_PT_bake(bpy.types.Panel):
         col.prop(settings, "target_error")
         layout.prop(settings, "threads")
         layout.prop(settings, "walk_event_cap")
+        layout.prop(settings, "texture_bake_size")
         layout.prop(settings, "seed")
         layout.prop(settings, "output_dir")
         layout.prop(settings, "load_result")

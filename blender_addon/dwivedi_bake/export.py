@@ -15,7 +15,7 @@ from typing import Any, Dict, List, Optional, Tuple
 
 import bpy
 
-from . import textures
+from . import evaluate, textures
 
 
 class ExportError(Exception):
@@ -228,7 +228,7 @@ def material_from_blender(material: Any, dwivedi: Any, warnings: List[str],
             warnings.append(f"material '{name}': Multiscatter GGX (3.x's stochastic microsurface walk) is not "
                             "modelled: its specular is baked as GGX")
     weight_socket = _input(node, ("Subsurface Weight",))
-    if blender4 and out.kind == "diffuse" and weight_socket is not None and textures.passes(weight_socket):
+    if blender4 and out.kind == "diffuse" and weight_socket is not None and textures.passes(weight_socket, material.name_full):
         out.kind = "subsurface"  # a textured weight may be above 0 anywhere
     if out.kind == "subsurface":
         model, note = subsurface_model(version, method)
@@ -253,8 +253,8 @@ def texture_uses(material: Any, converted: Any, warnings: List[str],
     if node is None:
         return []
     blender4 = tuple(version) >= (4, 0, 0)
-    uses = textures.material_uses(node, blender4, converted)
-    unpassed = textures.linked_unpassed(node, blender4)
+    uses = textures.material_uses(node, blender4, converted, material.name_full)
+    unpassed = textures.linked_unpassed(node, blender4, material.name_full)
     if unpassed:
         warnings.append(f"material '{material.name}': {', '.join(repr(n) for n in unpassed)} linked to nodes other "
                         "than an Image Texture (with a UV Map, a Normal Map or a Bump node): not evaluated, the "
@@ -501,8 +501,37 @@ def export_scene(context: Any, settings: Any, dwivedi: Any) -> Exported:
     """Builds and commits the dwivedi scene of `context.scene` for the bake `settings`
     (scene.dwivedi_bake); ExportError if it cannot be baked as asked."""
     scene = context.scene
-    depsgraph = context.evaluated_depsgraph_get()
     out = Exported()
+    warnings = out.warnings
+    # Inputs driven by node trees are evaluated by Blender (an emission bake) before the depsgraph
+    # is read: the bake re-evaluates it.
+    evaluated_images = _evaluate_inputs(context, settings, warnings)
+    try:
+        return _export(context, settings, dwivedi, out)
+    finally:
+        textures.EVALUATED.clear()
+        for image in evaluated_images:
+            bpy.data.images.remove(image)
+
+
+def _evaluate_inputs(context: Any, settings: Any, warnings: List[str]) -> List[Any]:
+    """Bakes the material inputs of the render-visible meshes that node trees other than Image
+    Textures drive into images (evaluate.py); returns them."""
+    blender4 = tuple(bpy.app.version) >= (4, 0, 0)
+    size = int(getattr(settings, "texture_bake_size", 256))
+    images: List[Any] = []
+    done: set = set()
+    for obj in context.view_layer.objects:
+        if obj.type != 'MESH' or obj.hide_render or not obj.visible_get():
+            continue
+        materials = [slot.material for slot in obj.material_slots]
+        images.extend(evaluate.evaluate_object(obj, materials, _surface_shader, blender4, size, done, warnings))
+    return images
+
+
+def _export(context: Any, settings: Any, dwivedi: Any, out: Exported) -> Exported:
+    scene = context.scene
+    depsgraph = context.evaluated_depsgraph_get()
     warnings = out.warnings
     target = settings.target
     uv_object = settings.uv_object if target == 'UV' else None

@@ -44,11 +44,35 @@ class Use:
         self.invert = invert
 
 
-def _image_source(socket: Any) -> Optional[Tuple[Any, str, Optional[str]]]:
+class EvaluatedImage:
+    """What the Image Texture node of an input that Blender evaluated into an image would be: the
+    image, linear interpolation, the edge extended (the bake's margin covers the seams)."""
+
+    def __init__(self, image: Any) -> None:
+        self.image = image
+        self.interpolation = 'Linear'
+        self.extension = 'EXTEND'
+
+
+# Inputs whose node trees Blender evaluated into images (evaluate.py), per (material name, node
+# name, input identifier): (EvaluatedImage, UV map). Filled before the materials are exported
+# (the depsgraph's copies of a material share its name); cleared after.
+EVALUATED: Dict[Tuple[str, str, str], Tuple[EvaluatedImage, str]] = {}
+
+
+def evaluated_key(material_name: str, socket: Any) -> Tuple[str, str, str]:
+    return material_name, socket.node.name, socket.identifier
+
+
+def _image_source(socket: Any, material_name: str = "") -> Optional[Tuple[Any, str, Optional[str]]]:
     """(Image Texture node, its output name, UV map or None) when `socket` is fed straight by an
-    Image Texture node that the library can look up as Blender does; None otherwise."""
+    Image Texture node that the library can look up as Blender does, or was evaluated into an
+    image (EVALUATED); None otherwise."""
     if socket is None or not socket.is_linked:
         return None
+    evaluated = EVALUATED.get(evaluated_key(material_name, socket))
+    if evaluated is not None:
+        return evaluated[0], "Color", evaluated[1]
     link = socket.links[0]
     node = link.from_node
     if node.type != 'TEX_IMAGE' or node.image is None or link.from_socket.name not in ("Color", "Alpha"):
@@ -68,9 +92,9 @@ def _image_source(socket: Any) -> Optional[Tuple[Any, str, Optional[str]]]:
     return node, link.from_socket.name, uv_map
 
 
-def passes(socket: Any) -> bool:
+def passes(socket: Any, material_name: str = "") -> bool:
     """Whether a linked input is one this module passes on (no warning about it)."""
-    return _image_source(socket) is not None or _normal_uses(socket) is not None
+    return _image_source(socket, material_name) is not None or _normal_uses(socket) is not None
 
 
 def _plain(socket: Any, default: float) -> float:
@@ -115,14 +139,14 @@ def _socket(node: Any, names: Tuple[str, ...]) -> Any:
     return None
 
 
-def material_uses(node: Any, blender4: bool, material: Any) -> List[Use]:
+def material_uses(node: Any, blender4: bool, material: Any, material_name: str = "") -> List[Use]:
     """The textures of a Principled BSDF or Subsurface Scattering node's inputs, in the order the
     library applies them; `material` (a dwivedi.Material made from the node's own values) is
     adjusted where a texture changes what a constant meant (Blender 3.x's subsurface colour mix)."""
     uses: List[Use] = []
 
     def add(input_name: str, names: Tuple[str, ...], blend: float = 1.0) -> Optional[Tuple[Any, str, Optional[str]]]:
-        found = _image_source(_socket(node, names))
+        found = _image_source(_socket(node, names), material_name)
         if found is not None:
             uses.append(Use(input_name, found[0], found[1], found[2], blend=blend))
         return found
@@ -149,7 +173,7 @@ def material_uses(node: Any, blender4: bool, material: Any) -> List[Use]:
         factor = _plain(node.inputs.get("Subsurface"), 0.0)
         base_socket, colour_socket = node.inputs.get("Base Color"), node.inputs.get("Subsurface Color")
         base = add("base_color", ("Base Color",))
-        colour = _image_source(colour_socket)
+        colour = _image_source(colour_socket, material_name)
         if factor > 0.0 and (base is not None or colour is not None):
             if base is not None:
                 material.subsurface_color = tuple(colour_socket.default_value)[:3]
@@ -169,7 +193,25 @@ def material_uses(node: Any, blender4: bool, material: Any) -> List[Use]:
     return uses
 
 
-def linked_unpassed(node: Any, blender4: bool) -> List[str]:
+def evaluable_inputs(node: Any, blender4: bool) -> List[Any]:
+    """The node's linked inputs that a texture could drive but no Image Texture feeds as it is:
+    what Blender evaluates into an image (evaluate.py)."""
+    if node.type == 'SUBSURFACE_SCATTERING':
+        names = ("Color", "Radius", "Scale", "Anisotropy")
+    elif blender4:
+        names = ("Base Color", "Subsurface Weight", "Subsurface Radius", "Subsurface Scale", "Subsurface Anisotropy",
+                 "Specular Tint")
+    else:
+        names = ("Base Color", "Subsurface Color", "Subsurface Radius", "Specular", "Roughness")
+    out = []
+    for name in names:
+        socket = node.inputs.get(name)
+        if socket is not None and socket.is_linked and _image_source(socket) is None:
+            out.append(socket)
+    return out
+
+
+def linked_unpassed(node: Any, blender4: bool, material_name: str = "") -> List[str]:
     """The names of the node's linked inputs that no texture use covers (their own values are
     used): for the warning."""
     covered = {"Base Color", "Color", "Radius", "Scale", "Anisotropy", "Subsurface Radius", "Normal", "Roughness"}
@@ -182,7 +224,8 @@ def linked_unpassed(node: Any, blender4: bool) -> List[str]:
     for socket in node.inputs:
         if not socket.is_linked:
             continue
-        if socket.name in covered and (passes(socket) if socket.name != "Normal" else _normal_uses(socket) is not None):
+        if socket.name in covered and (passes(socket, material_name) if socket.name != "Normal"
+                                       else _normal_uses(socket) is not None):
             continue
         names.append(socket.name)
     return names

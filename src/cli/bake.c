@@ -29,7 +29,7 @@ static void help(FILE *out)
             "  PREFIX.exr   float RGBA, scene-linear Rec.709, plus variance and sample-count layers\n"
             "  PREFIX.png   the display image through an OpenColorIO view\n"
             "  PREFIX.json  spp, seconds, estimated_relative_error, mean_rgb, events, features,\n"
-            "               error_vs_time and more\n"
+            "               error_vs_time, texture_bytes_per_texel (textured scenes) and more\n"
             "all three only when the bake completes: a failed or cancelled (Ctrl-C) bake exits non-zero\n"
             "and leaves earlier outputs untouched.\n\n"
             "  --spp N        samples per pixel (default: the scene's); the budgets --spp, --time and\n"
