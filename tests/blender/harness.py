@@ -84,3 +84,37 @@ def read_pixels(path):
         return width, height, pixels
     finally:
         bpy.data.images.remove(image)
+
+
+def cycles_render(scene, seed, samples, path):
+    """Renders `scene` with Cycles (seed, samples) into the float EXR `path`; (pixels, seconds)."""
+    import time
+    scene.cycles.seed = seed
+    scene.cycles.samples = samples
+    scene.render.image_settings.file_format = 'OPEN_EXR'
+    scene.render.image_settings.color_depth = '32'
+    scene.render.filepath = str(path)
+    start = time.monotonic()
+    bpy.ops.render.render(write_still=True)
+    seconds = time.monotonic() - start
+    _, _, pixels = read_pixels(path)
+    return pixels, seconds
+
+
+def dwivedi_bake(scene, seed, samples, output_dir):
+    """Bakes `scene` with the add-on (technique auto, 2 threads) into `output_dir`; (pixels of the
+    loaded result, seconds)."""
+    import time
+    props = scene.dwivedi_bake
+    props.samples = samples
+    props.threads = 2
+    props.seed = seed
+    props.technique = 'AUTO'
+    props.output_dir = str(output_dir)
+    start = time.monotonic()
+    result, error = call_operator()
+    seconds = time.monotonic() - start
+    if result != {'FINISHED'}:
+        raise AssertionError(f"the bake failed: {error}")
+    _, _, pixels = image_pixels("Dwivedi Camera")
+    return pixels, seconds

@@ -20,7 +20,6 @@ bake with a message naming the problem, and nothing is written.
 import json
 import math
 import sys
-import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -90,41 +89,12 @@ def textured_sphere(resolution, samples, subsurface, base=True, normal=True):
     return scene
 
 
-def cycles_render(scene, seed, name):
-    scene.cycles.seed = seed
-    scene.cycles.samples = CYCLES_SAMPLES
-    scene.render.image_settings.file_format = 'OPEN_EXR'
-    scene.render.image_settings.color_depth = '32'
-    scene.render.filepath = str(WORK / f"{name}_cycles_{seed}.exr")
-    start = time.monotonic()
-    bpy.ops.render.render(write_still=True)
-    seconds = time.monotonic() - start
-    _, _, pixels = harness.read_pixels(WORK / f"{name}_cycles_{seed}.exr")
-    return pixels, seconds
-
-
-def dwivedi_bake(scene, seed, name):
-    props = scene.dwivedi_bake
-    props.samples = DWIVEDI_SAMPLES
-    props.threads = 2
-    props.seed = seed
-    props.technique = 'AUTO'
-    props.output_dir = str(WORK / f"{name}_dwivedi_{seed}")
-    start = time.monotonic()
-    result, error = harness.call_operator()
-    seconds = time.monotonic() - start
-    if result != {'FINISHED'}:
-        raise AssertionError(f"the bake failed: {error}")
-    _, _, pixels = harness.image_pixels("Dwivedi Camera")
-    return pixels, seconds
-
-
 def compare(name, build):
     scene = build(RESOLUTION, CYCLES_SAMPLES)
-    c1, tc1 = cycles_render(scene, 1, name)
-    c2, tc2 = cycles_render(scene, 2, name)
-    o1, to1 = dwivedi_bake(scene, 1, name)
-    o2, to2 = dwivedi_bake(scene, 2, name)
+    c1, tc1 = harness.cycles_render(scene, 1, CYCLES_SAMPLES, WORK / f"{name}_cycles_1.exr")
+    c2, tc2 = harness.cycles_render(scene, 2, CYCLES_SAMPLES, WORK / f"{name}_cycles_2.exr")
+    o1, to1 = harness.dwivedi_bake(scene, 1, DWIVEDI_SAMPLES, WORK / f"{name}_dwivedi_1")
+    o2, to2 = harness.dwivedi_bake(scene, 2, DWIVEDI_SAMPLES, WORK / f"{name}_dwivedi_2")
     cycles = [(a + b) / 2 for a, b in zip(c1, c2)]
     ours = [(a + b) / 2 for a, b in zip(o1, o2)]
     n = len(ours) // 4

@@ -1,9 +1,9 @@
 /* Textures through the public API: refused inputs (0 x 0, NaN and infinite texels, bad ids, a
  * colour input given one channel, a UV layer the mesh lacks, a second normal map), and bakes
  * whose answer is known: a diffuse quad under a sun of irradiance pi seen straight on is its
- * albedo, so a 2 x 2 texture bakes to its texels' mean, a constant normal map tilted by 60
- * degrees halves it and a height ramp of slope s through a bump of distance d gives
- * 1 / sqrt(1 + (d s)^2); and a subsurface slab whose colour texture is A on one half and B on
+ * albedo, so a 2 x 2 texture bakes to its texels' mean, a constant normal map tilted by 30
+ * degrees gives cos 30 of it (60 degrees: sqrt(0.505), Cycles' ensure_valid_reflection) and a
+ * height ramp of slope s through a bump of distance d gives 1 / sqrt(1 + (d s)^2); and a subsurface slab whose colour texture is A on one half and B on
  * the other bakes each half as the slab of constant colour A or B does (the medium is the entry
  * point's: pixel differences within 5 standard errors, often bit-identical as the same numbers
  * drive the same walks), while the other colour is far off (the harness can fail). */
@@ -25,6 +25,19 @@ static dwv_scene_t *new_scene(void)
     return scene;
 }
 
+/* A sun of irradiance pi straight down and an orthographic camera at z = 5 seeing [-1, 1]^2. */
+static void sun_and_camera(dwv_scene_t *scene)
+{
+    dwv_light_desc_t sun = DWV_LIGHT_DESC_INIT;
+    sun.strength = 3.14159265358979323846;
+    dwv_scene_add_light(scene, &sun);
+    dwv_camera_t camera = DWV_CAMERA_INIT;
+    camera.kind = DWV_CAMERA_ORTHOGRAPHIC;
+    camera.transform[11] = 5.0;
+    camera.ortho_scale = 2.0;
+    dwv_scene_set_camera(scene, &camera);
+}
+
 /* The quad [-1, 1]^2 at z = 0 facing +z, u = (x + 1) / 2, v = (y + 1) / 2, seen from above by an
  * orthographic camera that fills the image with it, lit straight down by a sun of irradiance pi. */
 static void quad_scene(dwv_scene_t *scene, uint32_t material_id, const char *const *names, uint32_t extra_layers,
@@ -39,14 +52,7 @@ static void quad_scene(dwv_scene_t *scene, uint32_t material_id, const char *con
     mesh.uv_layer_count = extra_layers, mesh.uv_layers = layers, mesh.uv_layer_names = names;
     uint32_t id;
     CHECK(dwv_scene_add_mesh(scene, &mesh, &id) == DWV_SUCCESS, "quad: %s", dwv_last_error_message());
-    dwv_light_desc_t sun = DWV_LIGHT_DESC_INIT;
-    sun.strength = 3.14159265358979323846;
-    dwv_scene_add_light(scene, &sun);
-    dwv_camera_t camera = DWV_CAMERA_INIT;
-    camera.kind = DWV_CAMERA_ORTHOGRAPHIC;
-    camera.transform[11] = 5.0;
-    camera.ortho_scale = 2.0;
-    dwv_scene_set_camera(scene, &camera);
+    sun_and_camera(scene);
 }
 
 static uint32_t add_texture(dwv_scene_t *scene, uint32_t w, uint32_t h, uint32_t channels, dwv_texture_interpolation_t interp,
@@ -191,31 +197,38 @@ static void diffuse_bakes(void)
     free(r.rgba);
     dwv_scene_release(scene);
 
-    /* A constant normal map tilted 60 degrees toward +x: cos 60 = 0.5 of the albedo 0.8. */
-    scene = new_scene();
-    material = diffuse_material(scene);
-    double theta = 3.14159265358979323846 / 3.0;
-    const float tilt[3] = {(float)(0.5 + 0.5 * sin(theta)), 0.5f, (float)(0.5 + 0.5 * cos(theta))};
-    t = add_texture(scene, 1, 1, 3, DWV_INTERPOLATION_LINEAR, DWV_EXTENSION_REPEAT, tilt);
-    bind(scene, material, DWV_INPUT_NORMAL_MAP, t, 1.0);
-    quad_scene(scene, material, NULL, 0, NULL);
-    r = bake(scene, 8, 2);
-    CHECK(r.rgba && fabs(r.mean[0] - 0.8 * 0.5) < 2e-4, "normal map %g (0.4)", r.mean[0]);
-    free(r.rgba);
-    dwv_scene_release(scene);
+    /* A constant normal map tilted 30 degrees toward +x: cos 30 of the albedo 0.8. Tilted 60
+     * degrees, the view's mirror reflection would point below the surface (2 cos^2 60 - 1 < 0):
+     * Cycles' ensure_valid_reflection turns the normal back until that reflection is 0.01 above
+     * it, 2 z^2 - 1 = 0.01 for a view along the geometric normal, so z = sqrt(0.505). */
+    const double tilts[2] = {3.14159265358979323846 / 6.0, 3.14159265358979323846 / 3.0};
+    const double cosines[2] = {cos(tilts[0]), sqrt(0.505)};
+    for (int k = 0; k < 2; ++k) {
+        scene = new_scene();
+        material = diffuse_material(scene);
+        const float tilt[3] = {(float)(0.5 + 0.5 * sin(tilts[k])), 0.5f, (float)(0.5 + 0.5 * cos(tilts[k]))};
+        t = add_texture(scene, 1, 1, 3, DWV_INTERPOLATION_LINEAR, DWV_EXTENSION_REPEAT, tilt);
+        bind(scene, material, DWV_INPUT_NORMAL_MAP, t, 1.0);
+        quad_scene(scene, material, NULL, 0, NULL);
+        r = bake(scene, 8, 2);
+        CHECK(r.rgba && fabs(r.mean[0] - 0.8 * cosines[k]) < 2e-4, "normal map tilted %g: %g (%g)", tilts[k], r.mean[0],
+              0.8 * cosines[k]);
+        free(r.rgba);
+        dwv_scene_release(scene);
+    }
 
     /* A height ramp h = u (texel centres (i + 1/2) / 64, linear, extend): slope 1/2 per unit x;
-     * distance 2 makes grad h d = 1 along x: cos = 1 / sqrt(2). */
+     * distance 1 makes grad h d = 1/2 along x: cos = 1 / sqrt(1.25). */
     scene = new_scene();
     material = diffuse_material(scene);
     float height[64];
     for (int i = 0; i < 64; ++i) height[i] = (float)((i + 0.5) / 64.0);
     t = add_texture(scene, 64, 1, 1, DWV_INTERPOLATION_LINEAR, DWV_EXTENSION_EXTEND, height);
-    bind(scene, material, DWV_INPUT_BUMP, t, 2.0);
+    bind(scene, material, DWV_INPUT_BUMP, t, 1.0);
     quad_scene(scene, material, NULL, 0, NULL);
     r = bake(scene, 16, 2);
     /* Within half a texel of either edge (1/64 of the quad) the interpolated height is flat. */
-    double flat = 1.0 / 64.0, expected = 0.8 * ((1.0 - flat) / sqrt(2.0) + flat);
+    double flat = 1.0 / 64.0, expected = 0.8 * ((1.0 - flat) / sqrt(1.25) + flat);
     CHECK(r.rgba && fabs(r.mean[0] - expected) < 1e-3, "bump %g (%g)", r.mean[0], expected);
     free(r.rgba);
     dwv_scene_release(scene);
@@ -248,14 +261,7 @@ static test_result slab(const double colour[3], const float *texture_rgb)
     uint32_t id;
     dwv_scene_add_mesh(scene, &mesh, &id);
     test_mesh_free(&box);
-    dwv_light_desc_t sun = DWV_LIGHT_DESC_INIT;
-    sun.strength = 3.14159265358979323846;
-    dwv_scene_add_light(scene, &sun);
-    dwv_camera_t camera = DWV_CAMERA_INIT;
-    camera.kind = DWV_CAMERA_ORTHOGRAPHIC;
-    camera.transform[11] = 5.0;
-    camera.ortho_scale = 2.0;
-    dwv_scene_set_camera(scene, &camera);
+    sun_and_camera(scene);
     test_result r = bake(scene, 16, 32);
     dwv_scene_release(scene);
     return r;
