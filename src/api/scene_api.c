@@ -330,14 +330,8 @@ dwv_result_t dwv_scene_add_mesh(dwv_scene_t *scene, const dwv_mesh_t *mesh_in, u
         return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "%s: no memory for %u vertices and %u triangles", fn,
                         mesh->vertex_count, mesh->triangle_count);
     }
-    if (dwvb_scene_push_mesh(s, &made, mesh->shadow_terminator_geometry_offset)) {
+    if (dwvb_scene_push_mesh(s, &made, mesh->shadow_terminator_geometry_offset, &layers)) {
         dwvg_mesh_free(&made);
-        dwvb_mesh_layers_free(&layers);
-        return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "%s: out of memory", fn);
-    }
-    if (dwvb_scene_push_layers(s, &layers)) {
-        /* The mesh goes again: a scene never holds a mesh without its layers. */
-        dwvg_mesh_free(&s->meshes[--s->mesh_count]);
         dwvb_mesh_layers_free(&layers);
         return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "%s: out of memory", fn);
     }

@@ -65,12 +65,18 @@ int dwvb_scene_push_material(dwvb_scene *scene, const dwv_material_t *material)
     return 0;
 }
 
-int dwvb_scene_push_mesh(dwvb_scene *scene, const dwvg_mesh *mesh, double terminator_offset)
+int dwvb_scene_push_mesh(dwvb_scene *scene, const dwvg_mesh *mesh, double terminator_offset,
+                         const dwvb_mesh_layers *layers)
 {
     void *offsets = grow(scene->terminator_offsets, scene->mesh_count, &scene->terminator_capacity,
                          sizeof *scene->terminator_offsets);
     if (!offsets) return -1;
     scene->terminator_offsets = offsets;
+    void *tables = grow(scene->layers, scene->mesh_count, &scene->layer_capacity, sizeof *scene->layers);
+    if (!tables) return -1;
+    scene->layers = tables;
+    dwvb_mesh_layers none = {0u, NULL, NULL, NULL};
+    scene->layers[scene->mesh_count] = layers ? *layers : none;
     void *grown = grow(scene->meshes, scene->mesh_count, &scene->mesh_capacity, sizeof *mesh);
     if (!grown) return -1;
     scene->meshes = grown;
@@ -93,17 +99,6 @@ void dwvb_mesh_layers_free(dwvb_mesh_layers *layers)
     layers->names = NULL;
     layers->tangents = NULL;
     layers->count = 0;
-}
-
-int dwvb_scene_push_layers(dwvb_scene *scene, const dwvb_mesh_layers *layers)
-{
-    /* The mesh is pushed already: its layers go at mesh_count - 1. */
-    uint32_t index = scene->mesh_count - 1u;
-    void *grown = grow(scene->layers, index, &scene->layer_capacity, sizeof *layers);
-    if (!grown) return -1;
-    scene->layers = grown;
-    scene->layers[index] = *layers;
-    return 0;
 }
 
 int dwvb_scene_push_texture(dwvb_scene *scene, const dwvb_texture *texture)
@@ -268,6 +263,10 @@ static dwv_result_t commit_bindings(dwvb_scene *scene, char *message, size_t siz
         if (!scene->binding_layers[m]) {
             snprintf(message, size, "out of memory");
             return DWV_ERROR_OUT_OF_MEMORY;
+        }
+        if (!scene->layers[m].count) {
+            snprintf(message, size, "mesh %u has no UV layer table (it was not added by dwv_scene_add_mesh)", m);
+            return DWV_ERROR_INTERNAL;
         }
         for (uint32_t k = 0; k < t->count; ++k) {
             const dwvb_binding *binding = &scene->bindings[scene->binding_order[t->first + k]];

@@ -94,10 +94,11 @@ dwvb_scene *dwvb_scene_new(void);
 void dwvb_scene_free(dwvb_scene *scene);
 /* Append copies; 0 on success, -1 when out of memory (nothing appended). */
 int dwvb_scene_push_material(dwvb_scene *scene, const dwv_material_t *material);
-int dwvb_scene_push_mesh(dwvb_scene *scene, const dwvg_mesh *mesh, double terminator_offset);
+/* The mesh takes `layers` (moved in: the scene frees them; NULL: none, for meshes that no
+ * texture reads). */
+int dwvb_scene_push_mesh(dwvb_scene *scene, const dwvg_mesh *mesh, double terminator_offset,
+                         const dwvb_mesh_layers *layers);
 int dwvb_scene_push_light(dwvb_scene *scene, const dwv_light_desc_t *light);
-/* The mesh pushed last takes these layers (moved in: the scene frees them); 0, or -1 out of memory. */
-int dwvb_scene_push_layers(dwvb_scene *scene, const dwvb_mesh_layers *layers);
 int dwvb_scene_push_texture(dwvb_scene *scene, const dwvb_texture *texture);
 int dwvb_scene_push_binding(dwvb_scene *scene, const dwvb_binding *binding);
 void dwvb_mesh_layers_free(dwvb_mesh_layers *layers);
