@@ -741,16 +741,21 @@ enum {
  * grad h) with grad h the height's gradient along the surface, negated by `invert`, then
  * normalize(strength N' + (1 - strength) N) (Cycles' svm_node_set_bump in the limit of small
  * differentials). At most one normal map and one bump per material. */
-/* How diffuse lobes are shadowed where a normal map or bump tilts the shading normal
+/* How a Cycles release treats a normal that a normal map or bump tilted
  * (dwv_texture_binding_t.bump_shadowing of the normal map or bump). */
 typedef int32_t dwv_bump_shadowing_t;
 enum {
-    DWV_BUMP_SHADOWING_NONE = 0,
-    /* Chiang, Li and Burley 2019, "Taming the Shadow Terminator", as Cycles 3.x applies it to its
-     * diffuse closures (bsdf.h bump_shadowing_term): the diffuse BRDF times
-     * G = -g^3 + g^2 + g, g = (N_s . L) / ((N . L)(N_s . N)) clamped (1 from g >= 1, 0 below 0),
-     * N the mapped normal, N_s the smooth one; at the entry point and at a walk's exit. */
-    DWV_BUMP_SHADOWING_CHIANG2019 = 1
+    DWV_BUMP_SHADOWING_NONE = 0, /* the mapped normal as it is */
+    /* Blender 3.x: the closures' normal is kept such that the view's mirror reflection stays above
+     * the surface (ensure_valid_reflection, at the camera's hit), and diffuse lobes are multiplied
+     * by Chiang, Li and Burley 2019's term ("Taming the Shadow Terminator", bsdf.h
+     * bump_shadowing_term): G = -g^3 + g^2 + g, g = (N_s . L) / ((N . L)(N_s . N)) clamped (1
+     * from g >= 1, 0 below 0), N the mapped normal, N_s the smooth one; at the entry point and at
+     * a walk's exit. */
+    DWV_BUMP_SHADOWING_CHIANG2019 = 1,
+    /* Blender 4.x: Chiang 2019's term as above, without ensure_valid_reflection (4.x applies it
+     * to specular closures only; dwivedi's specular layer then uses the mapped normal as is). */
+    DWV_BUMP_SHADOWING_CHIANG2019_MAPPED = 2
 };
 typedef struct dwv_texture_binding_t {
     uint32_t struct_size;        /* sizeof(dwv_texture_binding_t): set by DWV_TEXTURE_BINDING_INIT */
@@ -762,7 +767,7 @@ typedef struct dwv_texture_binding_t {
     double blend;                /* in [0, 1], 1 by default */
     double strength;             /* normal map: >= 0 (1 by default); bump: in [0, 1] */
     double distance;             /* bump: finite, in scene units (Blender's Distance, 1 by default) */
-    dwv_bump_shadowing_t bump_shadowing; /* normal map, bump: DWV_BUMP_SHADOWING_* (Chiang 2019 by default) */
+    dwv_bump_shadowing_t bump_shadowing; /* normal map, bump: DWV_BUMP_SHADOWING_* (3.x's, Chiang 2019, by default) */
     uint32_t reserved;           /* 0 */
 } dwv_texture_binding_t;
 #define DWV_TEXTURE_BINDING_INIT                                                                    \

@@ -560,7 +560,8 @@ def _export(context: Any, settings: Any, dwivedi: Any, out: Exported) -> Exporte
                 material_ids[key] = dw_scene.add_material(converted)
                 material_textures[key] = uses
                 try:
-                    textures.bind(dw_scene, texture_cache, material_ids[key], uses, material.name if material else "")
+                    textures.bind(dw_scene, texture_cache, material_ids[key], uses, material.name if material else "",
+                                  tuple(bpy.app.version))
                 except textures.MissingImage as error:
                     raise ExportError(str(error)) from None
             return material_ids[key]

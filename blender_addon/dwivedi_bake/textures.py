@@ -279,7 +279,15 @@ class TextureCache:
         return texture
 
 
-def bind(dw_scene: Any, cache: TextureCache, material_id: int, uses: List[Use], material_name: str) -> None:
+def bump_shadowing(version: Tuple[int, ...]) -> str:
+    """How the Cycles of Blender `version` treats normals that a map tilted (dwv_bump_shadowing_t):
+    Chiang 2019's shadowing of diffuse lobes, with 3.x's ensure_valid_reflection on every closure
+    (4.x applies it to specular closures only; measured against 4.3's Cycles)."""
+    return "chiang2019" if tuple(version) < (4, 0, 0) else "chiang2019_mapped"
+
+
+def bind(dw_scene: Any, cache: TextureCache, material_id: int, uses: List[Use], material_name: str,
+         version: Tuple[int, ...]) -> None:
     """Adds the textures of `uses` and binds them to the material, in order."""
     for use in uses:
         try:
@@ -291,7 +299,8 @@ def bind(dw_scene: Any, cache: TextureCache, material_id: int, uses: List[Use], 
                 raise
             raise MissingImage(f"image '{use.node.image.name}' of material '{material_name}': {error}") from None
         dw_scene.bind_texture(material_id, use.input, texture, uv_layer=use.uv_map, blend=use.blend,
-                              strength=use.strength, distance=use.distance, invert=use.invert)
+                              strength=use.strength, distance=use.distance, invert=use.invert,
+                              bump_shadowing=bump_shadowing(version))
 
 
 def uv_layers(mesh: Any, loops: Any, first: Any, tangent_maps: List[Optional[str]]) -> Dict[str, Any]:

@@ -196,15 +196,15 @@ static void exit_light(const dwvb_shader *shader, uint32_t mesh_id, const dwvb_m
      * bump there, the rest of the material being the entry's. */
     dwvu_vec3 exit_smooth_n = exit_n;
     if (dwvb_textured_normal_bound(scene, mesh_id))
-        exit_n = dwvb_textured_normal(scene, mesh_id, exit->prim, exit->u, exit->v, exit_n, exit_ng);
+        exit_n = dwvb_textured_normal(scene, mesh_id, exit->prim, exit->u, exit->v, exit_n);
     /* Cycles shades the exit as a surface point of its triangle: the same terminator offset. */
     double cutoff = scene->terminator_offsets[mesh_id];
     dwvl_terminator exit_terminator = {mesh, exit->prim, exit->u, exit->v, cutoff};
     const dwvl_terminator *exit_smooth = mesh->normals && cutoff > 0.0 ? &exit_terminator : NULL;
     double exit_top = dwvg_world_top(&scene->geometry, mesh_id, exit->prim);
-    int bumped = dwvb_textured_bump_shadowing(scene, mesh_id) &&
-                 (exit_n.x != exit_smooth_n.x || exit_n.y != exit_smooth_n.y || exit_n.z != exit_smooth_n.z);
-    if (bumped) {
+    int mode = dwvb_textured_bump_shadowing(scene, mesh_id);
+    int tilted = exit_n.x != exit_smooth_n.x || exit_n.y != exit_smooth_n.y || exit_n.z != exit_smooth_n.z;
+    if (mode && tilted) {
         bumped_exit lobe = {exit_n, exit_smooth_n, material->principled_v1};
         dwvl_direct_lobe(&shader->env, walk->position, exit_n, exit_ng, exit_smooth, exit_top, sampler, pair,
                          bumped_exit_factor, &lobe, NULL, direct);
@@ -263,11 +263,13 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
     dwvu_vec3 smooth_n = n;
     if (dwvb_textured_normal_bound(scene, hit->mesh)) {
         /* Cycles 3.x's closures keep a mapped normal's mirror reflection of the view above the
-         * surface (svm_closure.h, ensure_valid_reflection). */
-        n = dwvb_textured_normal(scene, hit->mesh, hit->prim, hit->u, hit->v, n, ng);
-        n = dwvb_valid_reflection(ng, dwvu_scale(view, -1.0), n);
+         * surface (svm_closure.h, ensure_valid_reflection); 4.x's diffuse and subsurface ones do not. */
+        n = dwvb_textured_normal(scene, hit->mesh, hit->prim, hit->u, hit->v, n);
+        if (dwvb_textured_bump_shadowing(scene, hit->mesh) == DWV_BUMP_SHADOWING_CHIANG2019)
+            n = dwvb_valid_reflection(ng, dwvu_scale(view, -1.0), n);
     }
-    int bumped = dwvb_textured_bump_shadowing(scene, hit->mesh) && (n.x != smooth_n.x || n.y != smooth_n.y || n.z != smooth_n.z);
+    int tilted = n.x != smooth_n.x || n.y != smooth_n.y || n.z != smooth_n.z;
+    int bumped = tilted && dwvb_textured_bump_shadowing(scene, hit->mesh) != DWV_BUMP_SHADOWING_NONE;
     uint32_t light_pairs = dwvl_direct_pairs(&shader->env);
     /* Cycles 4.0-4.4: channels whose radius is below a quarter of the camera ray's footprint are
      * Lambertian at this hit (bssrdf_setup); their walks' results are not used. */

@@ -249,9 +249,8 @@ static dwvu_vec3 bump(const dwvb_scene *scene, uint32_t mesh_id, uint32_t layer,
 }
 
 dwvu_vec3 dwvb_textured_normal(const dwvb_scene *scene, uint32_t mesh_id, uint32_t prim, double u, double v,
-                               dwvu_vec3 n, dwvu_vec3 ng)
+                               dwvu_vec3 n)
 {
-    (void)ng;
     const dwvb_material_textures *t = textures_of(scene, mesh_id);
     if (!t) return n;
     if (t->normal_map >= 0) {

@@ -15,7 +15,7 @@ int dwvb_textured_normal_bound(const dwvb_scene *scene, uint32_t mesh_id);
 /* The DWV_BUMP_SHADOWING_* of the material of mesh `mesh_id` (0 without a normal binding). */
 int dwvb_textured_bump_shadowing(const dwvb_scene *scene, uint32_t mesh_id);
 /* Chiang et al. 2019's shadowing of a diffuse lobe whose normal n was tilted from the smooth
- * normal n_s (Cycles 3.x bump_shadowing_term): g = (n_s . L) / ((n . L)(n_s . n)); 1 for
+ * normal n_s (Cycles 3.x and 4.x bump_shadowing_term): g = (n_s . L) / ((n . L)(n_s . n)); 1 for
  * g >= 1, 0 for g < 0, else -g^3 + g^2 + g (a smooth step that is 1 with slope 0 at g = 1). */
 double dwvb_bump_shadowing(dwvu_vec3 n_s, dwvu_vec3 n, dwvu_vec3 light);
 /* Cycles' ensure_valid_reflection for a mapped normal n (unit) at a point of geometric normal ng
@@ -31,9 +31,9 @@ dwvu_vec3 dwvb_valid_reflection(dwvu_vec3 ng, dwvu_vec3 to_view, dwvu_vec3 n);
 void dwvb_textured_material(const dwvb_scene *scene, uint32_t mesh_id, uint32_t prim, double u, double v,
                             dwvb_material *out);
 /* The shading normal n (unit, from dwvg_shading_normal) after the material's normal map and bump
- * at (prim, u, v); ng the geometric normal on the same side. */
+ * at (prim, u, v). */
 dwvu_vec3 dwvb_textured_normal(const dwvb_scene *scene, uint32_t mesh_id, uint32_t prim, double u, double v,
-                               dwvu_vec3 n, dwvu_vec3 ng);
+                               dwvu_vec3 n);
 /* The input values a committed material's analysis uses: the material with each binding applied
  * with its texture's largest value per channel (so that a walk, a specular layer or a diffuse lobe
  * that any texel may make is planned for). */

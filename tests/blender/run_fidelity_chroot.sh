@@ -9,8 +9,11 @@
 # DWIVEDI_LIBRARY) with RTLD_DEEPBIND before the add-on loads it, so that it binds to its own
 # Embree 3 / OpenEXR and not to the ones Blender has loaded: a test set-up only, never part of a
 # package (as branch addon's run_package_tests.py).
+# DWIVEDI_CHROOT_TEST=test_textures.py runs that test instead (its figures: texture_figures.json).
 set -euo pipefail
 suite=${1:?trixie or sid}
+test=${DWIVEDI_CHROOT_TEST:-test_fidelity.py}
+figures=$([ "$test" = test_textures.py ] && echo texture_figures.json || echo fidelity_figures.json)
 build=$(cd "${2:?build dir}" && pwd)
 results=${3:-$build/tests/fidelity-$suite}
 root=/var/cache/dwivedi/chroots/$suite
@@ -23,7 +26,7 @@ mkdir -p "$stage/deps" "$stage/home" "$results"
 trap 'rm -rf "$stage"' EXIT
 cp "$build/dwivedi_bake.zip" "$stage/"
 mkdir -p "$stage/lib" && cp -L "$build/libdwivedi.so.1" "$stage/lib/"
-cp "$here"/harness.py "$here"/scenes.py "$here"/test_fidelity.py "$stage/"
+cp "$here"/harness.py "$here"/scenes.py "$here/$test" "$stage/"
 base='^(linux-vdso|libc\.so|libm\.so|libstdc\+\+|libgcc_s|ld-linux|libpthread|libdl\.so|librt\.so)'
 ldd "$build/libdwivedi.so.1" | awk '/=> \//{print $1, $3}' | while read -r name path; do
     if ! [[ $name =~ $base ]]; then cp -L "$path" "$stage/deps/$name"; fi
@@ -59,10 +62,10 @@ for v in DWIVEDI_FIDELITY_EVENT_CAP DWIVEDI_FIDELITY_ONLY DWIVEDI_FIDELITY_RESOL
 done
 set +e
 unshare --mount --propagation private sh -c 'mount -t proc proc "$1/proc" && shift && exec chroot "$@"' sh "$root" \
-    "$root" env "${env_vars[@]}" nice blender -b --factory-startup --python-exit-code 1 --python "$stage_rel/test_fidelity.py"
+    "$root" env "${env_vars[@]}" nice blender -b --factory-startup --python-exit-code 1 --python "$stage_rel/$test"
 status=$?
 set -e
-cp "$stage/home/fidelity_figures.json" "$results/" 2>/dev/null || true
+cp "$stage/home/$figures" "$results/" 2>/dev/null || true
 rm -rf "$results/work" && cp -r "$stage/home/work" "$results/work" 2>/dev/null || true
-echo "run_fidelity_chroot: $suite: exit $status; figures in $results/fidelity_figures.json"
+echo "run_fidelity_chroot: $suite: exit $status; figures in $results/$figures"
 exit $status

@@ -68,7 +68,10 @@ def textured_sphere(resolution, samples, subsurface, base=True, normal=True):
     tree = material.node_tree
     bsdf = tree.nodes["Principled BSDF"]
     if subsurface > 0:
-        bsdf.inputs["Subsurface"].default_value = subsurface
+        # 3.x: Subsurface mixes Subsurface Color into the walk's colour and scales the radius;
+        # 4.x+: Subsurface Weight mixes diffuse and subsurface, the walk's colour being Base Color.
+        key = "Subsurface Weight" if "Subsurface Weight" in bsdf.inputs else "Subsurface"
+        bsdf.inputs[key].default_value = subsurface
     grid = tree.nodes.new("ShaderNodeTexImage")
     grid.image = colour_grid()
     grid.interpolation = 'Linear'

@@ -1,8 +1,9 @@
 /* Texture lookup (src/bake/texture.c) against values worked out by hand from Blender's Image
  * Texture conventions: closest texels, bilinear midpoints, the cubic B-spline's weights at a
  * texel centre (1/6, 4/6, 1/6) and its exactness on linear ramps, each extension (repeat, extend,
- * clip, mirror) at points outside [0, 1), sRGB decoded after interpolation, and the tangents made
- * from UVs on a plane. */
+ * clip, mirror) at points outside [0, 1), sRGB decoded after interpolation, the tangents made
+ * from UVs on a plane, and the mapped normals' bump shadowing (Chiang 2019) and
+ * ensure_valid_reflection (src/bake/textured.c) at hand-computed points. */
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -30,6 +31,7 @@ static double at(const dwvb_texture *t, double u, double v)
     return out[0];
 }
 
+#define PI 3.14159265358979323846
 #define NEAR(a, b, tol) (fabs((a) - (b)) <= (tol))
 
 int main(void)
@@ -130,5 +132,24 @@ int main(void)
     tangents = dwvb_make_tangents(&mesh, uvs);
     for (int k = 0; k < 6 && tangents; ++k) CHECK(tangents[4 * k + 3] == -1.0f, "flipped v: sign %g", tangents[4 * k + 3]);
     free(tangents);
+
+    /* Bump shadowing (Chiang 2019), by hand: n_s = z, n tilted 60 degrees toward x;
+     * g = (n_s . L) / ((n . L)(n_s . n)). */
+    dwvu_vec3 z = dwvu_v(0, 0, 1), n60 = dwvu_v(sin(PI / 3), 0, cos(PI / 3)), n30 = dwvu_v(sin(PI / 6), 0, cos(PI / 6));
+    dwvu_vec3 up = dwvu_v(0, 0, 1);
+    CHECK(dwvb_bump_shadowing(z, n60, up) == 1.0, "g = 1 / (1/2 1/2) = 4: unshadowed");
+    /* L = normalize(1, 0, 0.2): n_s . L = 0.2 / |.|, n . L = (sin60 + 0.2 cos60) / |.|. */
+    double norm = sqrt(1.04);
+    dwvu_vec3 low = dwvu_v(1.0 / norm, 0, 0.2 / norm);
+    double g = (0.2 / norm) / (((sin(PI / 3) + 0.1) / norm) * 0.5);
+    CHECK(NEAR(dwvb_bump_shadowing(z, n60, low), -g * g * g + g * g + g, 1e-12), "Chiang at g = %g", g);
+    CHECK(dwvb_bump_shadowing(z, n60, dwvu_v(0.99, 0, -0.141)) == 0.0, "below n_s");
+    /* ensure_valid_reflection: seen along ng = z, a normal tilted 60 degrees reflects the view
+     * below the surface (2 cos^2 60 - 1 < 0): the kept normal has 2 z^2 - 1 = 0.01; 30 degrees stays. */
+    dwvu_vec3 fixed = dwvb_valid_reflection(z, up, n60);
+    CHECK(NEAR(fixed.z, sqrt(0.505), 1e-12) && fixed.x > 0.0 && NEAR(dwvu_length(fixed), 1.0, 1e-12),
+          "valid reflection %g %g %g", fixed.x, fixed.y, fixed.z);
+    dwvu_vec3 kept = dwvb_valid_reflection(z, up, n30);
+    CHECK(kept.x == n30.x && kept.z == n30.z, "a valid normal is kept");
     return check_report("test_texture_lookup");
 }
