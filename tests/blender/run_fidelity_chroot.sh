@@ -13,7 +13,7 @@
 set -euo pipefail
 suite=${1:?trixie or sid}
 test=${DWIVEDI_CHROOT_TEST:-test_fidelity.py}
-figures=$([ "$test" = test_textures.py ] && echo texture_figures.json || echo fidelity_figures.json)
+figures=$([[ "$test" == test_textures* ]] && echo texture_figures.json || echo fidelity_figures.json)
 build=$(cd "${2:?build dir}" && pwd)
 results=${3:-$build/tests/fidelity-$suite}
 root=/var/cache/dwivedi/chroots/$suite
