@@ -755,7 +755,14 @@ enum {
     DWV_BUMP_SHADOWING_CHIANG2019 = 1,
     /* Blender 4.x: Chiang 2019's term as above, without ensure_valid_reflection (4.x applies it
      * to specular closures only; dwivedi's specular layer then uses the mapped normal as is). */
-    DWV_BUMP_SHADOWING_CHIANG2019_MAPPED = 2
+    DWV_BUMP_SHADOWING_CHIANG2019_MAPPED = 2,
+    /* Blender 5.x (measured against 5.2): the mapped normal as is; diffuse lobes are 0 where L is
+     * on the other side of the smooth surface than N says ((N_s . L)(N_s . N)(N . L) < 0), else
+     * times Conty Estevez, Lecocq and Stein 2019's microfacet shadowing ("A Microfacet-Based
+     * Shadowing Function to Solve the Bump Terminator Problem"): the GGX G1 =
+     * 2 / (1 + sqrt(1 + alpha^2 tan^2 theta_i)), alpha^2 = min(tan^2 theta_d / 8, 1), theta_d the
+     * angle from N_s to N and theta_i from N_s to L. */
+    DWV_BUMP_SHADOWING_CONTY2019 = 3
 };
 typedef struct dwv_texture_binding_t {
     uint32_t struct_size;        /* sizeof(dwv_texture_binding_t): set by DWV_TEXTURE_BINDING_INIT */

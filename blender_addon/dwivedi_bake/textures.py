@@ -282,8 +282,13 @@ class TextureCache:
 def bump_shadowing(version: Tuple[int, ...]) -> str:
     """How the Cycles of Blender `version` treats normals that a map tilted (dwv_bump_shadowing_t):
     Chiang 2019's shadowing of diffuse lobes, with 3.x's ensure_valid_reflection on every closure
-    (4.x applies it to specular closures only; measured against 4.3's Cycles)."""
-    return "chiang2019" if tuple(version) < (4, 0, 0) else "chiang2019_mapped"
+    (4.x applies it to specular closures only; measured against 4.3's Cycles); 5.x Conty Estevez
+    2019's (measured against 5.2; the release between 4.3 and 5.2 that changed it is not known
+    here: 5.0 is assumed)."""
+    version = tuple(version)
+    if version < (4, 0, 0):
+        return "chiang2019"
+    return "chiang2019_mapped" if version < (5, 0, 0) else "conty2019"
 
 
 def bind(dw_scene: Any, cache: TextureCache, material_id: int, uses: List[Use], material_name: str,

@@ -462,7 +462,7 @@ class BakeStats:
 TEXEL_FORMATS = ("float32", "srgb8", "linear8")
 TEXTURE_EXTENSIONS = ("repeat", "extend", "clip", "mirror")
 TEXTURE_INTERPOLATIONS = ("linear", "closest", "cubic")
-BUMP_SHADOWINGS = ("none", "chiang2019", "chiang2019_mapped")
+BUMP_SHADOWINGS = ("none", "chiang2019", "chiang2019_mapped", "conty2019")
 MATERIAL_INPUTS = ("base_color", "subsurface_color", "subsurface_weight", "subsurface_radius", "subsurface_scale",
                    "subsurface_anisotropy", "roughness", "specular", "specular_tint", "normal_map", "bump")
 
@@ -680,7 +680,8 @@ class Scene:
         one of MATERIAL_INPUTS ("base_color", "subsurface_color", ..., "normal_map", "bump"),
         through the mesh's UV layer `uv_layer` (a name given to add_mesh; None: its first).
         bump_shadowing (normal map, bump): how Cycles treats tilted normals (dwv_bump_shadowing_t):
-        "chiang2019" (Blender 3.x), "chiang2019_mapped" (4.x: without ensure_valid_reflection) or "none"."""
+        "chiang2019" (Blender 3.x), "chiang2019_mapped" (4.x: without ensure_valid_reflection),
+        "conty2019" (5.x) or "none"."""
         binding = _library.TextureBinding()
         binding.input = _choice("input", input, MATERIAL_INPUTS)
         binding.texture_id = _uint("texture", texture)

@@ -560,10 +560,10 @@ dwv_result_t dwv_scene_bind_texture(dwv_scene_t *scene, uint32_t material_id, co
     DWV_TRY(dwv_check_range(fn, "distance", binding->distance, -1e30, 1e30));
     if (binding->invert != 0 && binding->invert != 1)
         return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: invert = %d is neither 0 nor 1", fn, (int)binding->invert);
-    if (binding->bump_shadowing < DWV_BUMP_SHADOWING_NONE || binding->bump_shadowing > DWV_BUMP_SHADOWING_CHIANG2019_MAPPED)
+    if (binding->bump_shadowing < DWV_BUMP_SHADOWING_NONE || binding->bump_shadowing > DWV_BUMP_SHADOWING_CONTY2019)
         return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
-                        "%s: bump_shadowing %d is not none (0), Chiang 2019 (1, Blender 3.x) or Chiang 2019 with the "
-                        "mapped normal (2, 4.x)", fn, (int)binding->bump_shadowing);
+                        "%s: bump_shadowing %d is not none (0), Chiang 2019 (1, Blender 3.x), Chiang 2019 with the "
+                        "mapped normal (2, 4.x) or Conty 2019 (3, 5.x)", fn, (int)binding->bump_shadowing);
     if (binding->reserved != 0u) return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: reserved must be 0", fn);
     if (binding->uv_layer && strlen(binding->uv_layer) > MAX_LAYER_NAME)
         return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: uv_layer is longer than %u bytes", fn, MAX_LAYER_NAME);

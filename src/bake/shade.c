@@ -140,7 +140,7 @@ typedef struct surface_lobes {
     const dwvb_material *material;
     retro_lobe lobe;
     double diffuse[3]; /* the diffuse lobe's weight per channel (layered) */
-    int bumped;        /* a normal map tilted lobe.n from smooth_n: the diffuse lobes are shadowed */
+    int bumped;        /* DWV_BUMP_SHADOWING_* where a normal map tilted lobe.n from smooth_n, else 0 */
     dwvu_vec3 smooth_n;
 } surface_lobes;
 
@@ -157,7 +157,7 @@ static void surface_factor(const void *context, dwvu_vec3 light, double f[3])
                        : 0.0;
     /* Cycles 3.x shadows its diffuse closures (the Lambertian, Principled diffuse and
      * retro-reflection), not the specular, where a normal map tilted them (textured.h). */
-    double shadow = s->bumped ? dwvb_bump_shadowing(s->smooth_n, s->lobe.n, light) : 1.0;
+    double shadow = s->bumped ? dwvb_bump_shadowing(s->bumped, s->smooth_n, s->lobe.n, light) : 1.0;
     dwvb_specular_factor(m, s->lobe.n, light, s->lobe.to_view, f);
     for (int c = 0; c < 3; ++c) f[c] += (s->diffuse[c] * diffuse + m->retro_albedo[c] * retro) * shadow;
 }
@@ -174,13 +174,14 @@ static double exit_factor(const void *context, dwvu_vec3 light)
 typedef struct bumped_exit {
     dwvu_vec3 n, smooth_n;
     int principled_v1;
+    int mode; /* DWV_BUMP_SHADOWING_* */
 } bumped_exit;
 
 static double bumped_exit_factor(const void *context, dwvu_vec3 light)
 {
     const bumped_exit *e = context;
     double f = e->principled_v1 ? dwvb_principled_exit_factor(dwvu_dot(e->n, light)) : 1.0;
-    return f * dwvb_bump_shadowing(e->smooth_n, e->n, light);
+    return f * dwvb_bump_shadowing(e->mode, e->smooth_n, e->n, light);
 }
 
 /* The light a walk gathers where it left mesh `mesh` (exit: its hit), from the sampler's light
@@ -205,7 +206,7 @@ static void exit_light(const dwvb_shader *shader, uint32_t mesh_id, const dwvb_m
     int mode = dwvb_textured_bump_shadowing(scene, mesh_id);
     int tilted = exit_n.x != exit_smooth_n.x || exit_n.y != exit_smooth_n.y || exit_n.z != exit_smooth_n.z;
     if (mode && tilted) {
-        bumped_exit lobe = {exit_n, exit_smooth_n, material->principled_v1};
+        bumped_exit lobe = {exit_n, exit_smooth_n, material->principled_v1, mode};
         dwvl_direct_lobe(&shader->env, walk->position, exit_n, exit_ng, exit_smooth, exit_top, sampler, pair,
                          bumped_exit_factor, &lobe, NULL, direct);
     } else if (material->principled_v1)
@@ -269,7 +270,7 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
             n = dwvb_valid_reflection(ng, dwvu_scale(view, -1.0), n);
     }
     int tilted = n.x != smooth_n.x || n.y != smooth_n.y || n.z != smooth_n.z;
-    int bumped = tilted && dwvb_textured_bump_shadowing(scene, hit->mesh) != DWV_BUMP_SHADOWING_NONE;
+    int bumped = tilted ? dwvb_textured_bump_shadowing(scene, hit->mesh) : DWV_BUMP_SHADOWING_NONE;
     uint32_t light_pairs = dwvl_direct_pairs(&shader->env);
     /* Cycles 4.0-4.4: channels whose radius is below a quarter of the camera ray's footprint are
      * Lambertian at this hit (bssrdf_setup); their walks' results are not used. */

@@ -35,10 +35,21 @@ int dwvb_textured_bump_shadowing(const dwvb_scene *scene, uint32_t mesh_id)
     return t && (t->normal_map >= 0 || t->bump >= 0) ? t->bump_shadowing : DWV_BUMP_SHADOWING_NONE;
 }
 
-double dwvb_bump_shadowing(dwvu_vec3 n_s, dwvu_vec3 n, dwvu_vec3 light)
+double dwvb_bump_shadowing(int mode, dwvu_vec3 n_s, dwvu_vec3 n, dwvu_vec3 light)
 {
-    double denominator = dwvu_dot(n, light) * dwvu_dot(n_s, n);
-    double g = denominator != 0.0 ? dwvu_dot(n_s, light) / denominator : 0.0;
+    double cos_si = dwvu_dot(n_s, light), cos_sn = dwvu_dot(n_s, n), cos_ni = dwvu_dot(n, light);
+    if (mode == DWV_BUMP_SHADOWING_CONTY2019) {
+        if (cos_si * cos_sn * cos_ni < 0.0) return 0.0;
+        double cos_i = fabs(cos_si), cos_d = fabs(cos_sn);
+        if (cos_d >= 1.0 || cos_i >= 1.0) return 1.0;
+        if (cos_i < 1e-6) return 0.0;
+        double alpha2 = fmin(0.125 * (1.0 / (cos_d * cos_d) - 1.0), 1.0);
+        double tan2_i = 1.0 / (cos_i * cos_i) - 1.0;
+        return 2.0 / (1.0 + sqrt(1.0 + alpha2 * tan2_i));
+    }
+    if (mode == DWV_BUMP_SHADOWING_NONE) return 1.0;
+    double denominator = cos_ni * cos_sn;
+    double g = denominator != 0.0 ? cos_si / denominator : 0.0;
     if (g >= 1.0) return 1.0;
     if (!(g >= 0.0)) return 0.0;
     return g * (1.0 + g * (1.0 - g));

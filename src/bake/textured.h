@@ -14,10 +14,12 @@ int dwvb_textured_inputs(const dwvb_scene *scene, uint32_t mesh_id);
 int dwvb_textured_normal_bound(const dwvb_scene *scene, uint32_t mesh_id);
 /* The DWV_BUMP_SHADOWING_* of the material of mesh `mesh_id` (0 without a normal binding). */
 int dwvb_textured_bump_shadowing(const dwvb_scene *scene, uint32_t mesh_id);
-/* Chiang et al. 2019's shadowing of a diffuse lobe whose normal n was tilted from the smooth
- * normal n_s (Cycles 3.x and 4.x bump_shadowing_term): g = (n_s . L) / ((n . L)(n_s . n)); 1 for
- * g >= 1, 0 for g < 0, else -g^3 + g^2 + g (a smooth step that is 1 with slope 0 at g = 1). */
-double dwvb_bump_shadowing(dwvu_vec3 n_s, dwvu_vec3 n, dwvu_vec3 light);
+/* The shadowing of a diffuse lobe whose normal n was tilted from the smooth normal n_s, for
+ * light along `light`, as DWV_BUMP_SHADOWING_* `mode` says (capi/dwivedi.h): Chiang et al.
+ * 2019's g = (n_s . L) / ((n . L)(n_s . n)), 1 for g >= 1, 0 for g < 0, else -g^3 + g^2 + g (a
+ * smooth step that is 1 with slope 0 at g = 1); or Conty Estevez et al. 2019's GGX G1 with
+ * alpha^2 = min(tan^2(n_s, n) / 8, 1) at the angle (n_s, L), 0 across the smooth surface. */
+double dwvb_bump_shadowing(int mode, dwvu_vec3 n_s, dwvu_vec3 n, dwvu_vec3 light);
 /* Cycles' ensure_valid_reflection for a mapped normal n (unit) at a point of geometric normal ng
  * seen from unit direction `to_view` (ng . to_view > 0): n itself where the mirror reflection of
  * to_view about n leaves at least t = min(0.9 ng . to_view, 0.01) above the surface (R . ng >= t),

@@ -2,7 +2,7 @@
  * Texture conventions: closest texels, bilinear midpoints, the cubic B-spline's weights at a
  * texel centre (1/6, 4/6, 1/6) and its exactness on linear ramps, each extension (repeat, extend,
  * clip, mirror) at points outside [0, 1), sRGB decoded after interpolation, the tangents made
- * from UVs on a plane, and the mapped normals' bump shadowing (Chiang 2019) and
+ * from UVs on a plane, and the mapped normals' bump shadowing (Chiang 2019, Conty 2019) and
  * ensure_valid_reflection (src/bake/textured.c) at hand-computed points. */
 #include <math.h>
 #include <stdint.h>
@@ -137,13 +137,21 @@ int main(void)
      * g = (n_s . L) / ((n . L)(n_s . n)). */
     dwvu_vec3 z = dwvu_v(0, 0, 1), n60 = dwvu_v(sin(PI / 3), 0, cos(PI / 3)), n30 = dwvu_v(sin(PI / 6), 0, cos(PI / 6));
     dwvu_vec3 up = dwvu_v(0, 0, 1);
-    CHECK(dwvb_bump_shadowing(z, n60, up) == 1.0, "g = 1 / (1/2 1/2) = 4: unshadowed");
+    CHECK(dwvb_bump_shadowing(DWV_BUMP_SHADOWING_CHIANG2019, z, n60, up) == 1.0, "g = 1 / (1/2 1/2) = 4: unshadowed");
     /* L = normalize(1, 0, 0.2): n_s . L = 0.2 / |.|, n . L = (sin60 + 0.2 cos60) / |.|. */
     double norm = sqrt(1.04);
     dwvu_vec3 low = dwvu_v(1.0 / norm, 0, 0.2 / norm);
     double g = (0.2 / norm) / (((sin(PI / 3) + 0.1) / norm) * 0.5);
-    CHECK(NEAR(dwvb_bump_shadowing(z, n60, low), -g * g * g + g * g + g, 1e-12), "Chiang at g = %g", g);
-    CHECK(dwvb_bump_shadowing(z, n60, dwvu_v(0.99, 0, -0.141)) == 0.0, "below n_s");
+    CHECK(NEAR(dwvb_bump_shadowing(DWV_BUMP_SHADOWING_CHIANG2019, z, n60, low), -g * g * g + g * g + g, 1e-12), "Chiang at g = %g", g);
+    CHECK(dwvb_bump_shadowing(DWV_BUMP_SHADOWING_CHIANG2019, z, n60, dwvu_v(0.99, 0, -0.141)) == 0.0, "below n_s");
+    /* Conty 2019: cos_d = cos 30, cos_i = 1/2: alpha^2 = tan^2 30 / 8 = 1/24, tan^2 theta_i = 3:
+     * G1 = 2 / (1 + sqrt(1 + 1/8)); 0 for light above n but below n_s. */
+    dwvu_vec3 l60 = dwvu_v(sin(PI / 3), 0, 0.5);
+    CHECK(NEAR(dwvb_bump_shadowing(DWV_BUMP_SHADOWING_CONTY2019, z, n30, l60), 2.0 / (1.0 + sqrt(1.125)), 1e-12),
+          "Conty %g", dwvb_bump_shadowing(DWV_BUMP_SHADOWING_CONTY2019, z, n30, l60));
+    CHECK(dwvb_bump_shadowing(DWV_BUMP_SHADOWING_CONTY2019, z, n30, dwvu_v(0.995, 0, -0.0995)) == 0.0,
+          "above n, below n_s");
+    CHECK(dwvb_bump_shadowing(DWV_BUMP_SHADOWING_NONE, z, n30, l60) == 1.0, "none");
     /* ensure_valid_reflection: seen along ng = z, a normal tilted 60 degrees reflects the view
      * below the surface (2 cos^2 60 - 1 < 0): the kept normal has 2 z^2 - 1 = 0.01; 30 degrees stays. */
     dwvu_vec3 fixed = dwvb_valid_reflection(z, up, n60);
