@@ -560,10 +560,26 @@ typedef struct dwv_mesh_t {
                                  With normals, shadow rays toward light within this cosine of the
                                  flat triangle's horizon leave from a smooth surface above it, as
                                  in Cycles; 0: from the flat triangle. No effect without normals. */
+    /* Added after 0.2 (issue 18: textures). A caller whose struct_size ends before them has one UV
+     * layer (uvs, unnamed) and no tangents. UV layer 0 is `uvs`; layers 1 to uv_layer_count are
+     * uv_layers[0 .. uv_layer_count - 1], each 2 x 3 x triangle_count per corner like `uvs`. */
+    uint32_t uv_layer_count;          /* extra UV layers, <= 64 */
+    uint32_t reserved_uv;             /* 0 */
+    const float *const *uv_layers;    /* uv_layer_count arrays (NULL when the count is 0) */
+    /* Optional: uv_layer_count + 1 names (Blender's UV map names), [0] for `uvs`; what a texture
+     * binding's uv_layer names. NULL: layer k is named by its number ("0", "1", ...). */
+    const char *const *uv_layer_names;
+    /* Optional: uv_layer_count + 1 pointers (each may be NULL), per layer the tangents of its
+     * normal maps: 4 x 3 x triangle_count per corner, xyz (object space) and the bitangent's sign
+     * (+1 or -1), as Blender's MikkTSpace tangents (MeshLoop.tangent, bitangent_sign after
+     * Mesh.calc_tangents). A layer without them gets tangents made at commit from the UV
+     * gradients (docs/scene-format.md, "Tangents": MikkTSpace's result on meshes whose UV
+     * charts are smooth, not bit for bit). */
+    const float *const *tangents;
 } dwv_mesh_t;
 #define DWV_MESH_INIT                                                                               \
     {sizeof(dwv_mesh_t), 0u, 0u, 0u, NULL, NULL, NULL, NULL,                                        \
-     {1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0}, 0.1}
+     {1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0}, 0.1, 0u, 0u, NULL, NULL, NULL}
 
 /* Adds a mesh; *mesh_id numbers meshes from 0 in order (the id a UV bake names). Open meshes,
  * zero-area or duplicate triangles are accepted and counted in the bake's warnings. */
@@ -706,6 +722,140 @@ enum {
 };
 /* The lower-case name of one feature bit ("embree", "closest_point"...), or NULL. */
 DWV_API const char *dwv_feature_name(uint32_t feature);
+
+/* ---------------------------------------------------------------------------------------------
+ * Textures (issue 18): images owned by the scene, bound to material inputs through a mesh's UV
+ * layer, looked up as Blender's Image Texture node (Cycles' kernel image lookup) at each surface
+ * point. The subsurface inputs are looked up once, at the walk's entry point, and the walk goes
+ * through the homogeneous medium they make there, as Cycles does. Add textures and bindings
+ * before dwv_scene_commit; the commit checks that every mesh of a textured material has the UV
+ * layers its bindings name.
+ * ------------------------------------------------------------------------------------------- */
+/* How texels are stored. 8-bit data is kept as bytes (1 byte per channel in memory), float as
+ * float (4 bytes). */
+typedef int32_t dwv_texel_format_t;
+enum {
+    DWV_TEXEL_FLOAT32 = 0,   /* scene-linear (or non-colour) float, finite */
+    DWV_TEXEL_SRGB8 = 1,     /* 8-bit sRGB-encoded colour (Blender's "sRGB" colour space): decoded
+                                to linear after interpolation, as Cycles does for byte images;
+                                a fourth channel (alpha) is linear */
+    DWV_TEXEL_LINEAR8 = 2    /* 8-bit data taken as value / 255 ("Non-Color", or "Linear") */
+};
+/* Blender's Image Texture "Extension": what lies outside [0, 1) of UV. */
+typedef int32_t dwv_texture_extension_t;
+enum {
+    DWV_EXTENSION_REPEAT = 0, /* tiles */
+    DWV_EXTENSION_EXTEND = 1, /* the edge texels go on */
+    DWV_EXTENSION_CLIP = 2,   /* zero outside (texels outside the image count as 0 when filtering) */
+    DWV_EXTENSION_MIRROR = 3  /* tiles, every other tile mirrored */
+};
+/* Blender's Image Texture "Interpolation". */
+typedef int32_t dwv_texture_interpolation_t;
+enum {
+    DWV_INTERPOLATION_LINEAR = 0,  /* bilinear between the four nearest texel centres */
+    DWV_INTERPOLATION_CLOSEST = 1, /* the texel under the point */
+    DWV_INTERPOLATION_CUBIC = 2    /* uniform cubic B-spline over the 4 x 4 nearest texels (Cycles'
+                                      "Cubic": smooth, it does not pass through the texels) */
+};
+typedef struct dwv_texture_desc_t {
+    uint32_t struct_size;  /* sizeof(dwv_texture_desc_t): set by DWV_TEXTURE_DESC_INIT */
+    uint32_t width, height;/* 1 to 65536 each, at most 2^28 texels */
+    uint32_t channels;     /* 1, 3 or 4 */
+    dwv_texel_format_t format;
+    dwv_texture_extension_t extension;
+    dwv_texture_interpolation_t interpolation;
+    uint32_t reserved;     /* 0 */
+    /* channels x width x height values (float for DWV_TEXEL_FLOAT32, uint8_t otherwise),
+     * interleaved, row 0 at v = 0 (the bottom, as Blender's Image.pixels); copied at the call. */
+    const void *texels;
+} dwv_texture_desc_t;
+#define DWV_TEXTURE_DESC_INIT                                                                       \
+    {sizeof(dwv_texture_desc_t), 0u, 0u, 4u, DWV_TEXEL_FLOAT32, DWV_EXTENSION_REPEAT,               \
+     DWV_INTERPOLATION_LINEAR, 0u, NULL}
+/* Adds a texture; *texture_id numbers them from 0 in order. NaN or infinite float texels are
+ * refused (the message names the first). */
+DWV_API dwv_result_t dwv_scene_add_texture(dwv_scene_t *scene, const dwv_texture_desc_t *texture,
+                                           uint32_t *texture_id);
+
+/* A texture from a PNG file (8 bits per channel; 16-bit files are reduced to 8): its size and
+ * channels (1 grey, 3 colour, 4 with alpha) come from the file, extension and interpolation from
+ * `settings`, whose format says what the bytes are (DWV_TEXEL_SRGB8 or DWV_TEXEL_LINEAR8; other
+ * fields ignored). A missing file: DWV_ERROR_IO; not a PNG: DWV_ERROR_FORMAT; the message names it. */
+DWV_API dwv_result_t dwv_scene_add_texture_file(dwv_scene_t *scene, const char *path,
+                                                const dwv_texture_desc_t *settings, uint32_t *texture_id);
+
+/* The material inputs a texture can drive (dwv_material_t's fields of those names). */
+typedef int32_t dwv_material_input_t;
+enum {
+    DWV_INPUT_BASE_COLOR = 0,          /* colour: 3 or 4 channels (alpha ignored) */
+    DWV_INPUT_SUBSURFACE_COLOR = 1,    /* colour */
+    DWV_INPUT_SUBSURFACE_WEIGHT = 2,   /* scalar */
+    DWV_INPUT_SUBSURFACE_RADIUS = 3,   /* colour (per-channel radius) */
+    DWV_INPUT_SUBSURFACE_SCALE = 4,    /* scalar */
+    DWV_INPUT_SUBSURFACE_ANISOTROPY = 5, /* scalar */
+    DWV_INPUT_ROUGHNESS = 6,           /* scalar */
+    DWV_INPUT_SPECULAR = 7,            /* scalar: 3.x Specular, 4.x+ Specular IOR Level */
+    DWV_INPUT_SPECULAR_TINT = 8,       /* colour (3.x: its first channel is the tint factor) */
+    DWV_INPUT_NORMAL_MAP = 9,          /* colour: Blender's Normal Map node, tangent space */
+    DWV_INPUT_BUMP = 10                /* scalar height: Blender's Bump node */
+};
+/* A texture bound to one input of a material. Scalar inputs take a 1-channel texture's value, or
+ * a colour texture's luminance 0.2126 R + 0.7152 G + 0.0722 B (Blender's colour-to-float socket
+ * conversion); colour inputs and normal maps need 3 or 4 channels. The value met at a point is
+ * clamped to the input's range (dwv_material_t) and mixed with what the input had:
+ * input = (1 - blend) x input + blend x value; bindings apply in the order they were made (so
+ * Blender 3.x's Subsurface Color = mix(Base Color, Subsurface Color, Subsurface) is a Base Color
+ * texture bound to DWV_INPUT_SUBSURFACE_COLOR with blend 1 - Subsurface over the material's own
+ * Subsurface Color). Normal map: N = normalize(x T + y B + z N_s) with (x, y, z) = 2 rgb - 1,
+ * B = sign N_s x T (the mesh's tangents for that UV layer), then normalize(N_s + strength (N - N_s))
+ * (Cycles' svm_node_normal_map). Bump (after a normal map, if both): N' = normalize(N - distance
+ * grad h) with grad h the height's gradient along the surface, negated by `invert`, then
+ * normalize(strength N' + (1 - strength) N) (Cycles' svm_node_set_bump in the limit of small
+ * differentials). At most one normal map and one bump per material. */
+/* How a Cycles release treats a normal that a normal map or bump tilted
+ * (dwv_texture_binding_t.bump_shadowing of the normal map or bump). */
+typedef int32_t dwv_bump_shadowing_t;
+enum {
+    DWV_BUMP_SHADOWING_NONE = 0, /* the mapped normal as it is */
+    /* Blender 3.x: the closures' normal is kept such that the view's mirror reflection stays above
+     * the surface (ensure_valid_reflection, at the camera's hit), and diffuse lobes are multiplied
+     * by Chiang, Li and Burley 2019's term ("Taming the Shadow Terminator", bsdf.h
+     * bump_shadowing_term): G = -g^3 + g^2 + g, g = (N_s . L) / ((N . L)(N_s . N)) clamped (1
+     * from g >= 1, 0 below 0), N the mapped normal, N_s the smooth one; at the entry point and at
+     * a walk's exit. */
+    DWV_BUMP_SHADOWING_CHIANG2019 = 1,
+    /* Blender 4.x: Chiang 2019's term as above, without ensure_valid_reflection (4.x applies it
+     * to specular closures only; dwivedi's specular layer then uses the mapped normal as is). */
+    DWV_BUMP_SHADOWING_CHIANG2019_MAPPED = 2,
+    /* Blender 5.x (measured against 5.2): the mapped normal as is; diffuse lobes are 0 where L is
+     * on the other side of the smooth surface than N says ((N_s . L)(N_s . N)(N . L) < 0), else
+     * times Conty Estevez, Lecocq and Stein 2019's microfacet shadowing ("A Microfacet-Based
+     * Shadowing Function to Solve the Bump Terminator Problem"): the GGX G1 =
+     * 2 / (1 + sqrt(1 + alpha^2 tan^2 theta_i)), alpha^2 = min(tan^2 theta_d / 8, 1), theta_d the
+     * angle from N_s to N and theta_i from N_s to L. */
+    DWV_BUMP_SHADOWING_CONTY2019 = 3
+};
+typedef struct dwv_texture_binding_t {
+    uint32_t struct_size;        /* sizeof(dwv_texture_binding_t): set by DWV_TEXTURE_BINDING_INIT */
+    dwv_material_input_t input;  /* DWV_INPUT_* */
+    uint32_t texture_id;         /* from dwv_scene_add_texture */
+    int32_t invert;              /* bump: 1 inverts the height (Blender's Invert) */
+    const char *uv_layer;        /* the UV layer's name (dwv_mesh_t.uv_layer_names); NULL or "": layer 0;
+                                    copied at the call */
+    double blend;                /* in [0, 1], 1 by default */
+    double strength;             /* normal map: >= 0 (1 by default); bump: in [0, 1] */
+    double distance;             /* bump: finite, in scene units (Blender's Distance, 1 by default) */
+    dwv_bump_shadowing_t bump_shadowing; /* normal map, bump: DWV_BUMP_SHADOWING_* (3.x's, Chiang 2019, by default) */
+    uint32_t reserved;           /* 0 */
+} dwv_texture_binding_t;
+#define DWV_TEXTURE_BINDING_INIT                                                                    \
+    {sizeof(dwv_texture_binding_t), DWV_INPUT_BASE_COLOR, 0u, 0, NULL, 1.0, 1.0, 1.0,              \
+     DWV_BUMP_SHADOWING_CHIANG2019, 0u}
+DWV_API dwv_result_t dwv_scene_bind_texture(dwv_scene_t *scene, uint32_t material_id,
+                                            const dwv_texture_binding_t *binding);
+/* The bytes the scene's textures hold in memory, and their texels (width x height summed): the
+ * memory per texel is bytes / texels. */
+DWV_API dwv_result_t dwv_scene_texture_memory(const dwv_scene_t *scene, uint64_t *bytes, uint64_t *texels);
 
 /* ---------------------------------------------------------------------------------------------
  * Bakes: images of a committed scene, progressive, deterministic, cancellable.

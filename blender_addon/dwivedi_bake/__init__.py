@@ -280,6 +280,9 @@ class DwivediBakeSettings(bpy.types.PropertyGroup):
     world_resolution: IntProperty(name="World Resolution", default=1024, min=8, max=16384, description=(
         "Width of the image Cycles renders the world into when its nodes are not an Environment Texture "
         "(the height is half): larger keeps small bright lights sharp, and takes longer"))
+    texture_bake_size: IntProperty(name="Texture Bake Size", default=256, min=8, max=8192, description=(
+        "Width and height of the images into which Blender evaluates material inputs driven by node trees "
+        "other than an Image Texture (procedural textures, Mapping...): larger keeps fine patterns, and takes longer"))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -1072,6 +1075,7 @@ class DWIVEDI_PT_bake_advanced(_SubPanel, bpy.types.Panel):
         layout.prop(settings, "walk_event_cap")
         layout.prop(settings, "threads")
         layout.prop(settings, "world_resolution")
+        layout.prop(settings, "texture_bake_size")
 
 
 CLASSES = (DwivediBakePreferences, DwivediBakeSettings, DWIVEDI_OT_bake, DWIVEDI_OT_bake_cancel, DWIVEDI_PT_bake,

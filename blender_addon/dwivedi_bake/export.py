@@ -4,8 +4,9 @@ camera in Blender's units, which are dwivedi's (capi/dwivedi.h).
 Everything here reads Blender data and calls the shim; nothing changes the .blend (a world that is
 not an Environment Texture is rendered by Cycles in a scene of its own, made and removed here).
 Problems that make a bake meaningless raise ExportError (the operator reports it); things dwivedi
-does not model (textures on material inputs, camera shift...) are collected as warnings and the
-bake goes on with the nearest supported meaning.
+does not model (node trees on material inputs other than Image Textures are evaluated by Blender
+into images, camera shift...) are collected as warnings and the bake goes on with the nearest
+supported meaning. Image textures go to the library as they are (textures.py).
 """
 from __future__ import annotations
 
@@ -14,6 +15,8 @@ import math
 from typing import Any, Dict, List, Optional, Tuple
 
 import bpy
+
+from . import evaluate, textures
 
 
 class ExportError(Exception):
@@ -48,13 +51,11 @@ def _input(node: Any, names: Tuple[str, ...]) -> Any:
 
 def _value(node: Any, names: Tuple[str, ...], default: Any, material_name: str, warnings: List[str]) -> Any:
     """The unlinked value of the first input of `names` the node has (Blender 3.x and 4.x name
-    them differently); a linked input (a texture) is not evaluated: its default value is used."""
+    them differently). A linked input's own value is the constant its texture binding starts from
+    (textures.py); linked inputs that no binding covers are warned about by material_from_blender."""
     socket = _input(node, names)
     if socket is None:
         return default
-    if socket.is_linked:
-        warnings.append(f"material '{material_name}': input '{socket.name}' is linked (textures are not baked); "
-                        "its own value is used")
     value = socket.default_value
     try:
         return tuple(value)
@@ -227,6 +228,9 @@ def material_from_blender(material: Any, dwivedi: Any, warnings: List[str],
         if distribution == 'MULTI_GGX' and roughness > 0.075:
             warnings.append(f"material '{name}': Multiscatter GGX (3.x's stochastic microsurface walk) is not "
                             "modelled: its specular is baked as GGX")
+    weight_socket = _input(node, ("Subsurface Weight",))
+    if blender4 and out.kind == "diffuse" and weight_socket is not None and textures.passes(weight_socket, material.name_full):
+        out.kind = "subsurface"  # a textured weight may be above 0 anywhere
     if out.kind == "subsurface":
         model, note = subsurface_model(version, method)
         out.subsurface_model = model
@@ -235,6 +239,28 @@ def material_from_blender(material: Any, dwivedi: Any, warnings: List[str],
     out.subsurface_anisotropy = max(-0.99, min(0.99, out.subsurface_anisotropy))  # the library clamps per model
     out.subsurface_min_footprint = footprint_rule(version)
     return out
+
+
+def texture_uses(material: Any, converted: Any, warnings: List[str],
+                 version: Optional[Tuple[int, ...]] = None) -> List[Any]:
+    """The image textures on the material's inputs (textures.Use, in binding order), adjusting
+    `converted` where a texture changes what its constants mean; warns about linked inputs that are
+    not passed (their own values are used)."""
+    if material is None:
+        return []
+    if version is None:
+        version = tuple(bpy.app.version) if bpy is not None else (3, 4, 0)
+    node = _surface_shader(material)
+    if node is None:
+        return []
+    blender4 = tuple(version) >= (4, 0, 0)
+    uses = textures.material_uses(node, blender4, converted, material.name_full)
+    unpassed = textures.linked_unpassed(node, blender4, material.name_full)
+    if unpassed:
+        warnings.append(f"material '{material.name}': {', '.join(repr(n) for n in unpassed)} linked to nodes other "
+                        "than an Image Texture (with a UV Map, a Normal Map or a Bump node): not evaluated, the "
+                        "inputs' own values are used")
+    return uses
 
 
 def footprint_rule(version: Tuple[int, ...]) -> float:
@@ -251,9 +277,11 @@ def _rows(matrix: Any) -> List[float]:
     return [float(matrix[r][c]) for r in range(3) for c in range(4)]
 
 
-def _mesh_arrays(mesh: Any, want_uvs: bool) -> Dict[str, Any]:
+def _mesh_arrays(mesh: Any, want_uvs: bool, texture_maps: Optional[List[Optional[str]]] = None) -> Dict[str, Any]:
     """Positions, triangle indices, per-corner UVs, normals and per-triangle material indices of
     an evaluated mesh, in float32 / uint32 arrays (foreach_get fills them without Python loops).
+    texture_maps (a list, maybe empty, of the UV maps normal maps read; None: layer 0) asks for
+    all UV maps by name and those maps' tangents, for textured materials.
 
     Smooth and flat faces both come out right: all-flat meshes share vertices without normals
     (flat shading); otherwise every triangle corner gets its own vertex with Blender's corner
@@ -284,6 +312,14 @@ def _mesh_arrays(mesh: Any, want_uvs: bool) -> Dict[str, Any]:
         out["uvs"] = uvs
     else:
         out["uvs"] = None
+    out["layers"] = None
+    if texture_maps is not None and len(mesh.uv_layers) > 0:
+        # Textures read UV maps by name, layer 0 without one: the active render map (a UV bake's
+        # layer 0 stays the active map it lays out).
+        render = next((layer for layer in mesh.uv_layers if layer.active_render), mesh.uv_layers.active)
+        first = mesh.uv_layers.active if want_uvs else render
+        out["layers"] = textures.uv_layers(mesh, loops, first, texture_maps)
+        out["uvs"] = out["layers"]["uvs"]
 
     vertex_co = array.array("f", [0.0]) * (3 * len(mesh.vertices))
     mesh.vertices.foreach_get("co", vertex_co)
@@ -315,7 +351,24 @@ def _subset(arrays: Dict[str, Any], keep: List[int]) -> Dict[str, Any]:
         indices[3 * n:3 * n + 3] = arrays["indices"][3 * tri:3 * tri + 3]
         if uvs is not None:
             uvs[6 * n:6 * n + 6] = arrays["uvs"][6 * tri:6 * tri + 6]
-    return {**arrays, "indices": indices, "uvs": uvs, "triangles": len(keep)}
+    layers = arrays.get("layers")
+    if layers is not None:
+        def pick(values: Any, group: int) -> Any:
+            out = array.array("f", [0.0]) * (group * len(keep))
+            for n, tri in enumerate(keep):
+                out[group * n:group * n + group] = values[group * tri:group * tri + group]
+            return out
+        layers = {**layers, "uvs": uvs, "uv_layers": [(name, pick(v, 6)) for name, v in layers["uv_layers"]],
+                  "tangents": {name: pick(v, 12) for name, v in layers["tangents"].items()}}
+    return {**arrays, "indices": indices, "uvs": uvs, "triangles": len(keep), "layers": layers}
+
+
+def _layer_arguments(arrays: Dict[str, Any]) -> Dict[str, Any]:
+    """add_mesh's UV arguments of a textured mesh (its UV maps by name and tangents), else none."""
+    layers = arrays.get("layers")
+    if layers is None:
+        return {}
+    return {"uv_name": layers["uv_name"], "uv_layers": layers["uv_layers"], "tangents": layers["tangents"]}
 
 
 def _shadow_terminator_geometry_offset(obj: Any) -> float:
@@ -685,8 +738,37 @@ def export_scene(context: Any, settings: Any, dwivedi: Any) -> Exported:
     """Builds and commits the dwivedi scene of `context.scene` for the bake `settings`
     (scene.dwivedi_bake); ExportError if it cannot be baked as asked."""
     scene = context.scene
-    depsgraph = context.evaluated_depsgraph_get()
     out = Exported()
+    warnings = out.warnings
+    # Inputs driven by node trees are evaluated by Blender (an emission bake) before the depsgraph
+    # is read: the bake re-evaluates it.
+    evaluated_images = _evaluate_inputs(context, settings, warnings)
+    try:
+        return _export(context, settings, dwivedi, out)
+    finally:
+        textures.EVALUATED.clear()
+        for image in evaluated_images:
+            bpy.data.images.remove(image)
+
+
+def _evaluate_inputs(context: Any, settings: Any, warnings: List[str]) -> List[Any]:
+    """Bakes the material inputs of the render-visible meshes that node trees other than Image
+    Textures drive into images (evaluate.py); returns them."""
+    blender4 = tuple(bpy.app.version) >= (4, 0, 0)
+    size = int(getattr(settings, "texture_bake_size", 256))
+    images: List[Any] = []
+    done: set = set()
+    for obj in context.view_layer.objects:
+        if obj.type != 'MESH' or obj.hide_render or not obj.visible_get():
+            continue
+        materials = [slot.material for slot in obj.material_slots]
+        images.extend(evaluate.evaluate_object(obj, materials, _surface_shader, blender4, size, done, warnings))
+    return images
+
+
+def _export(context: Any, settings: Any, dwivedi: Any, out: Exported) -> Exported:
+    scene = context.scene
+    depsgraph = context.evaluated_depsgraph_get()
     warnings = out.warnings
     target = settings.target
     uv_object = settings.uv_object if target == 'UV' else None
@@ -704,13 +786,44 @@ def export_scene(context: Any, settings: Any, dwivedi: Any) -> Exported:
     dw_scene = dwivedi.Scene()
     try:
         material_ids: Dict[Any, int] = {}
+        material_textures: Dict[Any, List[Any]] = {}
+        texture_cache = textures.TextureCache(dw_scene)
 
         def material_id(material: Any) -> int:
             key = None if material is None else material.name_full
             if key not in material_ids:
                 converted = material_from_blender(material, dwivedi, warnings)
+                uses = texture_uses(material, converted, warnings)
                 material_ids[key] = dw_scene.add_material(converted)
+                material_textures[key] = uses
+                try:
+                    textures.bind(dw_scene, texture_cache, material_ids[key], uses, material.name if material else "",
+                                  tuple(bpy.app.version))
+                except textures.MissingImage as error:
+                    raise ExportError(str(error)) from None
             return material_ids[key]
+
+        def texture_maps(obj: Any, slots: List[Any], mesh: Any) -> Optional[List[Optional[str]]]:
+            """None if no material of the object is textured; else the UV maps its normal maps
+            read, after checking that every UV map a texture names is on the mesh."""
+            maps: Optional[List[Optional[str]]] = None
+            for material in slots:
+                material_id(material)
+                uses = material_textures[None if material is None else material.name_full]
+                if not uses:
+                    continue
+                maps = maps or []
+                if len(mesh.uv_layers) == 0:
+                    raise ExportError(f"object '{obj.name}' has no UV map, which the image textures of material "
+                                      f"'{material.name}' need (UV > Unwrap)")
+                for use in uses:
+                    if use.uv_map is not None and mesh.uv_layers.get(use.uv_map) is None:
+                        raise ExportError(f"material '{material.name}' reads UV map '{use.uv_map}', which object "
+                                          f"'{obj.name}' does not have (its UV maps: "
+                                          f"{', '.join(layer.name for layer in mesh.uv_layers)})")
+                    if use.input == "normal_map":
+                        maps.append(use.uv_map)
+            return maps
 
         uv_found = False
         skipped: List[str] = []
@@ -735,8 +848,10 @@ def export_scene(context: Any, settings: Any, dwivedi: Any) -> Exported:
             try:
                 if mesh is None or len(mesh.polygons) == 0:
                     continue
-                arrays = _mesh_arrays(mesh, want_uvs=is_uv_target)
                 slots = [slot.material for slot in obj.material_slots]
+                arrays = _mesh_arrays(mesh, want_uvs=is_uv_target, texture_maps=texture_maps(obj, slots or [None], mesh))
+                if arrays["layers"] is not None:
+                    warnings.extend(arrays["layers"]["warnings"])
                 terminator = _shadow_terminator_geometry_offset(obj)
                 by_material: Dict[int, List[int]] = {}
                 for tri, index in enumerate(arrays["material_index"]):
@@ -753,7 +868,8 @@ def export_scene(context: Any, settings: Any, dwivedi: Any) -> Exported:
                     material = slots[main] if main < len(slots) else None
                     out.uv_mesh = dw_scene.add_mesh(arrays["positions"], arrays["indices"], material_id(material),
                                                     normals=arrays["normals"], uvs=arrays["uvs"], transform=transform,
-                                                    shadow_terminator_geometry_offset=terminator)
+                                                    shadow_terminator_geometry_offset=terminator,
+                                                    **_layer_arguments(arrays))
                     uv_found = True
                     out.mesh_count += 1
                     out.triangle_count += arrays["triangles"]
@@ -762,8 +878,8 @@ def export_scene(context: Any, settings: Any, dwivedi: Any) -> Exported:
                     part = arrays if len(by_material) == 1 else _subset(arrays, tris)
                     material = slots[index] if index < len(slots) else None
                     dw_scene.add_mesh(part["positions"], part["indices"], material_id(material),
-                                      normals=part["normals"], transform=transform,
-                                      shadow_terminator_geometry_offset=terminator)
+                                      normals=part["normals"], uvs=part["uvs"], transform=transform,
+                                      shadow_terminator_geometry_offset=terminator, **_layer_arguments(part))
                     out.mesh_count += 1
                     out.triangle_count += part["triangles"]
             finally:

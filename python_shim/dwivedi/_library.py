@@ -163,6 +163,44 @@ class Mesh(_SizedStructure):
         ("uvs", ctypes.c_void_p),
         ("transform", _Transform),
         ("shadow_terminator_geometry_offset", ctypes.c_double),
+        ("uv_layer_count", ctypes.c_uint32),
+        ("reserved_uv", ctypes.c_uint32),
+        ("uv_layers", ctypes.c_void_p),
+        ("uv_layer_names", ctypes.c_void_p),
+        ("tangents", ctypes.c_void_p),
+    ]
+
+
+class TextureDesc(_SizedStructure):
+    """dwv_texture_desc_t (texels borrowed for one call)."""
+
+    _fields_ = [
+        ("struct_size", ctypes.c_uint32),
+        ("width", ctypes.c_uint32),
+        ("height", ctypes.c_uint32),
+        ("channels", ctypes.c_uint32),
+        ("format", ctypes.c_int32),
+        ("extension", ctypes.c_int32),
+        ("interpolation", ctypes.c_int32),
+        ("reserved", ctypes.c_uint32),
+        ("texels", ctypes.c_void_p),
+    ]
+
+
+class TextureBinding(_SizedStructure):
+    """dwv_texture_binding_t."""
+
+    _fields_ = [
+        ("struct_size", ctypes.c_uint32),
+        ("input", ctypes.c_int32),
+        ("texture_id", ctypes.c_uint32),
+        ("invert", ctypes.c_int32),
+        ("uv_layer", ctypes.c_char_p),
+        ("blend", ctypes.c_double),
+        ("strength", ctypes.c_double),
+        ("distance", ctypes.c_double),
+        ("bump_shadowing", ctypes.c_int32),
+        ("reserved", ctypes.c_uint32),
     ]
 
 
@@ -373,6 +411,9 @@ _BAKER_PROTOTYPES: Dict[str, Tuple[object, Sequence[object]]] = {
     "dwv_scene_add_material": (_result_t, (_handle_p, _p(Material), _p(ctypes.c_uint32))),
     "dwv_scene_add_mesh": (_result_t, (_handle_p, _p(Mesh), _p(ctypes.c_uint32))),
     "dwv_scene_add_light": (_result_t, (_handle_p, _p(LightDesc))),
+    "dwv_scene_add_texture": (_result_t, (_handle_p, _p(TextureDesc), _p(ctypes.c_uint32))),
+    "dwv_scene_bind_texture": (_result_t, (_handle_p, ctypes.c_uint32, _p(TextureBinding))),
+    "dwv_scene_texture_memory": (_result_t, (_handle_p, _p(ctypes.c_uint64), _p(ctypes.c_uint64))),
     "dwv_scene_set_world": (_result_t, (_handle_p, _p(ctypes.c_double), ctypes.c_double)),
     "dwv_scene_set_world_environment": (_result_t, (_handle_p, _p(EnvironmentDesc))),
     "dwv_scene_set_camera": (_result_t, (_handle_p, _p(CameraDesc))),

@@ -496,6 +496,21 @@ class BakeStats:
 # Scene
 # ---------------------------------------------------------------------------------------------
 
+#: dwv_texel_format_t, dwv_texture_extension_t, dwv_texture_interpolation_t, dwv_material_input_t by name.
+TEXEL_FORMATS = ("float32", "srgb8", "linear8")
+TEXTURE_EXTENSIONS = ("repeat", "extend", "clip", "mirror")
+TEXTURE_INTERPOLATIONS = ("linear", "closest", "cubic")
+BUMP_SHADOWINGS = ("none", "chiang2019", "chiang2019_mapped", "conty2019")
+MATERIAL_INPUTS = ("base_color", "subsurface_color", "subsurface_weight", "subsurface_radius", "subsurface_scale",
+                   "subsurface_anisotropy", "roughness", "specular", "specular_tint", "normal_map", "bump")
+
+
+def _choice(name: str, value: str, names: Tuple[str, ...]) -> int:
+    if value not in names:
+        raise Error(f"{name} {value!r} is not one of {', '.join(names)}", _library.DWV_ERROR_UNKNOWN_NAME)
+    return names.index(value)
+
+
 class Scene:
     """A dwivedi scene (dwv_scene_t): add materials, meshes, lights, a world and a camera, then
     commit() it; a committed scene can be baked any number of times and no longer changed.
@@ -575,7 +590,9 @@ class Scene:
         return out.value
 
     def add_mesh(self, positions: Any, indices: Any, material: int = 0, *, normals: Any = None, uvs: Any = None,
-                 transform: Any = None, shadow_terminator_geometry_offset: float = 0.1) -> int:
+                 transform: Any = None, shadow_terminator_geometry_offset: float = 0.1,
+                 uv_name: Optional[str] = None, uv_layers: Optional[Sequence[Tuple[str, Any]]] = None,
+                 tangents: Optional[Dict[str, Any]] = None) -> int:
         """Adds a triangle mesh; returns its id (the uv_mesh of a UV bake).
 
         positions: 3 floats per vertex (object space); indices: 3 per triangle; normals: optional,
@@ -586,6 +603,10 @@ class Scene:
         shadow_terminator_geometry_offset: Cycles' object setting "Shadow Terminator > Geometry
         Offset" (>= 0, default 0.1 as Cycles; 0: shadow rays of smooth-shaded triangles leave from
         the flat triangle); see dwv_mesh_t.
+        uv_name: the name of `uvs` (Blender's UV map name, what bind_texture's uv_layer names; default
+        "0"); uv_layers: more UV layers as (name, uvs) pairs (default names "1", "2", ...); tangents:
+        per UV layer name, 4 floats per corner (xyz and the bitangent sign, Blender's MikkTSpace
+        tangents) for normal maps; layers without them get tangents from their UVs.
         """
         if isinstance(material, bool) or not isinstance(material, numbers.Integral):
             raise TypeError(f"material must be a material id (int), not {type(material).__name__}")
@@ -612,10 +633,109 @@ class Scene:
         mesh.transform[:] = transform12(transform)
         mesh.shadow_terminator_geometry_offset = _real("shadow_terminator_geometry_offset",
                                                        shadow_terminator_geometry_offset)
+        keep: List[Any] = []  # what the pointers borrow, alive until the call returns
+        extra = list(uv_layers or ())
+        if extra or uv_name is not None or tangents:
+            names = [uv_name if uv_name is not None else "0"]
+            arrays = []
+            for k, (name, values) in enumerate(extra):
+                layer = as_c_array(values, "f", f"uv_layers[{k}]", 6)
+                if layer.count != 2 * i.count:
+                    raise Error(f"uv_layers[{k}] holds {layer.count // 2} corners for {i.count // 3} triangles",
+                                _library.DWV_ERROR_INVALID_ARGUMENT)
+                names.append(str(name))
+                arrays.append(layer)
+            keep.extend(arrays)
+            if tangents:
+                unknown = sorted(set(tangents) - set(names))
+                if unknown:
+                    raise Error(f"tangents for UV layers the mesh does not have: {', '.join(unknown)}",
+                                _library.DWV_ERROR_INVALID_ARGUMENT)
+            encoded = [name.encode("utf-8") for name in names]
+            name_array = (ctypes.c_char_p * len(encoded))(*encoded)
+            layer_array = (ctypes.c_void_p * max(len(arrays), 1))(*[a.address for a in arrays])
+            tangent_array = (ctypes.c_void_p * len(names))()
+            for k, name in enumerate(names):
+                if tangents and name in tangents:
+                    t = as_c_array(tangents[name], "f", f"tangents[{name!r}]", 12)
+                    if t.count != 4 * i.count:
+                        raise Error(f"tangents[{name!r}] hold {t.count // 4} corners for {i.count // 3} triangles",
+                                    _library.DWV_ERROR_INVALID_ARGUMENT)
+                    keep.append(t)
+                    tangent_array[k] = t.address
+            keep.extend([encoded, name_array, layer_array, tangent_array])
+            mesh.uv_layer_count = len(arrays)
+            mesh.uv_layers = ctypes.addressof(layer_array) if arrays else None
+            mesh.uv_layer_names = ctypes.addressof(name_array)
+            mesh.tangents = ctypes.addressof(tangent_array)
         out = ctypes.c_uint32()
         _call("dwv_scene_add_mesh", self.handle, ctypes.byref(mesh), ctypes.byref(out))
+        del keep
         self._meshes = out.value + 1
         return out.value
+
+    def add_texture(self, texels: Any, width: int, height: int, channels: int = 4, *, format: str = "float32",
+                    extension: str = "repeat", interpolation: str = "linear") -> int:
+        """Adds a texture (dwv_texture_desc_t); returns its id. texels: channels x width x height
+        values, row 0 at v = 0 (Blender's Image.pixels order): floats for format "float32"
+        (scene-linear or non-colour data), bytes (0-255) for "srgb8" (8-bit sRGB colour) and
+        "linear8" (8-bit data, value / 255). extension: "repeat", "extend", "clip", "mirror";
+        interpolation: "linear", "closest", "cubic" (Blender's Image Texture node)."""
+        desc = _library.TextureDesc()
+        desc.width = _uint("width", width)
+        desc.height = _uint("height", height)
+        desc.channels = _uint("channels", channels)
+        desc.format = _choice("format", format, TEXEL_FORMATS)
+        desc.extension = _choice("extension", extension, TEXTURE_EXTENSIONS)
+        desc.interpolation = _choice("interpolation", interpolation, TEXTURE_INTERPOLATIONS)
+        wanted = desc.width * desc.height * desc.channels
+        if desc.format == 0:
+            data = as_c_array(texels, "f", "texels", 1)
+            count, address, owner = data.count, data.address, data
+        else:
+            try:
+                raw = bytes(memoryview(texels).cast("B")) if not isinstance(texels, (bytes, bytearray)) else bytes(texels)
+            except TypeError:
+                values = [int(v) for v in texels]
+                if any(v < 0 or v > 255 for v in values):
+                    raise Error("8-bit texels must be in [0, 255]", _library.DWV_ERROR_OUT_OF_RANGE) from None
+                raw = bytes(values)
+            owner = ctypes.create_string_buffer(raw, max(len(raw), 1))
+            count, address = len(raw), ctypes.addressof(owner)
+        if count != wanted:
+            raise Error(f"texels hold {count} values; {desc.width} x {desc.height} x {desc.channels} needs {wanted}",
+                        _library.DWV_ERROR_INVALID_ARGUMENT)
+        desc.texels = address or None
+        out = ctypes.c_uint32()
+        _call("dwv_scene_add_texture", self.handle, ctypes.byref(desc), ctypes.byref(out))
+        del owner
+        return out.value
+
+    def bind_texture(self, material: int, input: str, texture: int, *, uv_layer: Optional[str] = None,
+                     blend: float = 1.0, strength: float = 1.0, distance: float = 1.0, invert: bool = False,
+                     bump_shadowing: str = "chiang2019") -> None:
+        """Binds texture `texture` to input `input` of material `material` (dwv_texture_binding_t):
+        one of MATERIAL_INPUTS ("base_color", "subsurface_color", ..., "normal_map", "bump"),
+        through the mesh's UV layer `uv_layer` (a name given to add_mesh; None: its first).
+        bump_shadowing (normal map, bump): how Cycles treats tilted normals (dwv_bump_shadowing_t):
+        "chiang2019" (Blender 3.x), "chiang2019_mapped" (4.x: without ensure_valid_reflection),
+        "conty2019" (5.x) or "none"."""
+        binding = _library.TextureBinding()
+        binding.input = _choice("input", input, MATERIAL_INPUTS)
+        binding.texture_id = _uint("texture", texture)
+        binding.invert = 1 if invert else 0
+        binding.uv_layer = None if uv_layer is None else str(uv_layer).encode("utf-8")
+        binding.blend = _real("blend", blend)
+        binding.strength = _real("strength", strength)
+        binding.distance = _real("distance", distance)
+        binding.bump_shadowing = _choice("bump_shadowing", bump_shadowing, BUMP_SHADOWINGS)
+        _call("dwv_scene_bind_texture", self.handle, _uint("material", material), ctypes.byref(binding))
+
+    def texture_memory(self) -> Tuple[int, int]:
+        """(bytes, texels) of the scene's textures: the memory per texel is bytes / texels."""
+        size, count = ctypes.c_uint64(), ctypes.c_uint64()
+        _call("dwv_scene_texture_memory", self.handle, ctypes.byref(size), ctypes.byref(count))
+        return size.value, count.value
 
     def add_light(self, light: Light) -> None:
         """Adds a SunLight, PointLight, AreaLight or SpotLight."""

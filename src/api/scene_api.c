@@ -10,6 +10,7 @@
 #include <dwivedi.h>
 #include "util/error.h"
 #include "geom/mesh.h"
+#include "output/png_reader.h"
 #include "scene_handle.h"
 
 dwv_result_t dwv_scene_create(dwv_scene_t **scene)
@@ -160,6 +161,115 @@ dwv_result_t dwv_scene_add_material(dwv_scene_t *scene, const dwv_material_t *ma
     return DWV_SUCCESS;
 }
 
+#define MAX_UV_LAYERS 64u
+#define MAX_LAYER_NAME 1024u
+
+/* The mesh's extra UV layers, names and tangents: present where counted, finite, names unique. */
+static dwv_result_t check_layers(const char *fn, const dwv_mesh_t *mesh)
+{
+    size_t nt = mesh->triangle_count;
+    uint32_t count = mesh->uv_layer_count;
+    if (mesh->reserved_uv != 0u)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: reserved_uv must be 0", fn);
+    if (count > MAX_UV_LAYERS)
+        return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: uv_layer_count = %u is above %u", fn, count, MAX_UV_LAYERS);
+    if (count > 0u) DWV_TRY(dwv_check_pointer(fn, "mesh->uv_layers", mesh->uv_layers));
+    for (uint32_t k = 0; k < count; ++k) {
+        if (!mesh->uv_layers[k])
+            return dwv_fail(DWV_ERROR_NULL_POINTER, "%s: uv_layers[%u] is NULL", fn, k);
+        for (size_t i = 0; i < 6u * nt; ++i)
+            if (!isfinite(mesh->uv_layers[k][i]))
+                return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: uv_layers[%u][%zu] (triangle %zu) is not finite", fn,
+                                k, i, i / 6u);
+    }
+    if (mesh->uv_layer_names)
+        for (uint32_t k = 0; k <= count; ++k) {
+            const char *name = mesh->uv_layer_names[k];
+            if (!name) return dwv_fail(DWV_ERROR_NULL_POINTER, "%s: uv_layer_names[%u] is NULL", fn, k);
+            if (!*name || strlen(name) > MAX_LAYER_NAME)
+                return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: uv_layer_names[%u] is empty or longer than %u bytes",
+                                fn, k, MAX_LAYER_NAME);
+            for (uint32_t j = 0; j < k; ++j)
+                if (strcmp(mesh->uv_layer_names[j], name) == 0)
+                    return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: UV layers %u and %u are both named \"%s\"", fn, j,
+                                    k, name);
+        }
+    if (mesh->tangents)
+        for (uint32_t k = 0; k <= count; ++k) {
+            const float *t = mesh->tangents[k];
+            if (!t) continue;
+            if (k == 0u && !mesh->uvs)
+                return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: tangents[0] given for a mesh without uvs", fn);
+            for (size_t i = 0; i < 12u * nt; ++i)
+                if (!isfinite(t[i]) || (i % 4u == 3u && t[i] != 1.0f && t[i] != -1.0f))
+                    return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
+                                    "%s: tangents[%u][%zu] (triangle %zu) is %s", fn, k, i, i / 12u,
+                                    i % 4u == 3u ? "a sign other than +1 or -1" : "not finite");
+        }
+    return DWV_SUCCESS;
+}
+
+/* Copies the extra layers in the stored corner order (a mirroring transform swaps corners 1 and
+ * 2, as dwvg_mesh_init does) and the given tangents to world space (the normals' transform, the
+ * inverse transpose, whose orientation the sign takes on: exact for rotations, uniform scales and
+ * mirrors, as Cycles' object_normal_transform of the mapped normal). 0, or -1 out of memory. */
+static int copy_layers(const dwv_mesh_t *mesh, dwvb_mesh_layers *layers)
+{
+    size_t nt = mesh->triangle_count;
+    uint32_t count = mesh->uv_layer_count + 1u;
+    layers->count = count;
+    layers->uvs = calloc(count, sizeof *layers->uvs);
+    layers->names = calloc(count, sizeof *layers->names);
+    layers->tangents = calloc(count, sizeof *layers->tangents);
+    if (!layers->uvs || !layers->names || !layers->tangents) goto fail;
+    const double *m = mesh->transform;
+    double det = dwvg_transform_determinant(m);
+    int mirror = det < 0.0;
+    /* The cofactor matrix is det x the inverse transpose: its sign-corrected form keeps direction. */
+    double cof[9] = {m[5] * m[10] - m[6] * m[9], m[6] * m[8] - m[4] * m[10], m[4] * m[9] - m[5] * m[8],
+                     m[2] * m[9] - m[1] * m[10], m[0] * m[10] - m[2] * m[8], m[1] * m[8] - m[0] * m[9],
+                     m[1] * m[6] - m[2] * m[5], m[2] * m[4] - m[0] * m[6], m[0] * m[5] - m[1] * m[4]};
+    double orient = mirror ? -1.0 : 1.0;
+    for (uint32_t k = 0; k < count; ++k) {
+        char number[16];
+        snprintf(number, sizeof number, "%u", k);
+        const char *name = mesh->uv_layer_names ? mesh->uv_layer_names[k] : number;
+        layers->names[k] = malloc(strlen(name) + 1u);
+        if (!layers->names[k]) goto fail;
+        strcpy(layers->names[k], name);
+        if (k > 0u) {
+            const float *uv = mesh->uv_layers[k - 1u];
+            layers->uvs[k] = malloc(6u * nt * sizeof(float));
+            if (!layers->uvs[k]) goto fail;
+            for (size_t t = 0; t < nt; ++t)
+                for (int c = 0; c < 3; ++c) {
+                    int from = mirror && c > 0 ? 3 - c : c;
+                    layers->uvs[k][6 * t + 2 * (size_t)c] = uv[6 * t + 2 * (size_t)from];
+                    layers->uvs[k][6 * t + 2 * (size_t)c + 1] = uv[6 * t + 2 * (size_t)from + 1];
+                }
+        }
+        const float *given = mesh->tangents ? mesh->tangents[k] : NULL;
+        if (!given) continue;
+        layers->tangents[k] = malloc(12u * nt * sizeof(float));
+        if (!layers->tangents[k]) goto fail;
+        for (size_t t = 0; t < nt; ++t)
+            for (int c = 0; c < 3; ++c) {
+                int from = mirror && c > 0 ? 3 - c : c;
+                const float *g = given + 12u * t + 4u * (size_t)from;
+                double w[3];
+                for (int r = 0; r < 3; ++r) w[r] = orient * (cof[3 * r] * g[0] + cof[3 * r + 1] * g[1] + cof[3 * r + 2] * g[2]);
+                double length = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+                float *o = layers->tangents[k] + 12u * t + 4u * (size_t)c;
+                for (int r = 0; r < 3; ++r) o[r] = length > 0.0 ? (float)(w[r] / length) : 0.0f;
+                o[3] = (float)(g[3] * orient);
+            }
+    }
+    return 0;
+fail:
+    dwvb_mesh_layers_free(layers);
+    return -1;
+}
+
 dwv_result_t dwv_scene_add_mesh(dwv_scene_t *scene, const dwv_mesh_t *mesh_in, uint32_t *mesh_id)
 {
     static const char fn[] = "dwv_scene_add_mesh";
@@ -209,13 +319,20 @@ dwv_result_t dwv_scene_add_mesh(dwv_scene_t *scene, const dwv_mesh_t *mesh_in, u
         for (size_t i = 0; i < 6u * nt; ++i)
             if (!isfinite(mesh->uvs[i]))
                 return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: uvs[%zu] (triangle %zu) is not finite", fn, i, i / 6u);
+    DWV_TRY(check_layers(fn, mesh));
+    dwvb_mesh_layers layers;
+    if (copy_layers(mesh, &layers))
+        return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "%s: no memory for the UV layers of %u triangles", fn, mesh->triangle_count);
     dwvg_mesh made;
     if (dwvg_mesh_init(&made, mesh->vertex_count, mesh->triangle_count, mesh->material_id, mesh->positions,
-                       mesh->indices, mesh->normals, mesh->uvs, mesh->transform))
+                       mesh->indices, mesh->normals, mesh->uvs, mesh->transform)) {
+        dwvb_mesh_layers_free(&layers);
         return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "%s: no memory for %u vertices and %u triangles", fn,
                         mesh->vertex_count, mesh->triangle_count);
-    if (dwvb_scene_push_mesh(s, &made, mesh->shadow_terminator_geometry_offset)) {
+    }
+    if (dwvb_scene_push_mesh(s, &made, mesh->shadow_terminator_geometry_offset, &layers)) {
         dwvg_mesh_free(&made);
+        dwvb_mesh_layers_free(&layers);
         return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "%s: out of memory", fn);
     }
     *mesh_id = s->mesh_count - 1u;
@@ -436,4 +553,159 @@ const char *dwv_feature_name(uint32_t feature)
     case DWV_FEATURE_SHEET: return "sheet";
     default: return NULL;
     }
+}
+
+dwv_result_t dwv_scene_add_texture(dwv_scene_t *scene, const dwv_texture_desc_t *texture, uint32_t *texture_id)
+{
+    static const char fn[] = "dwv_scene_add_texture";
+    dwvb_scene *s;
+    DWV_TRY(open_scene(fn, scene, &s));
+    DWV_TRY(dwv_check_struct(fn, "texture", texture, (uint32_t)sizeof(dwv_texture_desc_t)));
+    DWV_TRY(dwv_check_pointer(fn, "texture_id", texture_id));
+    /* Sizes first: nothing is read for an absurd image. */
+    if (texture->width < 1u || texture->height < 1u)
+        return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: the texture is %u x %u texels (an image needs at least 1 x 1)", fn,
+                        texture->width, texture->height);
+    if (texture->width > DWVB_MAX_TEXTURE_SIDE || texture->height > DWVB_MAX_TEXTURE_SIDE ||
+        (uint64_t)texture->width * texture->height > DWVB_MAX_TEXTURE_TEXELS)
+        return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: the texture is %u x %u texels (at most %u per side and 2^28 in all)",
+                        fn, texture->width, texture->height, DWVB_MAX_TEXTURE_SIDE);
+    if (texture->channels != 1u && texture->channels != 3u && texture->channels != 4u)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: channels = %u (1, 3 or 4)", fn, texture->channels);
+    if (texture->format != DWV_TEXEL_FLOAT32 && texture->format != DWV_TEXEL_SRGB8 && texture->format != DWV_TEXEL_LINEAR8)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: format %d is not float32 (0), sRGB 8-bit (1) or linear 8-bit (2)",
+                        fn, (int)texture->format);
+    if (texture->extension < DWV_EXTENSION_REPEAT || texture->extension > DWV_EXTENSION_MIRROR)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
+                        "%s: extension %d is not repeat (0), extend (1), clip (2) or mirror (3)", fn, (int)texture->extension);
+    if (texture->interpolation < DWV_INTERPOLATION_LINEAR || texture->interpolation > DWV_INTERPOLATION_CUBIC)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: interpolation %d is not linear (0), closest (1) or cubic (2)", fn,
+                        (int)texture->interpolation);
+    if (texture->reserved != 0u) return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: reserved must be 0", fn);
+    DWV_TRY(dwv_check_pointer(fn, "texture->texels", texture->texels));
+    if (texture->format == DWV_TEXEL_FLOAT32) {
+        const float *texels = texture->texels;
+        size_t n = (size_t)texture->width * texture->height * texture->channels;
+        for (size_t i = 0; i < n; ++i)
+            if (!isfinite(texels[i])) {
+                size_t t = i / texture->channels;
+                return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: texel (%zu, %zu) channel %zu is %s", fn,
+                                t % texture->width, t / texture->width, i % texture->channels,
+                                isnan(texels[i]) ? "NaN" : "infinite");
+            }
+    }
+    if (s->texture_count >= DWVB_MAX_TEXTURES)
+        return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: a scene holds at most %u textures", fn, DWVB_MAX_TEXTURES);
+    dwvb_texture made;
+    if (dwvb_texture_init(&made, texture))
+        return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "%s: no memory for %u x %u texels", fn, texture->width, texture->height);
+    if (dwvb_scene_push_texture(s, &made)) {
+        dwvb_texture_free(&made);
+        return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "%s: out of memory", fn);
+    }
+    *texture_id = s->texture_count - 1u;
+    return DWV_SUCCESS;
+}
+
+dwv_result_t dwv_scene_add_texture_file(dwv_scene_t *scene, const char *path, const dwv_texture_desc_t *settings,
+                                        uint32_t *texture_id)
+{
+    static const char fn[] = "dwv_scene_add_texture_file";
+    dwvb_scene *s;
+    DWV_TRY(open_scene(fn, scene, &s));
+    DWV_TRY(dwv_check_pointer(fn, "path", path));
+    DWV_TRY(dwv_check_struct(fn, "settings", settings, (uint32_t)sizeof(dwv_texture_desc_t)));
+    DWV_TRY(dwv_check_pointer(fn, "texture_id", texture_id));
+    if (settings->format != DWV_TEXEL_SRGB8 && settings->format != DWV_TEXEL_LINEAR8)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
+                        "%s: a PNG holds 8-bit values: format must be sRGB 8-bit (1) or linear 8-bit (2), not %d", fn,
+                        (int)settings->format);
+    dwv_texture_desc_t desc = *settings;
+    uint8_t *pixels = NULL;
+    char message[512];
+    dwv_result_t r = dwvo_read_png8(path, &desc.width, &desc.height, &desc.channels, &pixels, message, sizeof message);
+    if (r != DWV_SUCCESS) return dwv_fail(r, "%s: %s", fn, message);
+    desc.struct_size = (uint32_t)sizeof desc;
+    desc.texels = pixels;
+    r = dwv_scene_add_texture(scene, &desc, texture_id);
+    free(pixels);
+    return r;
+}
+
+dwv_result_t dwv_scene_bind_texture(dwv_scene_t *scene, uint32_t material_id, const dwv_texture_binding_t *binding)
+{
+    static const char fn[] = "dwv_scene_bind_texture";
+    dwvb_scene *s;
+    DWV_TRY(open_scene(fn, scene, &s));
+    DWV_TRY(dwv_check_struct(fn, "binding", binding, (uint32_t)sizeof(dwv_texture_binding_t)));
+    if (material_id >= s->material_count)
+        return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: material_id = %u but the scene has %u material(s)", fn, material_id,
+                        s->material_count);
+    if (binding->texture_id >= s->texture_count)
+        return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: texture_id = %u but the scene has %u texture(s)", fn,
+                        binding->texture_id, s->texture_count);
+    dwv_material_input_t input = binding->input;
+    if (input < DWV_INPUT_BASE_COLOR || input > DWV_INPUT_BUMP)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: input %d is not a DWV_INPUT_* value (0 to 10)", fn, (int)input);
+    const dwvb_texture *texture = &s->textures[binding->texture_id];
+    int colour = input == DWV_INPUT_BASE_COLOR || input == DWV_INPUT_SUBSURFACE_COLOR ||
+                 input == DWV_INPUT_SUBSURFACE_RADIUS || input == DWV_INPUT_SPECULAR_TINT || input == DWV_INPUT_NORMAL_MAP;
+    if (colour && texture->channels < 3u)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
+                        "%s: input %d takes a colour (3 or 4 channels) but texture %u has %u channel", fn, (int)input,
+                        binding->texture_id, texture->channels);
+    DWV_TRY(dwv_check_range(fn, "blend", binding->blend, 0.0, 1.0));
+    DWV_TRY(dwv_check_range(fn, "strength", binding->strength, 0.0, input == DWV_INPUT_BUMP ? 1.0 : 1e6));
+    DWV_TRY(dwv_check_range(fn, "distance", binding->distance, -1e30, 1e30));
+    if (binding->invert != 0 && binding->invert != 1)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: invert = %d is neither 0 nor 1", fn, (int)binding->invert);
+    if (binding->bump_shadowing < DWV_BUMP_SHADOWING_NONE || binding->bump_shadowing > DWV_BUMP_SHADOWING_CONTY2019)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
+                        "%s: bump_shadowing %d is not none (0), Chiang 2019 (1, Blender 3.x), Chiang 2019 with the "
+                        "mapped normal (2, 4.x) or Conty 2019 (3, 5.x)", fn, (int)binding->bump_shadowing);
+    if (binding->reserved != 0u) return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: reserved must be 0", fn);
+    if (binding->uv_layer && strlen(binding->uv_layer) > MAX_LAYER_NAME)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: uv_layer is longer than %u bytes", fn, MAX_LAYER_NAME);
+    const dwv_material_t *material = &s->materials[material_id];
+    if (material->specular_model == DWV_SPECULAR_PRINCIPLED_V2 && (input == DWV_INPUT_ROUGHNESS || input == DWV_INPUT_SPECULAR))
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
+                        "%s: a textured %s under the 4.x+ Principled v2 specular layer is not supported (its albedo "
+                        "tables are made per material); give the input a constant", fn,
+                        input == DWV_INPUT_ROUGHNESS ? "Roughness" : "Specular IOR Level");
+    for (uint32_t b = 0; b < s->binding_count; ++b)
+        if (s->bindings[b].material_id == material_id && s->bindings[b].input == input &&
+            (input == DWV_INPUT_NORMAL_MAP || input == DWV_INPUT_BUMP))
+            return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: material %u already has a %s texture", fn, material_id,
+                            input == DWV_INPUT_BUMP ? "bump" : "normal map");
+    if (s->binding_count >= DWVB_MAX_BINDINGS)
+        return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: a scene holds at most %u bindings", fn, DWVB_MAX_BINDINGS);
+    dwvb_binding made = {material_id, input, binding->texture_id, binding->invert, NULL,
+                         binding->blend, binding->strength, binding->distance, binding->bump_shadowing};
+    if (binding->uv_layer && *binding->uv_layer) {
+        made.uv_layer = malloc(strlen(binding->uv_layer) + 1u);
+        if (!made.uv_layer) return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "%s: out of memory", fn);
+        strcpy(made.uv_layer, binding->uv_layer);
+    }
+    if (dwvb_scene_push_binding(s, &made)) {
+        free(made.uv_layer);
+        return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "%s: out of memory", fn);
+    }
+    return DWV_SUCCESS;
+}
+
+dwv_result_t dwv_scene_texture_memory(const dwv_scene_t *scene, uint64_t *bytes, uint64_t *texels)
+{
+    static const char fn[] = "dwv_scene_texture_memory";
+    DWV_TRY(dwv_check_pointer(fn, "scene", scene));
+    DWV_TRY(dwv_check_pointer(fn, "bytes", bytes));
+    DWV_TRY(dwv_check_pointer(fn, "texels", texels));
+    const dwvb_scene *s = dwv_scene_object(scene);
+    *bytes = *texels = 0u;
+    for (uint32_t i = 0; i < s->texture_count; ++i) {
+        const dwvb_texture *t = &s->textures[i];
+        uint64_t n = (uint64_t)t->width * t->height;
+        *texels += n;
+        *bytes += n * dwvb_texture_texel_bytes(t);
+    }
+    return DWV_SUCCESS;
 }

@@ -1,6 +1,7 @@
 #include "material.h"
 
 #include <math.h>
+#include <string.h>
 
 #define FOUR_PI 12.566370614359172954
 #define PI 3.14159265358979323846
@@ -292,7 +293,7 @@ double dwvb_specular_layer_weight(const dwvb_material *m, double mu)
 }
 
 /* The specular layer's constants (svm_closure.h of each release, capi's DWV_SPECULAR_*). */
-static void specular_init(dwvb_material *out, const dwv_material_t *in)
+static void specular_init(dwvb_material *out, const dwv_material_t *in, const dwvb_material *tables)
 {
     out->specular = 0;
     out->spec_multiscatter = 0;
@@ -329,8 +330,15 @@ static void specular_init(dwvb_material *out, const dwv_material_t *in)
     double rr = (eta - 1.0) / (eta + 1.0);
     out->spec_F0 = rr * rr;
     for (int c = 0; c < 3; ++c) out->spec_f0[c] = fmin(fmax(f0 * in->specular_tint[c], 0.0), 1.0);
-    for (int i = 0; i < DWVB_SPEC_MU; ++i)
-        dwvb_ggx_albedo(out->spec_alpha, eta, (double)i / (DWVB_SPEC_MU - 1), 48, &out->spec_E[i], &out->spec_s[i]);
+    /* The tables depend on roughness and eta only, which a texture never changes under v2
+     * (dwv_scene_bind_texture refuses it): a textured point copies its material's. */
+    if (tables && tables->specular == DWV_SPECULAR_PRINCIPLED_V2) {
+        memcpy(out->spec_E, tables->spec_E, sizeof out->spec_E);
+        memcpy(out->spec_s, tables->spec_s, sizeof out->spec_s);
+    } else {
+        for (int i = 0; i < DWVB_SPEC_MU; ++i)
+            dwvb_ggx_albedo(out->spec_alpha, eta, (double)i / (DWVB_SPEC_MU - 1), 48, &out->spec_E[i], &out->spec_s[i]);
+    }
     if (!out->spec_multiscatter) return;
     /* E_avg = 2 int E(mu) mu dmu (Simpson on the table); Fss from Kulla and Conty's fit of
      * 2 int F_d(mu) mu dmu, (eta - 1) / (4.08567 + 1.00071 eta), as Cycles. */
@@ -348,7 +356,19 @@ static void specular_init(dwvb_material *out, const dwv_material_t *in)
     }
 }
 
+static void material_init(dwvb_material *out, const dwv_material_t *in, const dwvb_material *tables);
+
 void dwvb_material_init(dwvb_material *out, const dwv_material_t *in)
+{
+    material_init(out, in, NULL);
+}
+
+void dwvb_material_init_like(dwvb_material *out, const dwv_material_t *in, const dwvb_material *tables)
+{
+    material_init(out, in, tables);
+}
+
+static void material_init(dwvb_material *out, const dwv_material_t *in, const dwvb_material *tables)
 {
     out->subsurface = 0;
     out->grey = 0;
@@ -358,7 +378,7 @@ void dwvb_material_init(dwvb_material *out, const dwv_material_t *in)
     out->model = in->subsurface_model;
     out->entry = DWVB_ENTRY_DIFFUSE;
     out->entry_alpha = in->roughness * in->roughness;
-    specular_init(out, in);
+    specular_init(out, in, tables);
     out->min_footprint = in->kind == DWV_MATERIAL_SUBSURFACE ? in->subsurface_min_footprint : 0.0;
     for (int c = 0; c < 3; ++c) {
         out->radius[c] = in->subsurface_radius[c] * in->subsurface_scale;
@@ -460,5 +480,6 @@ void dwvb_material_init(dwvb_material *out, const dwv_material_t *in)
                 out->walk_scale[1] == out->walk_scale[2];
     dwvw_medium_init(&out->medium, out->grey ? 1 : 3, sigma_t, alpha, g);
     for (int c = 0; c < 3; ++c)
-        if (!out->grey && out->walk_scale[c] > 0.0) dwvw_medium_init(&out->channel_medium[c], 1, &sigma_t[c], &alpha[c], g);
+        if ((!out->grey || tables) && out->walk_scale[c] > 0.0)
+            dwvw_medium_init(&out->channel_medium[c], 1, &sigma_t[c], &alpha[c], g);
 }

@@ -142,5 +142,9 @@ double dwvb_principled_retro_factor(double cos_light, double cos_view, double li
 double dwvb_principled_diffuse_factor(double cos_light, double cos_view, double light_dot_view, double roughness);
 /* Derives the shading of a validated material. */
 void dwvb_material_init(dwvb_material *out, const dwv_material_t *in);
+/* The same for a textured point of a material whose committed shading is `tables`: its channel
+ * media are made for every walking channel (its mesh may walk channels apart while the point is
+ * grey), and the v2 specular tables are copied from `tables`. */
+void dwvb_material_init_like(dwvb_material *out, const dwv_material_t *in, const dwvb_material *tables);
 
 #endif

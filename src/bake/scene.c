@@ -6,9 +6,11 @@
 #include <string.h>
 
 #include "kernel/rng.h"
+#include "bake/textured.h"
 #include "light/direct.h"
 
 static dwv_result_t uncommit(dwvb_scene *scene, dwv_result_t result);
+static dwv_result_t commit_bindings(dwvb_scene *scene, char *message, size_t size);
 
 /* The clearance grids of a scene stop once they hold this many cells (64 MiB): a scene of many
  * large subsurface meshes keeps rays at every step in the later ones (in mesh order, so the same
@@ -27,8 +29,16 @@ void dwvb_scene_free(dwvb_scene *scene)
 {
     if (!scene) return;
     uncommit(scene, DWV_SUCCESS);
-    for (uint32_t i = 0; i < scene->mesh_count; ++i) dwvg_mesh_free(&scene->meshes[i]);
+    for (uint32_t i = 0; i < scene->mesh_count; ++i) {
+        dwvg_mesh_free(&scene->meshes[i]);
+        dwvb_mesh_layers_free(&scene->layers[i]);
+    }
     free(scene->meshes);
+    free(scene->layers);
+    for (uint32_t i = 0; i < scene->texture_count; ++i) dwvb_texture_free(&scene->textures[i]);
+    free(scene->textures);
+    for (uint32_t i = 0; i < scene->binding_count; ++i) free(scene->bindings[i].uv_layer);
+    free(scene->bindings);
     free(scene->terminator_offsets);
     free(scene->materials);
     free(scene->lights);
@@ -65,17 +75,57 @@ int dwvb_scene_push_material(dwvb_scene *scene, const dwv_material_t *material)
     return 0;
 }
 
-int dwvb_scene_push_mesh(dwvb_scene *scene, const dwvg_mesh *mesh, double terminator_offset)
+int dwvb_scene_push_mesh(dwvb_scene *scene, const dwvg_mesh *mesh, double terminator_offset,
+                         const dwvb_mesh_layers *layers)
 {
     void *offsets = grow(scene->terminator_offsets, scene->mesh_count, &scene->terminator_capacity,
                          sizeof *scene->terminator_offsets);
     if (!offsets) return -1;
     scene->terminator_offsets = offsets;
+    void *tables = grow(scene->layers, scene->mesh_count, &scene->layer_capacity, sizeof *scene->layers);
+    if (!tables) return -1;
+    scene->layers = tables;
+    dwvb_mesh_layers none = {0u, NULL, NULL, NULL};
+    scene->layers[scene->mesh_count] = layers ? *layers : none;
     void *grown = grow(scene->meshes, scene->mesh_count, &scene->mesh_capacity, sizeof *mesh);
     if (!grown) return -1;
     scene->meshes = grown;
     scene->terminator_offsets[scene->mesh_count] = terminator_offset;
     scene->meshes[scene->mesh_count++] = *mesh;
+    return 0;
+}
+
+void dwvb_mesh_layers_free(dwvb_mesh_layers *layers)
+{
+    for (uint32_t k = 0; k < layers->count; ++k) {
+        if (layers->uvs) free(layers->uvs[k]);
+        if (layers->names) free(layers->names[k]);
+        if (layers->tangents) free(layers->tangents[k]);
+    }
+    free(layers->uvs);
+    free(layers->names);
+    free(layers->tangents);
+    layers->uvs = NULL;
+    layers->names = NULL;
+    layers->tangents = NULL;
+    layers->count = 0;
+}
+
+int dwvb_scene_push_texture(dwvb_scene *scene, const dwvb_texture *texture)
+{
+    void *grown = grow(scene->textures, scene->texture_count, &scene->texture_capacity, sizeof *texture);
+    if (!grown) return -1;
+    scene->textures = grown;
+    scene->textures[scene->texture_count++] = *texture;
+    return 0;
+}
+
+int dwvb_scene_push_binding(dwvb_scene *scene, const dwvb_binding *binding)
+{
+    void *grown = grow(scene->bindings, scene->binding_count, &scene->binding_capacity, sizeof *binding);
+    if (!grown) return -1;
+    scene->bindings = grown;
+    scene->bindings[scene->binding_count++] = *binding;
     return 0;
 }
 
@@ -166,6 +216,94 @@ static int make_patches(const dwvb_scene *scene, const dwvl_environment *env, ui
     return count;
 }
 
+static const char *input_name(dwv_material_input_t input)
+{
+    static const char *const names[] = {"base_color", "subsurface_color", "subsurface_weight", "subsurface_radius",
+                                        "subsurface_scale", "subsurface_anisotropy", "roughness", "specular",
+                                        "specular_tint", "normal_map", "bump"};
+    return input >= 0 && input <= DWV_INPUT_BUMP ? names[input] : "?";
+}
+
+/* The index of the UV layer called `name` (NULL: 0) on mesh m, or -1. */
+static int32_t find_layer(const dwvb_scene *scene, uint32_t m, const char *name)
+{
+    if (!name) return 0;
+    const dwvb_mesh_layers *layers = &scene->layers[m];
+    for (uint32_t k = 0; k < layers->count; ++k)
+        if (strcmp(layers->names[k], name) == 0) return (int32_t)k;
+    return -1;
+}
+
+/* The commit's view of the bindings: per material its run of bindings, its normal map and bump;
+ * per mesh of a textured material the UV layer of each (which must be there, with UVs), and the
+ * tangents of the layers normal maps use (made from the UVs where the caller gave none). */
+static dwv_result_t commit_bindings(dwvb_scene *scene, char *message, size_t size)
+{
+    uint32_t nm = scene->material_count, nb = scene->binding_count, nmesh = scene->mesh_count;
+    scene->material_textures = calloc(nm ? nm : 1u, sizeof *scene->material_textures);
+    scene->binding_order = malloc((nb ? nb : 1u) * sizeof *scene->binding_order);
+    scene->binding_layers = calloc(nmesh ? nmesh : 1u, sizeof *scene->binding_layers);
+    if (!scene->material_textures || !scene->binding_order || !scene->binding_layers) {
+        snprintf(message, size, "out of memory");
+        return DWV_ERROR_OUT_OF_MEMORY;
+    }
+    for (uint32_t i = 0; i < nm; ++i) scene->material_textures[i].normal_map = scene->material_textures[i].bump = -1;
+    for (uint32_t b = 0; b < nb; ++b) ++scene->material_textures[scene->bindings[b].material_id].count;
+    uint32_t first = 0;
+    for (uint32_t i = 0; i < nm; ++i) {
+        scene->material_textures[i].first = first;
+        first += scene->material_textures[i].count;
+        scene->material_textures[i].count = 0;
+    }
+    for (uint32_t b = 0; b < nb; ++b) {
+        const dwvb_binding *binding = &scene->bindings[b];
+        dwvb_material_textures *t = &scene->material_textures[binding->material_id];
+        scene->binding_order[t->first + t->count++] = b;
+        if (binding->input == DWV_INPUT_NORMAL_MAP) t->normal_map = (int32_t)b;
+        else if (binding->input == DWV_INPUT_BUMP) t->bump = (int32_t)b;
+        else t->inputs = 1;
+        if (binding->input == DWV_INPUT_NORMAL_MAP || binding->input == DWV_INPUT_BUMP)
+            if (binding->bump_shadowing) t->bump_shadowing = binding->bump_shadowing;
+    }
+    for (uint32_t m = 0; m < nmesh; ++m) {
+        const dwvg_mesh *mesh = &scene->meshes[m];
+        const dwvb_material_textures *t = &scene->material_textures[mesh->material_id];
+        if (!t->count) continue;
+        scene->binding_layers[m] = malloc(t->count * sizeof **scene->binding_layers);
+        if (!scene->binding_layers[m]) {
+            snprintf(message, size, "out of memory");
+            return DWV_ERROR_OUT_OF_MEMORY;
+        }
+        if (!scene->layers[m].count) {
+            snprintf(message, size, "mesh %u has no UV layer table (it was not added by dwv_scene_add_mesh)", m);
+            return DWV_ERROR_INTERNAL;
+        }
+        for (uint32_t k = 0; k < t->count; ++k) {
+            const dwvb_binding *binding = &scene->bindings[scene->binding_order[t->first + k]];
+            int32_t layer = find_layer(scene, m, binding->uv_layer);
+            if (layer < 0) {
+                snprintf(message, size, "mesh %u has no UV layer \"%s\", which the %s texture of its material %u names",
+                         m, binding->uv_layer, input_name(binding->input), mesh->material_id);
+                return DWV_ERROR_INVALID_ARGUMENT;
+            }
+            if (layer == 0 && !mesh->uvs) {
+                snprintf(message, size, "mesh %u has no UVs, which the %s texture of its material %u needs", m,
+                         input_name(binding->input), mesh->material_id);
+                return DWV_ERROR_INVALID_ARGUMENT;
+            }
+            scene->binding_layers[m][k] = (uint32_t)layer;
+            if (binding->input != DWV_INPUT_NORMAL_MAP || scene->layers[m].tangents[layer]) continue;
+            const float *uvs = layer == 0 ? mesh->uvs : scene->layers[m].uvs[layer];
+            scene->layers[m].tangents[layer] = dwvb_make_tangents(mesh, uvs);
+            if (!scene->layers[m].tangents[layer]) {
+                snprintf(message, size, "out of memory while making the tangents of mesh %u", m);
+                return DWV_ERROR_OUT_OF_MEMORY;
+            }
+        }
+    }
+    return DWV_SUCCESS;
+}
+
 /* Drops what a failed commit made, so that the scene is as before and may be committed again. */
 static dwv_result_t uncommit(dwvb_scene *scene, dwv_result_t result)
 {
@@ -174,6 +312,14 @@ static dwv_result_t uncommit(dwvb_scene *scene, dwv_result_t result)
     free(scene->emitters);
     free(scene->patches);
     free(scene->patch_count);
+    free(scene->material_textures);
+    free(scene->binding_order);
+    if (scene->binding_layers)
+        for (uint32_t m = 0; m < scene->mesh_count; ++m) free(scene->binding_layers[m]);
+    free(scene->binding_layers);
+    scene->material_textures = NULL;
+    scene->binding_order = NULL;
+    scene->binding_layers = NULL;
     scene->shading = NULL;
     scene->emitters = NULL;
     scene->patches = NULL;
@@ -192,7 +338,14 @@ dwv_result_t dwvb_scene_commit(dwvb_scene *scene, char *message, size_t size)
         snprintf(message, size, "out of memory");
         return uncommit(scene, DWV_ERROR_OUT_OF_MEMORY);
     }
-    for (uint32_t i = 0; i < nm; ++i) dwvb_material_init(&scene->shading[i], &scene->materials[i]);
+    dwv_result_t bound = commit_bindings(scene, message, size);
+    if (bound != DWV_SUCCESS) return uncommit(scene, bound);
+    for (uint32_t i = 0; i < nm; ++i) {
+        /* A textured material is planned for with its inputs' largest texture values. */
+        dwv_material_t planned = scene->materials[i];
+        if (scene->material_textures[i].count) dwvb_textured_representative(scene, i, &planned);
+        dwvb_material_init(&scene->shading[i], &planned);
+    }
     for (uint32_t i = 0; i < nl; ++i) dwvl_light_init(&scene->emitters[i], &scene->lights[i]);
     uint32_t features = 0;
     if (nmesh > 0) {
@@ -232,7 +385,7 @@ dwv_result_t dwvb_scene_commit(dwvb_scene *scene, char *message, size_t size)
             const dwvg_clearance *grid = &scene->geometry.clearance[m];
             if (grid->lower) grid_cells += (uint64_t)grid->n[0] * grid->n[1] * grid->n[2];
         }
-        if (!material->grey) features |= DWV_FEATURE_RGB_WALKS;
+        if (!material->grey || dwvb_textured_inputs(scene, m)) features |= DWV_FEATURE_RGB_WALKS;
         if (!lights_lit && !world_lit) continue;
         int count = make_patches(scene, &env, m, scene->patches[m]);
         if (count < 0) {

@@ -2,6 +2,8 @@
 
 #include <math.h>
 
+#include "bake/textured.h"
+
 
 /* The mixture terms of the step just sampled (see dwvb_tally): `per_component` (the channels
  * squared) for each component of weight > 0, of which a walk with a single one (the classical
@@ -182,6 +184,8 @@ typedef struct surface_lobes {
     const dwvb_material *material;
     retro_lobe lobe;
     double diffuse[3]; /* the diffuse lobe's weight per channel (layered) */
+    int bumped;        /* DWV_BUMP_SHADOWING_* where a normal map tilted lobe.n from smooth_n, else 0 */
+    dwvu_vec3 smooth_n;
 } surface_lobes;
 
 static void surface_factor(const void *context, dwvu_vec3 light, double f[3])
@@ -195,8 +199,11 @@ static void surface_factor(const void *context, dwvu_vec3 light, double f[3])
     double retro = m->principled_v1
                        ? dwvb_principled_retro_factor(cos_l, s->lobe.cos_view, l_dot_v, s->lobe.roughness)
                        : 0.0;
+    /* Cycles 3.x shadows its diffuse closures (the Lambertian, Principled diffuse and
+     * retro-reflection), not the specular, where a normal map tilted them (textured.h). */
+    double shadow = s->bumped ? dwvb_bump_shadowing(s->bumped, s->smooth_n, s->lobe.n, light) : 1.0;
     dwvb_specular_factor(m, s->lobe.n, light, s->lobe.to_view, f);
-    for (int c = 0; c < 3; ++c) f[c] += s->diffuse[c] * diffuse + m->retro_albedo[c] * retro;
+    for (int c = 0; c < 3; ++c) f[c] += (s->diffuse[c] * diffuse + m->retro_albedo[c] * retro) * shadow;
 }
 
 /* The exit weight of Blender 3.x's Principled BSDF; the context is the exit's shading normal. */
@@ -204,6 +211,21 @@ static double exit_factor(const void *context, dwvu_vec3 light)
 {
     const dwvu_vec3 *n = context;
     return dwvb_principled_exit_factor(dwvu_dot(*n, light));
+}
+
+/* The exit's diffuse lobe where a normal map tilted its normal n from smooth_n: the 3.x
+ * Principled exit weight (or 1) times the bump shadowing (textured.h). */
+typedef struct bumped_exit {
+    dwvu_vec3 n, smooth_n;
+    int principled_v1;
+    int mode; /* DWV_BUMP_SHADOWING_* */
+} bumped_exit;
+
+static double bumped_exit_factor(const void *context, dwvu_vec3 light)
+{
+    const bumped_exit *e = context;
+    double f = e->principled_v1 ? dwvb_principled_exit_factor(dwvu_dot(e->n, light)) : 1.0;
+    return f * dwvb_bump_shadowing(e->mode, e->smooth_n, e->n, light);
 }
 
 /* The light a walk gathers where it left mesh `mesh` (exit: its hit), from the sampler's light
@@ -215,12 +237,23 @@ static void exit_light(const dwvb_shader *shader, uint32_t mesh_id, const dwvb_m
     const dwvg_mesh *mesh = &scene->meshes[mesh_id];
     dwvu_vec3 exit_ng = walk->exit_normal;
     dwvu_vec3 exit_n = dwvg_shading_normal(mesh, exit->prim, exit->u, exit->v, exit_ng);
+    /* Cycles evaluates the exit's shader for its normal (SD_HAS_BSSRDF_BUMP): the normal map and
+     * bump there, the rest of the material being the entry's. */
+    dwvu_vec3 exit_smooth_n = exit_n;
+    if (dwvb_textured_normal_bound(scene, mesh_id))
+        exit_n = dwvb_textured_normal(scene, mesh_id, exit->prim, exit->u, exit->v, exit_n);
     /* Cycles shades the exit as a surface point of its triangle: the same terminator offset. */
     double cutoff = scene->terminator_offsets[mesh_id];
     dwvl_terminator exit_terminator = {mesh, exit->prim, exit->u, exit->v, cutoff};
     const dwvl_terminator *exit_smooth = mesh->normals && cutoff > 0.0 ? &exit_terminator : NULL;
     double exit_top = dwvg_world_top(&scene->geometry, mesh_id, exit->prim);
-    if (material->principled_v1)
+    int mode = dwvb_textured_bump_shadowing(scene, mesh_id);
+    int tilted = exit_n.x != exit_smooth_n.x || exit_n.y != exit_smooth_n.y || exit_n.z != exit_smooth_n.z;
+    if (mode && tilted) {
+        bumped_exit lobe = {exit_n, exit_smooth_n, material->principled_v1, mode};
+        dwvl_direct_lobe(&shader->env, walk->position, exit_n, exit_ng, exit_smooth, exit_top, sampler, pair,
+                         bumped_exit_factor, &lobe, NULL, direct);
+    } else if (material->principled_v1)
         dwvl_direct_lobe(&shader->env, walk->position, exit_n, exit_ng, exit_smooth, exit_top, sampler, pair, exit_factor,
                          &exit_n, NULL, direct);
     else
@@ -246,6 +279,13 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
     const dwvg_mesh *mesh = &scene->meshes[hit->mesh];
     uint32_t material_id = mesh->material_id;
     const dwvb_material *material = &scene->shading[material_id];
+    /* Textured inputs: the material as the textures make it here, once, for the surface lobes and
+     * for the whole walk from here (Cycles' homogeneous medium from the entry's closure). */
+    dwvb_material textured;
+    if (dwvb_textured_inputs(scene, hit->mesh)) {
+        dwvb_textured_material(scene, hit->mesh, hit->prim, hit->u, hit->v, &textured);
+        material = &textured;
+    }
     rgb[0] = rgb[1] = rgb[2] = 0.0;
     dwvu_vec3 ng = dwvg_geometric_normal(mesh, hit->prim);
     if (ng.x == 0.0 && ng.y == 0.0 && ng.z == 0.0) {
@@ -265,6 +305,16 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
     }
     dwvu_vec3 x = dwvg_point(mesh, hit->prim, hit->u, hit->v);
     dwvu_vec3 n = dwvg_shading_normal(mesh, hit->prim, hit->u, hit->v, ng);
+    dwvu_vec3 smooth_n = n;
+    if (dwvb_textured_normal_bound(scene, hit->mesh)) {
+        /* Cycles 3.x's closures keep a mapped normal's mirror reflection of the view above the
+         * surface (svm_closure.h, ensure_valid_reflection); 4.x's diffuse and subsurface ones do not. */
+        n = dwvb_textured_normal(scene, hit->mesh, hit->prim, hit->u, hit->v, n);
+        if (dwvb_textured_bump_shadowing(scene, hit->mesh) == DWV_BUMP_SHADOWING_CHIANG2019)
+            n = dwvb_valid_reflection(ng, dwvu_scale(view, -1.0), n);
+    }
+    int tilted = n.x != smooth_n.x || n.y != smooth_n.y || n.z != smooth_n.z;
+    int bumped = tilted ? dwvb_textured_bump_shadowing(scene, hit->mesh) : DWV_BUMP_SHADOWING_NONE;
     uint32_t light_pairs = dwvl_direct_pairs(&shader->env);
     /* Cycles 4.0-4.4: channels whose radius is below a quarter of the camera ray's footprint are
      * Lambertian at this hit (bssrdf_setup); their walks' results are not used. */
@@ -292,8 +342,10 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
     /* The layers under a 4.x+ specular keep 1 - its albedo toward the viewer (1 otherwise). */
     double cos_view = -dwvu_dot(n, view);
     double layer = material->specular ? dwvb_specular_layer_weight(material, cos_view) : 1.0;
-    if (material->specular) {
-        surface_lobes lobes = {material, {n, dwvu_scale(view, -1.0), cos_view, material->roughness}, {0.0, 0.0, 0.0}};
+    if (material->specular || bumped) {
+        /* (A tilted normal's shadowing goes through the general lobe too.) */
+        surface_lobes lobes = {material, {n, dwvu_scale(view, -1.0), cos_view, material->roughness}, {0.0, 0.0, 0.0},
+                               bumped, smooth_n};
         for (int c = 0; c < 3; ++c) lobes.diffuse[c] = layer * diffuse_albedo[c];
         double surface[3];
         dwvl_direct_rgb(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, surface_factor, &lobes,

@@ -31,7 +31,7 @@ static void help(FILE *out)
             "  PREFIX.exr   float RGBA, scene-linear Rec.709, plus variance and sample-count layers\n"
             "  PREFIX.png   the display image through an OpenColorIO view\n"
             "  PREFIX.json  spp, seconds, estimated_relative_error, mean_rgb, events, features,\n"
-            "               error_vs_time and more\n"
+            "               error_vs_time, texture_bytes_per_texel (textured scenes) and more\n"
             "all three only when the bake completes: a failed or cancelled (Ctrl-C) bake exits non-zero\n"
             "and leaves earlier outputs untouched.\n\n"
             "  --spp N        samples per pixel (default: the scene's); the budgets --spp, --time and\n"
@@ -236,7 +236,7 @@ static void json_triple(FILE *out, const double v[3])
 
 /* Writes the stats as JSON to `path`; 0 or -1 after reporting. */
 static int write_stats_json(const char *path, const dwv_image_t *image, const dwv_bake_options_t *o,
-                            const char *scene_name)
+                            const char *scene_name, const dwv_scene_t *scene)
 {
     dwv_bake_stats_t s = DWV_BAKE_STATS_INIT;
     uint32_t count = 0;
@@ -283,7 +283,15 @@ static int write_stats_json(const char *path, const dwv_image_t *image, const dw
         fprintf(out, "%s\"%s\"", first ? "" : ", ", dwv_feature_name(bit));
         first = 0;
     }
-    fprintf(out, "],\n  \"error_vs_time\": [");
+    fprintf(out, "]");
+    uint64_t texture_bytes = 0, texels = 0;
+    if (scene && dwv_scene_texture_memory(scene, &texture_bytes, &texels) == DWV_SUCCESS && texels > 0) {
+        /* Texture memory per texel (issue 18): 1 byte per 8-bit channel, 4 per float channel. */
+        fprintf(out, ",\n  \"texture_bytes\": %llu,\n  \"texture_texels\": %llu,\n  \"texture_bytes_per_texel\": ",
+                (unsigned long long)texture_bytes, (unsigned long long)texels);
+        cli_json_number(out, (double)texture_bytes / (double)texels);
+    }
+    fprintf(out, ",\n  \"error_vs_time\": [");
     for (uint32_t i = 0; i < count; ++i) {
         fprintf(out, "%s\n    {\"seconds\": ", i ? "," : "");
         cli_json_number(out, points[i].seconds);
@@ -325,7 +333,7 @@ static char *hidden_join(const char *prefix, const char *suffix)
 
 /* Writes the three outputs under temporary names, then renames them into place. */
 int cli_bake_write_outputs(const char *prefix, const dwv_image_t *image, const dwv_bake_options_t *o,
-                           const dwv_display_options_t *display, const char *scene_name)
+                           const dwv_display_options_t *display, const char *scene_name, const dwv_scene_t *scene)
 {
     static const char *const final_suffix[3] = {".exr", ".png", ".json"};
     char temp_suffix[3][64];
@@ -347,7 +355,7 @@ int cli_bake_write_outputs(const char *prefix, const dwv_image_t *image, const d
         goto done;
     }
     written = 2;
-    if (write_stats_json(temp_path[2], image, o, scene_name) != 0) goto done;
+    if (write_stats_json(temp_path[2], image, o, scene_name, scene) != 0) goto done;
     written = 3;
     for (int k = 0; k < 3; ++k) {
         if (rename(temp_path[k], final_path[k]) != 0) {
@@ -517,7 +525,8 @@ static int run(int argc, char **argv)
         exit_code = CLI_OK;
         goto done;
     }
-    if (cli_bake_write_outputs(f.prefix, image, &o, &f.display, f.scene_path ? f.scene_path : "default") != 0) goto done;
+    if (cli_bake_write_outputs(f.prefix, image, &o, &f.display, f.scene_path ? f.scene_path : "default", scene) != 0)
+        goto done;
 
     dwv_bake_stats_t s = DWV_BAKE_STATS_INIT;
     dwv_image_stats(image, &s);
@@ -608,7 +617,7 @@ static int merge_run(int argc, char **argv)
     dwv_bake_options_t o = DWV_BAKE_OPTIONS_INIT;
     o.width = info.width;
     o.height = info.height;
-    if (cli_bake_write_outputs(prefix, image, &o, &display, "merged") == 0) {
+    if (cli_bake_write_outputs(prefix, image, &o, &display, "merged", NULL) == 0) {
         dwv_bake_stats_t s = DWV_BAKE_STATS_INIT;
         dwv_image_stats(image, &s);
         printf("merged %u chunk(s): %ux%u, %llu spp, %.2f s of bakes, estimated relative error %.3g%%\n", count,

@@ -30,9 +30,10 @@ int cli_bake_load(int argc, char **argv, cli_bake_flags *f, dwv_bake_options_t *
 int cli_bake_check_outputs(const char *prefix, const dwv_display_options_t *display);
 
 /* PREFIX.exr, .png and .json of `image`, each written under a temporary name and renamed into
- * place only when all three are complete; 0, or -1 after reporting (earlier outputs kept). */
+ * place only when all three are complete; 0, or -1 after reporting (earlier outputs kept).
+ * `scene` (NULL for a merge): the baked scene, whose texture memory the JSON reports. */
 int cli_bake_write_outputs(const char *prefix, const dwv_image_t *image, const dwv_bake_options_t *o,
-                           const dwv_display_options_t *display, const char *scene_name);
+                           const dwv_display_options_t *display, const char *scene_name, const dwv_scene_t *scene);
 
 /* `dwivedi bake ... --mpi` (mpi_bake.c, built where CMake finds MPI): the exit code. */
 int cli_mpi_bake(int argc, char **argv);

@@ -496,7 +496,7 @@ static int run_root(job *j, double start)
     if (dwv_merge_partials((const char *const *)j->paths, j->path_count, &image) != DWV_SUCCESS)
         root_fail(j, 0, "%s", dwv_last_error_message());
     if (cli_bake_write_outputs(j->flags.prefix, image, &j->options, &j->flags.display,
-                               j->flags.scene_path ? j->flags.scene_path : "default") != 0) {
+                               j->flags.scene_path ? j->flags.scene_path : "default", j->scene) != 0) {
         dwv_image_release(image);
         end_all(j, CLI_FAILED);
     }

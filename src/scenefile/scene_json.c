@@ -144,7 +144,7 @@ static void snippet(const unsigned char *s, size_t n, size_t offset, char out[24
 static dwv_result_t read_scene(dwvs_parser *ps, const cJSON *root)
 {
     static const char *const keys[] = {"version", "description", "materials", "meshes",
-                                       "lights",  "world",       "camera",    "bake"};
+                                       "lights",  "world",       "camera",    "bake", "textures"};
     if (!cJSON_IsObject(root))
         return dwvs_fail_at(DWV_ERROR_FORMAT, "", "expected an object, found %s", dwvs_type_name(root));
     DWV_TRY(dwvs_check_keys(root, "", keys, sizeof keys / sizeof keys[0]));
@@ -160,6 +160,8 @@ static dwv_result_t read_scene(dwvs_parser *ps, const cJSON *root)
         return dwvs_fail_at(DWV_ERROR_FORMAT, "description", "expected a string, found %s", dwvs_type_name(description));
 
     const cJSON *materials = dwvs_member(root, "materials"), *meshes = dwvs_member(root, "meshes");
+    const cJSON *textures = dwvs_member(root, "textures");
+    if (textures) DWV_TRY(dwvs_read_textures(ps, textures));
     if (materials) DWV_TRY(dwvs_read_materials(ps, materials));
     if (!meshes) return dwvs_fail_at(DWV_ERROR_FORMAT, "", "missing key 'meshes'");
     DWV_TRY(dwvs_read_meshes(ps, meshes));
@@ -216,6 +218,7 @@ dwv_result_t dwvs_scene_from_json(const char *json, size_t size, const char *bas
     dwv_result_t r = dwv_scene_create(&ps.scene);
     if (r == DWV_SUCCESS) r = read_scene(&ps, root);
     free(ps.materials);
+    free(ps.textures);
     free(ps.meshes);
     cJSON_Delete(root);
     if (r != DWV_SUCCESS) {

@@ -17,6 +17,7 @@
 #define SHOWN_BYTES 40 /* of a user's string shown in a message, before "..." */
 #define SHOWN_SIZE (SHOWN_BYTES + 8)
 #define MESSAGE_SIZE 400
+#define MAX_FILE_PATH 4096 /* a mesh or image file's path, resolved */
 
 /* A material or mesh of the file by name, with the id the scene gave it. */
 typedef struct dwvs_named {
@@ -30,6 +31,8 @@ typedef struct dwvs_parser {
     const char *base_dir;
     dwvs_named *materials; /* sorted by name once read */
     size_t material_count;
+    dwvs_named *textures; /* sorted by name once read */
+    size_t texture_count;
     dwvs_named *meshes; /* in file order; names may be NULL */
     size_t mesh_count;
     int has_camera;
@@ -88,8 +91,14 @@ dwv_result_t dwvs_opt_choice(const cJSON *object, const char *parent, const char
  * row-major m; m is left alone when the key is absent. */
 dwv_result_t dwvs_opt_transform(const cJSON *object, const char *parent, double m[12]);
 
+/* `file` resolved against base_dir (absolute paths kept); `path` is the JSON path for a message. */
+dwv_result_t dwvs_resolve_path(const char *base_dir, const char *file, const char *path, char out[MAX_FILE_PATH]);
+
 /* ---- the sections of a scene file, in the order read_scene reads them ---- */
 
+dwv_result_t dwvs_read_textures(dwvs_parser *ps, const cJSON *item);
+/* A material's "textures" array: its bindings (after dwvs_read_textures). */
+dwv_result_t dwvs_read_material_textures(dwvs_parser *ps, const cJSON *item, const char *path, uint32_t material_id);
 dwv_result_t dwvs_read_materials(dwvs_parser *ps, const cJSON *item);
 dwv_result_t dwvs_read_meshes(dwvs_parser *ps, const cJSON *item);
 dwv_result_t dwvs_read_lights(dwvs_parser *ps, const cJSON *item);

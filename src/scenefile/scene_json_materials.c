@@ -12,7 +12,7 @@ static dwv_result_t read_material(dwvs_parser *ps, const cJSON *item, const char
                                        "subsurface_radius", "subsurface_scale", "subsurface_anisotropy",
                                        "subsurface_ior", "subsurface_exit", "roughness", "subsurface_model",
                                        "specular_model", "ior", "specular", "specular_tint",
-                                       "specular_distribution", "subsurface_min_footprint"};
+                                       "specular_distribution", "subsurface_min_footprint", "textures"};
     static const char *const kinds[] = {"subsurface", "diffuse"};
     static const char *const exits[] = {"lambert", "principled_v1"};
     /* In the order of dwv_subsurface_model_t's and dwv_specular_model_t's values (0, 1, ...). */
@@ -51,6 +51,8 @@ static dwv_result_t read_material(dwvs_parser *ps, const cJSON *item, const char
     uint32_t id;
     dwv_result_t r = dwv_scene_add_material(ps->scene, &m, &id);
     if (r != DWV_SUCCESS) return dwvs_prefix_capi(r, path);
+    const cJSON *textures = dwvs_member(item, "textures");
+    if (textures) DWV_TRY(dwvs_read_material_textures(ps, textures, path, id));
     ps->materials[ps->material_count].name = item->string;
     ps->materials[ps->material_count].id = id;
     ++ps->material_count;

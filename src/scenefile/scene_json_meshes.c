@@ -10,7 +10,6 @@
 #include "scenefile/mesh_file.h"
 #include "util/error.h"
 
-#define MAX_FILE_PATH 4096
 
 static const double identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
 
@@ -68,7 +67,7 @@ static dwv_result_t read_indices(const cJSON *item, const char *path, size_t *co
     return DWV_SUCCESS;
 }
 
-static dwv_result_t resolve_path(const char *base_dir, const char *file, const char *path, char out[MAX_FILE_PATH])
+dwv_result_t dwvs_resolve_path(const char *base_dir, const char *file, const char *path, char out[MAX_FILE_PATH])
 {
     int n;
     if (file[0] == '/' || !base_dir || !base_dir[0])
@@ -83,7 +82,8 @@ static dwv_result_t resolve_path(const char *base_dir, const char *file, const c
 static dwv_result_t read_mesh(dwvs_parser *ps, const cJSON *item, const char *path, dwvs_named *record)
 {
     static const char *const keys[] = {"name",    "material", "transform", "file", "positions",
-                                       "indices", "normals",  "uvs",       "shadow_terminator_geometry_offset"};
+                                       "indices", "normals",  "uvs",       "shadow_terminator_geometry_offset",
+                                       "uv_name"};
     DWV_TRY(dwvs_check_keys(item, path, keys, sizeof keys / sizeof keys[0]));
     char p[PATH_SIZE], name[SHOWN_SIZE];
     const cJSON *name_item = dwvs_member(item, "name");
@@ -109,6 +109,13 @@ static dwv_result_t read_mesh(dwvs_parser *ps, const cJSON *item, const char *pa
     memcpy(mesh.transform, identity, sizeof identity);
     DWV_TRY(dwvs_opt_transform(item, path, mesh.transform));
     DWV_TRY(dwvs_opt_number(item, path, "shadow_terminator_geometry_offset", &mesh.shadow_terminator_geometry_offset));
+    /* The name of the mesh's UV layer, which texture bindings name ("Textures"). */
+    const char *uv_names[1] = {NULL};
+    if (dwvs_member(item, "uv_name")) {
+        dwvs_path_key(p, path, "uv_name");
+        DWV_TRY(dwvs_read_string(dwvs_member(item, "uv_name"), p, &uv_names[0]));
+        mesh.uv_layer_names = uv_names;
+    }
 
     const cJSON *file = dwvs_member(item, "file");
     int inline_data = dwvs_member(item, "positions") || dwvs_member(item, "indices") || dwvs_member(item, "normals") ||
@@ -125,7 +132,7 @@ static dwv_result_t read_mesh(dwvs_parser *ps, const cJSON *item, const char *pa
         char resolved[MAX_FILE_PATH];
         dwvs_path_key(p, path, "file");
         DWV_TRY(dwvs_read_string(file, p, &file_name));
-        DWV_TRY(resolve_path(ps->base_dir, file_name, p, resolved));
+        DWV_TRY(dwvs_resolve_path(ps->base_dir, file_name, p, resolved));
         dwvs_mesh_data data;
         r = dwvs_mesh_file_read(resolved, &data);
         if (r != DWV_SUCCESS) return dwvs_prefix_capi(r, p);

@@ -23,7 +23,7 @@ static dwvb_scene *commit_meshes(const test_mesh *meshes, int count, const doubl
         dwvg_mesh mesh;
         dwvg_mesh_init(&mesh, meshes[i].vertex_count, meshes[i].triangle_count, 0, meshes[i].positions,
                        meshes[i].indices, NULL, NULL, transform ? transform : identity);
-        dwvb_scene_push_mesh(scene, &mesh, 0.1);
+        dwvb_scene_push_mesh(scene, &mesh, 0.1, NULL);
     }
     char message[256];
     dwv_result_t r = dwvb_scene_commit(scene, message, sizeof message);

@@ -77,15 +77,16 @@ class StructLayoutTest(unittest.TestCase):
         "dwv_bake_options_t": _library.BakeOptions, "dwv_image_info_t": _library.ImageInfo,
         "dwv_bake_stats_t": _library.BakeStats, "dwv_error_point_t": _library.ErrorPoint,
         "dwv_display_options_t": _library.DisplayOptions, "dwv_environment_t": _library.EnvironmentDesc,
+        "dwv_texture_desc_t": _library.TextureDesc, "dwv_texture_binding_t": _library.TextureBinding,
     }
 
     def test_sizes_on_lp64(self):
         if ctypes.sizeof(ctypes.c_void_p) != 8:
             self.skipTest("the sizes below are those of an LP64 ABI")
-        sizes = {"dwv_material_t": 192, "dwv_mesh_t": 152, "dwv_light_desc_t": 240, "dwv_camera_t": 128,
+        sizes = {"dwv_material_t": 192, "dwv_mesh_t": 184, "dwv_light_desc_t": 240, "dwv_camera_t": 128,
                  "dwv_bake_progress_t": 48, "dwv_bake_options_t": 120, "dwv_image_info_t": 40,
                  "dwv_bake_stats_t": 128, "dwv_error_point_t": 24, "dwv_display_options_t": 56,
-                 "dwv_environment_t": 104}
+                 "dwv_environment_t": 104, "dwv_texture_desc_t": 40, "dwv_texture_binding_t": 56}
         for name, size in sizes.items():
             self.assertEqual(ctypes.sizeof(self.STRUCTS[name]), size, name)
 

@@ -1,0 +1,347 @@
+"""Image textures on material inputs: an Image Texture node connected to a shader input (directly,
+or through a UV Map node or a Texture Coordinate node's UV for its vector; through a Normal Map
+node in tangent space or a Bump node for the Normal) is passed to the library as it is: its
+pixels (Image.pixels), its colour space (image.colorspace_settings: sRGB bytes stay 8-bit sRGB,
+Non-Color and linear bytes 8-bit data, float images scene-linear float), its extension and
+interpolation, and the UV map it reads (the UV Map node's, else the mesh's active render UV map).
+
+Anything else linked to an input (a Mapping node, a procedural texture, a Mix node...) is not
+evaluated: the input's own value is used, with a warning that says so.
+"""
+from __future__ import annotations
+
+import array
+from typing import Any, Dict, List, Optional, Tuple
+
+
+class MissingImage(Exception):
+    """An Image Texture's image has no pixels (its file is missing or unreadable), or pixels the
+    library refuses (NaN or infinite values)."""
+
+
+# Blender's image colour spaces whose 8-bit values are data (value / 255) rather than sRGB.
+_LINEAR_SPACES = {"Non-Color", "Linear", "Linear Rec.709", "Linear CIE-XYZ E", "Raw", "Linear Rec.2020"}
+
+_EXTENSIONS = {"REPEAT": "repeat", "EXTEND": "extend", "CLIP": "clip", "MIRROR": "mirror"}
+# Cycles interpolates "Smart" as Cubic (kernel/device/cpu/image.h).
+_INTERPOLATIONS = {"Linear": "linear", "Closest": "closest", "Cubic": "cubic", "Smart": "cubic"}
+
+
+class Use:
+    """One texture on one input: the Image Texture node, its output ('Color' or 'Alpha'), the UV
+    map name (None: the active render UV map) and the binding's blend, strength, distance and
+    invert."""
+
+    def __init__(self, input_name: str, node: Any, output: str, uv_map: Optional[str], blend: float = 1.0,
+                 strength: float = 1.0, distance: float = 1.0, invert: bool = False) -> None:
+        self.input = input_name
+        self.node = node
+        self.output = output
+        self.uv_map = uv_map
+        self.blend = blend
+        self.strength = strength
+        self.distance = distance
+        self.invert = invert
+
+
+class EvaluatedImage:
+    """What the Image Texture node of an input that Blender evaluated into an image would be: the
+    image, linear interpolation, the edge extended (the bake's margin covers the seams)."""
+
+    def __init__(self, image: Any) -> None:
+        self.image = image
+        self.interpolation = 'Linear'
+        self.extension = 'EXTEND'
+
+
+# Inputs whose node trees Blender evaluated into images (evaluate.py), per (material name, node
+# name, input identifier): (EvaluatedImage, UV map). Filled before the materials are exported
+# (the depsgraph's copies of a material share its name); cleared after.
+EVALUATED: Dict[Tuple[str, str, str], Tuple[EvaluatedImage, str]] = {}
+
+
+def evaluated_key(material_name: str, socket: Any) -> Tuple[str, str, str]:
+    return material_name, socket.node.name, socket.identifier
+
+
+def _image_source(socket: Any, material_name: str = "") -> Optional[Tuple[Any, str, Optional[str]]]:
+    """(Image Texture node, its output name, UV map or None) when `socket` is fed straight by an
+    Image Texture node that the library can look up as Blender does, or was evaluated into an
+    image (EVALUATED); None otherwise."""
+    if socket is None or not socket.is_linked:
+        return None
+    evaluated = EVALUATED.get(evaluated_key(material_name, socket))
+    if evaluated is not None:
+        return evaluated[0], "Color", evaluated[1]
+    link = socket.links[0]
+    node = link.from_node
+    if node.type != 'TEX_IMAGE' or node.image is None or link.from_socket.name not in ("Color", "Alpha"):
+        return None
+    if getattr(node, "projection", 'FLAT') != 'FLAT' or node.image.source not in {'FILE', 'GENERATED'}:
+        return None
+    if getattr(node, "extension", 'REPEAT') not in _EXTENSIONS or node.interpolation not in _INTERPOLATIONS:
+        return None
+    vector = node.inputs.get("Vector")
+    uv_map = None
+    if vector is not None and vector.is_linked:
+        source = vector.links[0].from_node
+        if source.type == 'UVMAP' and not getattr(source, "from_instancer", False):
+            uv_map = source.uv_map or None
+        elif not (source.type == 'TEX_COORD' and vector.links[0].from_socket.name == "UV"):
+            return None
+    return node, link.from_socket.name, uv_map
+
+
+def passes(socket: Any, material_name: str = "") -> bool:
+    """Whether a linked input is one this module passes on (no warning about it)."""
+    return _image_source(socket, material_name) is not None or _normal_uses(socket) is not None
+
+
+def _plain(socket: Any, default: float) -> float:
+    return float(socket.default_value) if socket is not None and not socket.is_linked else default
+
+
+def _normal_uses(socket: Any) -> Optional[List[Use]]:
+    """The normal map and bump feeding a Normal input, or None if it is fed otherwise."""
+    if socket is None or not socket.is_linked:
+        return None
+    node = socket.links[0].from_node
+    uses: List[Use] = []
+    if node.type == 'BUMP':
+        height = _image_source(node.inputs.get("Height"))
+        if height is None or node.inputs.get("Strength").is_linked or node.inputs.get("Distance").is_linked:
+            return None
+        inner = node.inputs.get("Normal")
+        if inner is not None and inner.is_linked:
+            mapped = _normal_uses(inner)
+            if mapped is None or any(u.input != "normal_map" for u in mapped):
+                return None
+            uses.extend(mapped)
+        uses.append(Use("bump", height[0], height[1], height[2], strength=min(max(_plain(node.inputs["Strength"], 1.0), 0.0), 1.0),
+                        distance=_plain(node.inputs["Distance"], 1.0), invert=bool(node.invert)))
+        return uses
+    if node.type == 'NORMAL_MAP':
+        if node.space != 'TANGENT' or node.inputs.get("Strength").is_linked:
+            return None
+        colour = _image_source(node.inputs.get("Color"))
+        if colour is None or colour[1] != "Color":
+            return None
+        uv_map = node.uv_map or colour[2]
+        return [Use("normal_map", colour[0], "Color", uv_map, strength=max(_plain(node.inputs["Strength"], 1.0), 0.0))]
+    return None
+
+
+def _socket(node: Any, names: Tuple[str, ...]) -> Any:
+    for name in names:
+        socket = node.inputs.get(name)
+        if socket is not None:
+            return socket
+    return None
+
+
+def material_uses(node: Any, blender4: bool, material: Any, material_name: str = "") -> List[Use]:
+    """The textures of a Principled BSDF or Subsurface Scattering node's inputs, in the order the
+    library applies them; `material` (a dwivedi.Material made from the node's own values) is
+    adjusted where a texture changes what a constant meant (Blender 3.x's subsurface colour mix)."""
+    uses: List[Use] = []
+
+    def add(input_name: str, names: Tuple[str, ...], blend: float = 1.0) -> Optional[Tuple[Any, str, Optional[str]]]:
+        found = _image_source(_socket(node, names), material_name)
+        if found is not None:
+            uses.append(Use(input_name, found[0], found[1], found[2], blend=blend))
+        return found
+
+    if node.type == 'SUBSURFACE_SCATTERING':
+        colour = add("base_color", ("Color",))
+        if colour is not None:
+            uses.append(Use("subsurface_color", colour[0], colour[1], colour[2]))
+        add("subsurface_radius", ("Radius",))
+        add("subsurface_scale", ("Scale",))
+        add("subsurface_anisotropy", ("Anisotropy",))
+    elif blender4:
+        base = add("base_color", ("Base Color",))
+        if base is not None:
+            uses.append(Use("subsurface_color", base[0], base[1], base[2]))
+        add("subsurface_weight", ("Subsurface Weight",))
+        add("subsurface_radius", ("Subsurface Radius",))
+        add("subsurface_scale", ("Subsurface Scale",))
+        add("subsurface_anisotropy", ("Subsurface Anisotropy",))
+        add("specular_tint", ("Specular Tint",))
+    else:
+        # 3.x: the walk's colour is mix(Base Color, Subsurface Color, Subsurface); the bindings
+        # rebuild the mix from the constant they start with (dwv_texture_binding_t.blend).
+        factor = _plain(node.inputs.get("Subsurface"), 0.0)
+        base_socket, colour_socket = node.inputs.get("Base Color"), node.inputs.get("Subsurface Color")
+        base = add("base_color", ("Base Color",))
+        colour = _image_source(colour_socket, material_name)
+        if factor > 0.0 and (base is not None or colour is not None):
+            if base is not None:
+                material.subsurface_color = tuple(colour_socket.default_value)[:3]
+                if colour is not None:
+                    uses.append(Use("subsurface_color", colour[0], colour[1], colour[2]))
+                uses.append(Use("subsurface_color", base[0], base[1], base[2], blend=max(0.0, 1.0 - factor)))
+            else:
+                material.subsurface_color = tuple(base_socket.default_value)[:3]
+                uses.append(Use("subsurface_color", colour[0], colour[1], colour[2], blend=min(factor, 1.0)))
+        add("subsurface_radius", ("Subsurface Radius",))
+        add("specular", ("Specular",))
+    if node.type != 'SUBSURFACE_SCATTERING' and not (blender4 and material.specular_model == "principled_v2"):
+        add("roughness", ("Roughness",))
+    normal = _normal_uses(node.inputs.get("Normal"))
+    if normal:
+        uses.extend(normal)
+    return uses
+
+
+def evaluable_inputs(node: Any, blender4: bool) -> List[Any]:
+    """The node's linked inputs that a texture could drive but no Image Texture feeds as it is:
+    what Blender evaluates into an image (evaluate.py)."""
+    if node.type == 'SUBSURFACE_SCATTERING':
+        names = ("Color", "Radius", "Scale", "Anisotropy")
+    elif blender4:
+        names = ("Base Color", "Subsurface Weight", "Subsurface Radius", "Subsurface Scale", "Subsurface Anisotropy",
+                 "Specular Tint")
+    else:
+        names = ("Base Color", "Subsurface Color", "Subsurface Radius", "Specular", "Roughness")
+    out = []
+    for name in names:
+        socket = node.inputs.get(name)
+        if socket is not None and socket.is_linked and _image_source(socket) is None:
+            out.append(socket)
+    return out
+
+
+def linked_unpassed(node: Any, blender4: bool, material_name: str = "") -> List[str]:
+    """The names of the node's linked inputs that no texture use covers (their own values are
+    used): for the warning."""
+    covered = {"Base Color", "Color", "Radius", "Scale", "Anisotropy", "Subsurface Radius", "Normal", "Roughness"}
+    if blender4:
+        covered |= {"Subsurface Weight", "Subsurface Scale", "Subsurface Anisotropy", "Specular Tint"}
+        covered.discard("Roughness")
+    else:
+        covered |= {"Subsurface Color", "Specular"}
+    names = []
+    for socket in node.inputs:
+        if not socket.is_linked:
+            continue
+        if socket.name in covered and (passes(socket, material_name) if socket.name != "Normal"
+                                       else _normal_uses(socket) is not None):
+            continue
+        names.append(socket.name)
+    return names
+
+
+class TextureCache:
+    """The scene's textures, one per image and output (Color, Alpha), made once."""
+
+    def __init__(self, dw_scene: Any) -> None:
+        self.scene = dw_scene
+        self.ids: Dict[Tuple[str, str, str, str], int] = {}
+        self.bytes = 0
+        self.texels = 0
+
+    def texture(self, use: Use, material_name: str) -> int:
+        node, image = use.node, use.node.image
+        extension = _EXTENSIONS[getattr(node, "extension", 'REPEAT')]
+        interpolation = _INTERPOLATIONS[node.interpolation]
+        key = (image.name_full, use.output, extension, interpolation)
+        if key in self.ids:
+            return self.ids[key]
+        count = len(image.pixels)  # loads the image if it is not loaded yet
+        width, height = int(image.size[0]), int(image.size[1])
+        channels = int(image.channels)
+        if width * height == 0 or channels == 0 or count != width * height * channels:
+            where = f" (file '{image.filepath}')" if image.filepath else ""
+            raise MissingImage(f"image '{image.name}'{where} of material '{material_name}' has no pixels: its file "
+                               "is missing or cannot be read; nothing was baked")
+        pixels = array.array("f", [0.0]) * (width * height * channels)
+        image.pixels.foreach_get(pixels)
+        if channels == 4 and use.output == "Color" and int(image.depth) in (24, 96):
+            # An RGB image (Image.pixels always has 4 channels): its constant alpha is left out.
+            pixels = array.array("f", (v for i, v in enumerate(pixels) if i % 4 != 3))
+            channels = 3
+        if use.output == "Alpha" or channels == 2:
+            alpha = channels - 1
+            pixels = array.array("f", pixels[alpha::channels]) if channels in (2, 4) else array.array("f", [1.0]) * (width * height)
+            channels = 1
+        space = image.colorspace_settings.name
+        if image.is_float:
+            texture = self.scene.add_texture(pixels, width, height, channels, format="float32", extension=extension,
+                                             interpolation=interpolation)
+        else:
+            # Byte images: Image.pixels gives the stored bytes / 255; the library decodes sRGB
+            # after interpolation, as Cycles does for byte images.
+            data = bytes(min(255, max(0, int(round(v * 255.0)))) for v in pixels)
+            colour = space not in _LINEAR_SPACES and use.output == "Color"
+            texture = self.scene.add_texture(data, width, height, channels, format="srgb8" if colour else "linear8",
+                                             extension=extension, interpolation=interpolation)
+        self.ids[key] = texture
+        return texture
+
+
+def bump_shadowing(version: Tuple[int, ...]) -> str:
+    """How the Cycles of Blender `version` treats normals that a map tilted (dwv_bump_shadowing_t):
+    Chiang 2019's shadowing of diffuse lobes, with 3.x's ensure_valid_reflection on every closure
+    (4.x applies it to specular closures only; measured against 4.3's Cycles); 5.x Conty Estevez
+    2019's (measured against 5.2; the release between 4.3 and 5.2 that changed it is not known
+    here: 5.0 is assumed)."""
+    version = tuple(version)
+    if version < (4, 0, 0):
+        return "chiang2019"
+    return "chiang2019_mapped" if version < (5, 0, 0) else "conty2019"
+
+
+def bind(dw_scene: Any, cache: TextureCache, material_id: int, uses: List[Use], material_name: str,
+         version: Tuple[int, ...]) -> None:
+    """Adds the textures of `uses` and binds them to the material, in order."""
+    for use in uses:
+        try:
+            texture = cache.texture(use, material_name)
+        except MissingImage:
+            raise
+        except Exception as error:  # the library's refusal (a NaN texel...), said with the image's name
+            if type(error).__name__ != "Error":
+                raise
+            raise MissingImage(f"image '{use.node.image.name}' of material '{material_name}': {error}") from None
+        dw_scene.bind_texture(material_id, use.input, texture, uv_layer=use.uv_map, blend=use.blend,
+                              strength=use.strength, distance=use.distance, invert=use.invert,
+                              bump_shadowing=bump_shadowing(version))
+
+
+def uv_layers(mesh: Any, loops: Any, first: Any, tangent_maps: List[Optional[str]]) -> Dict[str, Any]:
+    """A mesh's UV maps per triangle corner for the library: `first` (the map that is layer 0,
+    what bindings without a UV map read: the active render map) and the others by name, plus
+    Blender's MikkTSpace tangents (Mesh.calc_tangents) of the maps normal maps read."""
+    def corner_uvs(layer: Any) -> Any:
+        loop_uv = array.array("f", [0.0]) * (2 * len(mesh.loops))
+        layer.data.foreach_get("uv", loop_uv)
+        out = array.array("f", [0.0]) * (2 * len(loops))
+        for c, loop in enumerate(loops):
+            out[2 * c] = loop_uv[2 * loop]
+            out[2 * c + 1] = loop_uv[2 * loop + 1]
+        return out
+
+    result: Dict[str, Any] = {"uv_name": first.name, "uvs": corner_uvs(first), "uv_layers": [], "tangents": {},
+                              "warnings": []}
+    for layer in mesh.uv_layers:
+        if layer.name != first.name:
+            result["uv_layers"].append((layer.name, corner_uvs(layer)))
+    for name in sorted({first.name if n is None else n for n in tangent_maps}):
+        if mesh.uv_layers.get(name) is None:
+            continue  # the library refuses the binding with the mesh's layer names
+        try:
+            mesh.calc_tangents(uvmap=name)
+        except RuntimeError as error:
+            result["warnings"].append(f"no MikkTSpace tangents for UV map '{name}' ({error}): the library makes "
+                                      "them from the UVs")
+            continue
+        tangent = array.array("f", [0.0]) * (3 * len(mesh.loops))
+        sign = array.array("f", [0.0]) * len(mesh.loops)
+        mesh.loops.foreach_get("tangent", tangent)
+        mesh.loops.foreach_get("bitangent_sign", sign)
+        out = array.array("f", [0.0]) * (4 * len(loops))
+        for c, loop in enumerate(loops):
+            out[4 * c:4 * c + 3] = tangent[3 * loop:3 * loop + 3]
+            out[4 * c + 3] = 1.0 if sign[loop] >= 0.0 else -1.0
+        result["tangents"][name] = out
+    return result
