@@ -57,7 +57,59 @@ static void fnv_add(fnv *f, const void *data, size_t size)
 _Static_assert(sizeof(dwv_material_t) == 192, "a new dwv_material_t field: hash it in dwv_scene_hash");
 _Static_assert(sizeof(dwv_light_desc_t) == 240, "a new dwv_light_desc_t field: hash it in dwv_scene_hash");
 _Static_assert(sizeof(dwv_camera_t) == 128, "a new dwv_camera_t field: hash it in dwv_scene_hash");
-_Static_assert(sizeof(dwvb_scene) == 416, "a new dwvb_scene field: hash it in dwv_scene_hash if it changes images");
+_Static_assert(sizeof(dwvb_texture) == 64, "a new dwvb_texture field: hash it in dwv_scene_hash");
+_Static_assert(sizeof(dwvb_binding) == 56, "a new dwvb_binding field: hash it in dwv_scene_hash");
+_Static_assert(sizeof(dwvb_mesh_layers) == 32, "a new dwvb_mesh_layers field: hash it in dwv_scene_hash");
+
+static void add_string(fnv *f, const char *text)
+{
+    uint8_t present = text != NULL;
+    ADD(f, present);
+    if (text) fnv_add(f, text, strlen(text) + 1u);
+}
+
+/* Textures, their bindings and the meshes' extra UV layers and tangents (issue 18), hashed only
+ * when a scene has any: scenes without them hash as before. */
+static void add_textures(fnv *f, const dwvb_scene *s)
+{
+    ADD(f, s->texture_count);
+    for (uint32_t i = 0; i < s->texture_count; ++i) {
+        const dwvb_texture *t = &s->textures[i];
+        ADD(f, t->width);
+        ADD(f, t->height);
+        ADD(f, t->channels);
+        ADD(f, t->format);
+        ADD(f, t->extension);
+        ADD(f, t->interpolation);
+        fnv_add(f, t->texels, (size_t)t->width * t->height * dwvb_texture_texel_bytes(t));
+    }
+    ADD(f, s->binding_count);
+    for (uint32_t i = 0; i < s->binding_count; ++i) {
+        const dwvb_binding *b = &s->bindings[i];
+        ADD(f, b->material_id);
+        ADD(f, b->input);
+        ADD(f, b->texture_id);
+        ADD(f, b->invert);
+        add_string(f, b->uv_layer);
+        ADD(f, b->blend);
+        ADD(f, b->strength);
+        ADD(f, b->distance);
+        ADD(f, b->bump_shadowing);
+    }
+    for (uint32_t i = 0; i < s->mesh_count && s->layers; ++i) {
+        const dwvb_mesh_layers *l = &s->layers[i];
+        ADD(f, l->count);
+        size_t corner_values = 3u * (size_t)s->meshes[i].triangle_count;
+        for (uint32_t k = 0; k < l->count; ++k) {
+            if (k > 0 && l->uvs) fnv_add(f, l->uvs[k], 2u * corner_values * sizeof(float));
+            add_string(f, l->names ? l->names[k] : NULL);
+            uint8_t tangents = l->tangents && l->tangents[k];
+            ADD(f, tangents);
+            if (tangents) fnv_add(f, l->tangents[k], 4u * corner_values * sizeof(float));
+        }
+    }
+}
+_Static_assert(sizeof(dwvb_scene) == 488, "a new dwvb_scene field: hash it in dwv_scene_hash if it changes images");
 
 uint64_t dwv_scene_hash(const dwvb_scene *s)
 {
@@ -139,6 +191,7 @@ uint64_t dwv_scene_hash(const dwvb_scene *s)
     }
     uint32_t ball = (uint32_t)s->ball_mode;
     ADD(&f, ball);
+    if (s->texture_count || s->binding_count) add_textures(&f, s);
     return f.h;
 }
 

@@ -31,6 +31,38 @@ class ShimSplitTest(unittest.TestCase):
             with self.assertRaises(dwivedi.Error):
                 whole.write_partial(os.path.join(folder, "whole.dwvpart"))
 
+    def test_chunks_of_differently_textured_scenes_do_not_merge(self) -> None:
+        """The chunks' scene hash covers textures, their bindings and the UV layers they read: a
+        chunk of a scene whose texture differs in one texel is another scene's."""
+        def textured_scene(corner_texel: float, uv_layer_name: str = "UVMap") -> dwivedi.Scene:
+            scene = dwivedi.Scene()
+            material = scene.add_material(dwivedi.Material(subsurface_scale=0.2))
+            positions = [-1.0, -1.0, 0.0, 1.0, -1.0, 0.0, 1.0, 1.0, 0.0, -1.0, 1.0, 0.0]
+            uvs = [0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 1.0]
+            scene.add_mesh(positions, [0, 1, 2, 0, 2, 3], material, uvs=uvs, uv_name=uv_layer_name)
+            texels = [0.8, 0.5, 0.3] * 4
+            texels[0] = corner_texel
+            texture = scene.add_texture(texels, 2, 2, 3)
+            scene.bind_texture(material, "base_color", texture, uv_layer=uv_layer_name)
+            scene.add_light(dwivedi.SunLight(direction=(0.2, 0.3, -1.0), strength=3.0))
+            scene.set_camera(dwivedi.Camera.look_at((0.0, -0.5, 3.0), (0.0, 0.0, 0.0)))
+            scene.commit()
+            return scene
+        settings = dwivedi.BakeSettings(width=8, height=8, samples=4, threads=2)
+        with tempfile.TemporaryDirectory() as folder:
+            def chunk(scene: dwivedi.Scene, first: int, name: str) -> str:
+                path = os.path.join(folder, name)
+                scene.bake(dataclasses.replace(settings, sample_first=first, sample_count=2)).write_partial(path)
+                scene.close()
+                return path
+            same = [chunk(textured_scene(0.8), 0, "a.dwvpart"), chunk(textured_scene(0.8), 2, "b.dwvpart")]
+            dwivedi.merge_partials(same).close()
+            for other in (textured_scene(0.7), textured_scene(0.8, "Other")):
+                foreign = chunk(other, 2, "c.dwvpart")
+                with self.assertRaises(dwivedi.Error) as caught:
+                    dwivedi.merge_partials([same[0], foreign])
+                self.assertIn("another scene", str(caught.exception))
+
 
 if __name__ == "__main__":
     unittest.main()
