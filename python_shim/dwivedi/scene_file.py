@@ -25,7 +25,9 @@ import os
 from typing import Any, Dict, List, Optional
 
 from ._buffers import as_c_array, real_tuple, transform12
-from .baker import SPECULAR_MODELS, SUBSURFACE_MODELS, AreaLight, Camera, Material, PointLight, SunLight
+from . import _library
+from .baker import (SPECULAR_MODELS, SUBSURFACE_MODELS, AreaLight, Camera, Error, Material, PointLight, SpotLight,
+                    SunLight)
 
 MAX_JSON_VALUES = 1 << 22  # docs/scene-format.md: "at most 2^22 JSON values"
 _RADIANS_PER_DEGREE = 3.14159265358979323846 / 180.0  # as src/scenefile/scene_json_lights.c
@@ -116,11 +118,29 @@ class SceneFileWriter:
             self.lights.append({"kind": "area", "color": color, "strength": float(light.power), "shape": light.shape,
                                 "size_x": float(light.size_x), "size_y": float(light.size_y),
                                 "transform": {"matrix": [float(v) for v in transform12(light.transform)]}})
+        elif isinstance(light, SpotLight):
+            self.lights.append({"kind": "spot", "color": color, "strength": float(light.power),
+                                "position": list(real_tuple(light.position, "position", 3)),
+                                "direction": list(real_tuple(light.direction, "direction", 3)),
+                                "radius": float(light.radius), "spot_size": degrees_for(float(light.spot_size)),
+                                "spot_blend": float(light.spot_blend), "spot_falloff": light.falloff})
         else:
-            raise TypeError(f"light must be a SunLight, PointLight or AreaLight, not {type(light).__name__}")
+            raise TypeError(f"light must be a SunLight, PointLight, AreaLight or SpotLight, not {type(light).__name__}")
 
     def set_world(self, color: Any, strength: float = 1.0) -> None:
         self.world = {"color": list(real_tuple(color, "color", 3)), "strength": float(strength)}
+
+    # What the scene file cannot yet hold so that it bakes the same bits: refused, never left out.
+    def set_world_environment(self, *_args: Any, **_kwargs: Any) -> None:
+        raise Error("a scene file cannot hold an environment-map world yet (its rotation is written as Euler "
+                    "degrees, which need not give back the same matrix): bake this scene on one machine",
+                    _library.DWV_ERROR_INVALID_ARGUMENT)
+
+    def add_texture(self, *_args: Any, **_kwargs: Any) -> int:
+        raise Error("a scene file cannot hold textured materials yet (extra UV layers and tangents are not in the "
+                    "format): bake this scene on one machine", _library.DWV_ERROR_INVALID_ARGUMENT)
+
+    bind_texture = add_texture
 
     def set_camera(self, camera: Camera) -> None:
         if not isinstance(camera, Camera):

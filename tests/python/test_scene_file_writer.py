@@ -34,6 +34,8 @@ def build(scene) -> None:
     scene.add_light(dwivedi.PointLight(position=(0.1, -0.1, 0.2), power=3.0, radius=0.01))
     area = dwivedi.Camera.look_at((-0.2, -0.1, 0.15), (0, 0, 0.03)).transform
     scene.add_light(dwivedi.AreaLight(transform=area, size_x=0.05, size_y=0.08, power=4.0, shape="disk"))
+    scene.add_light(dwivedi.SpotLight(position=(-0.1, 0.05, 0.3), direction=(0.2, 0.1, -1.0), power=5.0, radius=0.02,
+                                      spot_size=0.7, spot_blend=0.3, falloff="cycles4"))
     scene.set_world((0.6, 0.7, 1.0), 0.05)
     scene.set_camera(dwivedi.Camera.look_at((0.05, -0.3, 0.12), (0, 0, 0.03), focal_length=40.0))
 
@@ -69,6 +71,14 @@ class SceneFileWriterTest(unittest.TestCase):
         per_degree = 3.14159265358979323846 / 180.0
         for radians in (0.0, 0.1234567, 0.009250245035569947, 1.0, math.pi / 7):
             self.assertEqual(degrees_for(radians) * per_degree, radians, radians)
+
+    def test_what_a_file_cannot_hold_is_refused(self) -> None:
+        writer = scene_file.SceneFileWriter()
+        for call in (lambda: writer.add_texture([0.5] * 3, 1, 1, 3), lambda: writer.bind_texture(0, "base_color", 0),
+                     lambda: writer.set_world_environment([0.5] * 3, 1, 1)):
+            with self.assertRaises(dwivedi.Error) as caught:
+                call()
+            self.assertIn("bake this scene on one machine", str(caught.exception))
 
     def test_too_many_values_are_refused(self) -> None:
         writer = SceneFileWriter()
