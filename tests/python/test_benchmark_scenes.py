@@ -68,7 +68,7 @@ class BenchmarkScenesTest(unittest.TestCase):
             bad = subprocess.run([sys.executable, str(report), "--sections", "cycles", "--no-cycles", "--cycles-scenes",
                                   "nosuch", "--out", tmp], capture_output=True, text=True, env=env, timeout=120)
             self.assertEqual(bad.returncode, 1)
-            self.assertIn("unknown section or scene 'nosuch'", bad.stderr)
+            self.assertIn("unknown section, scene or Blender 'nosuch'", bad.stderr)
 
 
 if __name__ == "__main__":
