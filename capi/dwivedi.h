@@ -935,10 +935,75 @@ typedef struct dwv_bake_options_t {
      * premultiplied by its alpha. The world lights the scene either way. */
     int32_t transparent_background;
     uint32_t reserved;        /* 0 */
+    /* Added after 0.3 (issue 18; a caller whose struct_size ends before it gets 0). Bake passes
+     * (docs/output.md): DWV_PASS_BIT(pass) for each dwv_pass_t the image should hold beside its
+     * combined RGBA (DWV_PASS_BIT(DWV_PASS_COMBINED) may be set; it is always there). 0: the
+     * combined image only, with no extra memory. Not with sample_count > 0 (split bakes' partial
+     * files carry the combined sums only). Each pass costs 96 bytes per pixel while baking and 24
+     * in the image. */
+    uint32_t passes;
+    uint32_t reserved2;       /* 0 */
 } dwv_bake_options_t;
 #define DWV_BAKE_OPTIONS_INIT                                                                       \
     {sizeof(dwv_bake_options_t), DWV_BAKE_CAMERA, 256u, 256u, 0u, 16u, DWV_TECHNIQUE_AUTO, 64u, 0.0,  \
-     0.0, 0u, 0u, 0u, 0u, 0u, NULL, NULL, 0u, 0u, 0, 0u}
+     0.0, 0u, 0u, 0u, 0u, 0u, NULL, NULL, 0u, 0u, 0, 0u, 0u, 0u}
+
+/* Bake passes as Cycles' (Blender's render passes and its bake types' pass filter). Direct:
+ * light from the lights and the world at the first scattering, the one at the camera ray's hit
+ * (or the texel): for a subsurface walk, at its exit; indirect: light that scattered again after
+ * it; colour: the lobe's closures' weights (Blender 3.x) or albedos (4.x+) at that hit. Diffuse
+ * holds the Lambertian, Principled diffuse, retro-reflection and subsurface lobes (Cycles 3.0+);
+ * glossy the specular layer; transmission none of this library's materials (0). Emission: the
+ * surfaces' own (0: no material emits). Environment: camera bakes, the world seen directly (where
+ * the camera ray meets nothing; also with transparent_background); UV bakes, Cycles' Environment
+ * bake: the world along the direction of the texel's position from the origin. Combined (the
+ * image's RGBA) = the direct and indirect passes, emission and (camera bakes without a
+ * transparent background) environment. dwv_image_pass gives each as Blender shows it: direct
+ * and indirect divided by their colour (Cycles' DiffDir = light / DiffCol). */
+typedef enum dwv_pass_t {
+    DWV_PASS_COMBINED = 0,
+    DWV_PASS_DIFFUSE_DIRECT = 1,
+    DWV_PASS_DIFFUSE_INDIRECT = 2,
+    DWV_PASS_DIFFUSE_COLOR = 3,
+    DWV_PASS_GLOSSY_DIRECT = 4,
+    DWV_PASS_GLOSSY_INDIRECT = 5,
+    DWV_PASS_GLOSSY_COLOR = 6,
+    DWV_PASS_TRANSMISSION_DIRECT = 7,
+    DWV_PASS_TRANSMISSION_INDIRECT = 8,
+    DWV_PASS_TRANSMISSION_COLOR = 9,
+    DWV_PASS_EMISSION = 10,
+    DWV_PASS_ENVIRONMENT = 11
+} dwv_pass_t;
+#define DWV_PASS_COUNT 12u
+#define DWV_PASS_BIT(pass) (1u << (uint32_t)(pass))
+
+/* Blender's name of the pass, its layer's name in a multilayer OpenEXR ("Combined", "DiffDir",
+ * "DiffInd", "DiffCol", "GlossDir", ..., "Emit", "Env"); NULL for an unknown value. */
+DWV_API const char *dwv_pass_name(dwv_pass_t pass);
+
+/* Blender's bake types (bpy: scene.cycles.bake_type) that this library bakes, and the pass filter
+ * bits (scene.render.bake.use_pass_*). */
+typedef enum dwv_bake_type_t {
+    DWV_BAKE_TYPE_COMBINED = 0,
+    DWV_BAKE_TYPE_DIFFUSE = 1,
+    DWV_BAKE_TYPE_GLOSSY = 2,
+    DWV_BAKE_TYPE_TRANSMISSION = 3,
+    DWV_BAKE_TYPE_EMIT = 4,
+    DWV_BAKE_TYPE_ENVIRONMENT = 5
+} dwv_bake_type_t;
+#define DWV_BAKE_FILTER_DIRECT 1u       /* use_pass_direct */
+#define DWV_BAKE_FILTER_INDIRECT 2u     /* use_pass_indirect */
+#define DWV_BAKE_FILTER_COLOR 4u        /* use_pass_color (Diffuse, Glossy, Transmission) */
+#define DWV_BAKE_FILTER_DIFFUSE 8u      /* use_pass_diffuse (Combined) */
+#define DWV_BAKE_FILTER_GLOSSY 16u      /* use_pass_glossy (Combined) */
+#define DWV_BAKE_FILTER_TRANSMISSION 32u /* use_pass_transmission (Combined) */
+#define DWV_BAKE_FILTER_EMIT 64u        /* use_pass_emit (Combined) */
+
+/* The passes (for dwv_bake_options_t.passes) that bake type `type` with pass filter `filter`
+ * needs. An unknown type, filter bits beyond DWV_BAKE_FILTER_EMIT, or a filter that selects
+ * nothing (Diffuse with none of direct, indirect, colour; Combined with no lobe and no emission,
+ * or with neither direct nor indirect and no emission) fail with a message, as Blender refuses them. */
+DWV_API dwv_result_t dwv_bake_type_passes(dwv_bake_type_t type, uint32_t filter, uint32_t *passes);
 
 typedef struct dwv_bake_s dwv_bake_t;
 typedef struct dwv_image_s dwv_image_t;
@@ -1022,6 +1087,29 @@ DWV_API dwv_result_t dwv_image_create(uint32_t width, uint32_t height, const flo
  * (variance_R/G/B) and the sample counts (samples), and metadata: technique, samples, seconds,
  * estimated error, features, library version, the error-against-time series. */
 DWV_API dwv_result_t dwv_image_write_exr(const dwv_image_t *image, const char *path);
+
+/* Added after 0.3 (issue 18): bake passes. *passes: DWV_PASS_BIT of every pass the image holds
+ * (DWV_PASS_COMBINED always). */
+DWV_API dwv_result_t dwv_image_passes(const dwv_image_t *image, uint32_t *passes);
+/* A new image (release it) of one pass as Blender shows it: RGB the pass (direct and indirect
+ * divided by their lobe's colour, 0 where the colour is 0), A the combined image's alpha,
+ * variance that of the pass's mean (divided by the colour squared for direct and indirect, the
+ * colour's own noise not counted), the same samples and stats. DWV_PASS_COMBINED gives a copy.
+ * A pass the image does not hold: DWV_ERROR_INVALID_ARGUMENT. */
+DWV_API dwv_result_t dwv_image_pass(const dwv_image_t *image, dwv_pass_t pass, dwv_image_t **pass_image);
+/* The image of a Blender bake type and pass filter (dwv_bake_type_passes), as Cycles' bake makes
+ * it: Combined, the sum of the filter's lobes' direct and / or indirect light plus emission;
+ * Diffuse / Glossy / Transmission, (direct + indirect) with colour, their sum divided by the
+ * colour without it, the colour alone with neither; Emit; Environment. A the combined image's
+ * alpha. The image must hold the passes that dwv_bake_type_passes names. */
+DWV_API dwv_result_t dwv_image_bake_type(const dwv_image_t *image, dwv_bake_type_t type, uint32_t filter,
+                                         dwv_image_t **result);
+/* Writes a multilayer OpenEXR as Blender's (one scanline part, ZIP, FLOAT): channels
+ * Combined.R/G/B/A and, for every other pass the image holds, <name>.R/G/B (dwv_pass_name; as
+ * dwv_image_pass gives it), and the metadata of dwv_image_write_exr. Blender opens it as a
+ * multilayer image whose passes are these layers (an empty render layer name); dwv_image_write_exr's
+ * variance and sample channels are not in it. Atomic as dwv_image_write_exr. */
+DWV_API dwv_result_t dwv_image_write_exr_layers(const dwv_image_t *image, const char *path);
 
 /* Blender's colour-management settings, applied through OpenColorIO: exposure (stops) in scene
  * linear, then the display/view/look transform, then gamma (display = display^(1/gamma)).

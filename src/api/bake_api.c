@@ -86,6 +86,15 @@ static dwv_result_t check_options(const char *fn, const dwvb_scene *s, const dwv
         return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: transparent_background = %d is neither 0 nor 1", fn,
                         (int)o->transparent_background);
     if (o->reserved != 0u) return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: reserved = %u must be 0", fn, o->reserved);
+    if (o->reserved2 != 0u) return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: reserved2 = %u must be 0", fn, o->reserved2);
+    if (o->passes >> DWV_PASS_COUNT)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
+                        "%s: passes = 0x%x has bits beyond DWV_PASS_ENVIRONMENT (the mask is DWV_PASS_BIT of dwv_pass_t "
+                        "values 0 to %u)", fn, o->passes, DWV_PASS_COUNT - 1u);
+    if (o->sample_count > 0u && (o->passes & ~DWV_PASS_BIT(DWV_PASS_COMBINED)))
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
+                        "%s: a chunk of a split bake (sample_count > 0) cannot bake passes (passes = 0x%x): partial "
+                        "files carry the combined image's sums only; bake the passes whole", fn, o->passes);
     DWV_TRY(dwv_check_range(fn, "time_limit", o->time_limit, 0.0, HUGE_VAL));
     DWV_TRY(dwv_check_range(fn, "target_error", o->target_error, 0.0, HUGE_VAL));
     if (o->threads > MAX_THREADS)
@@ -138,6 +147,11 @@ dwv_result_t dwv_bake_start(dwv_scene_t *scene, const dwv_bake_options_t *option
     }
     if (resolved.tile_size == 0u) resolved.tile_size = default_tile_size(resolved.width, resolved.height, resolved.threads);
     if (resolved.max_events == 0u) resolved.max_events = DEFAULT_MAX_EVENTS;
+    /* A direct or indirect pass is shown divided by its lobe's colour (dwv_image_pass): the
+     * colour comes with it. */
+    for (uint32_t lobe = 0; lobe < 3u; ++lobe)
+        if (resolved.passes & (DWV_PASS_BIT(1u + 3u * lobe) | DWV_PASS_BIT(2u + 3u * lobe)))
+            resolved.passes |= DWV_PASS_BIT(3u + 3u * lobe);
     dwv_bake_t *handle = calloc(1, sizeof *handle);
     if (!handle) return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "%s: out of memory", fn);
     char message[256];

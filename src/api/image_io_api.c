@@ -14,6 +14,7 @@
 #include "output/display.h"
 #include "output/exr.h"
 #include "output/png_writer.h"
+#include "pass_pixels.h"
 
 /* The message of an io call, prefixed with the entry point's name. */
 static dwv_result_t io_result(const char *fn, dwv_result_t result, const char *message)
@@ -83,9 +84,44 @@ dwv_result_t dwv_image_write_exr(const dwv_image_t *image, const char *path)
     const char *technique = dwv_technique_name(img->stats.technique);
     if (img->stats.samples_per_pixel == 0u) technique = "none"; /* caller-made pixels, not a bake */
     dwvo_exr_image exr = {img->width, img->height, img->rgba, img->variance, img->samples, &img->stats,
-                          img->error_vs_time, technique ? technique : "unknown", features};
+                          img->error_vs_time, technique ? technique : "unknown", features, 0, 0u, NULL, NULL};
     char message[512];
     return io_result(fn, dwvo_write_exr(&exr, path, message, sizeof message), message);
+}
+
+dwv_result_t dwv_image_write_exr_layers(const dwv_image_t *image, const char *path)
+{
+    static const char fn[] = "dwv_image_write_exr_layers";
+    DWV_TRY(dwv_check_pointer(fn, "image", image));
+    DWV_TRY(check_path(fn, path));
+    const dwvb_image *img = dwv_image_object(image);
+    char features[512];
+    features_text(img->stats.features, features, sizeof features);
+    const char *technique = dwv_technique_name(img->stats.technique);
+    if (img->stats.samples_per_pixel == 0u) technique = "none";
+    /* Each pass as Blender shows it (dwv_image_pass): direct and indirect divided by colour. */
+    size_t plane = 3u * (size_t)img->width * img->height;
+    const char *names[DWV_PASS_COUNT];
+    const float *planes[DWV_PASS_COUNT];
+    uint32_t layers = 0u;
+    float *pixels = img->pass_count ? malloc((size_t)img->pass_count * plane * sizeof *pixels) : NULL;
+    if (img->pass_count && !pixels)
+        return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "%s: no memory for %u pass layers", fn, img->pass_count);
+    for (uint32_t pass = 1u; pass < DWV_PASS_COUNT; ++pass) {
+        if (!(img->passes & DWV_PASS_BIT(pass))) continue;
+        float *rgb = pixels + (size_t)layers * plane;
+        dwva_pass_pixels(img, (dwv_pass_t)pass, rgb, NULL);
+        names[layers] = dwv_pass_name((dwv_pass_t)pass);
+        planes[layers++] = rgb;
+    }
+    /* Without passes the file is still multilayer, with its one Combined layer. */
+    dwvo_exr_image exr = {img->width, img->height, img->rgba, img->variance, img->samples, &img->stats,
+                          img->error_vs_time, technique ? technique : "unknown", features, 1, layers,
+                          names, (const float *const *)planes};
+    char message[512];
+    dwv_result_t result = dwvo_write_exr(&exr, path, message, sizeof message);
+    free(pixels);
+    return io_result(fn, result, message);
 }
 
 /* The display bytes of `img` into `out` (4 x width x height). */

@@ -39,7 +39,7 @@ static void camera_sample(const dwvb_bake *bake, uint32_t x, uint32_t row, const
 }
 
 void dwvb_bake_sample(const dwvb_bake *bake, const dwvb_shader *shader, uint64_t stream, uint32_t index, uint64_t s,
-                      double rgb[3], double *alpha, uint32_t *mesh_seen, dwvb_tally *tally)
+                      dwvb_shade_parts *parts, double rgb[3], double *alpha, uint32_t *mesh_seen, dwvb_tally *tally)
 {
     /* Pixel position, entry direction, light points and the walk's first events (shade.h,
      * DWVB_STRATIFIED_EVENTS): stratified per pixel (kernel/sampler.h), in REPLICATES independent
@@ -57,9 +57,12 @@ void dwvb_bake_sample(const dwvb_bake *bake, const dwvb_shader *shader, uint64_t
         dwvu_vec3 origin;
         camera_sample(bake, x, row, &sampler, &origin, &view);
         if (!(bake->scene->mesh_count > 0 && dwvg_intersect(&bake->scene->geometry, origin, view, 0.0, INFINITY, &hit))) {
-            if (bake->options.transparent_background) rgb[0] = rgb[1] = rgb[2] = 0.0; /* Film > Transparent */
-            else if (bake->scene->envmap) dwvl_envmap_radiance(bake->scene->envmap, view, rgb);
-            else for (int c = 0; c < 3; ++c) rgb[c] = bake->scene->world[c];
+            /* The world seen directly: the Env pass always (as Cycles writes its background
+             * pass under a transparent film too), the combined image unless Film > Transparent. */
+            *parts = (dwvb_shade_parts){0};
+            if (bake->scene->envmap) dwvl_envmap_radiance(bake->scene->envmap, view, parts->environment);
+            else for (int c = 0; c < 3; ++c) parts->environment[c] = bake->scene->world[c];
+            for (int c = 0; c < 3; ++c) rgb[c] = bake->options.transparent_background ? 0.0 : parts->environment[c];
             *alpha = 0.0;
             return;
         }
@@ -75,18 +78,33 @@ void dwvb_bake_sample(const dwvb_bake *bake, const dwvb_shader *shader, uint64_t
         view = dwvu_scale(dwvg_geometric_normal(mesh, hit.prim), -1.0);
     }
     *mesh_seen = hit.mesh;
-    dwvb_shade(shader, &hit, view, &sampler, PIXEL_PAIR + 1u, key_walk, rgb, tally);
+    dwvb_shade(shader, &hit, view, &sampler, PIXEL_PAIR + 1u, key_walk, parts, tally);
+    dwvb_shade_parts_combined(parts, rgb);
     *alpha = 1.0;
     if (!(isfinite(rgb[0]) && isfinite(rgb[1]) && isfinite(rgb[2]))) {
         ++tally->warnings;
+        *parts = (dwvb_shade_parts){0};
         rgb[0] = rgb[1] = rgb[2] = 0.0;
+    }
+    if (bake->options.target == DWV_BAKE_UV && (bake->options.passes & DWV_PASS_BIT(DWV_PASS_ENVIRONMENT))) {
+        /* Cycles' Environment bake: the world along the texel's position seen from the origin
+         * (integrator_init_from_bake: ray.D = normalize(P)), not part of the combined image. */
+        const dwvg_mesh *mesh = &bake->scene->meshes[hit.mesh];
+        dwvu_vec3 p = dwvg_point(mesh, hit.prim, hit.u, hit.v);
+        double length = dwvu_length(p);
+        if (length > 0.0) {
+            dwvu_vec3 d = dwvu_scale(p, 1.0 / length);
+            if (bake->scene->envmap) dwvl_envmap_radiance(bake->scene->envmap, d, parts->environment);
+            else for (int c = 0; c < 3; ++c) parts->environment[c] = bake->scene->world[c];
+        }
     }
 }
 
-static void sample_pixel(dwvb_bake *bake, uint32_t index, uint64_t s, double rgb[3], double *alpha, dwvb_tally *tally)
+static void sample_pixel(dwvb_bake *bake, uint32_t index, uint64_t s, dwvb_shade_parts *parts, double rgb[3],
+                         double *alpha, dwvb_tally *tally)
 {
     uint32_t mesh_seen;
-    dwvb_bake_sample(bake, &bake->shader, 0u, index, s, rgb, alpha, &mesh_seen, tally);
+    dwvb_bake_sample(bake, &bake->shader, 0u, index, s, parts, rgb, alpha, &mesh_seen, tally);
 }
 
 static void *worker(void *arg)
@@ -114,7 +132,16 @@ static void *worker(void *arg)
                      * time limit cuts where the clock says (pixels keep the samples they got). */
                     if ((stop = dwvb_bake_must_stop(bake))) break;
                     double rgb[3], alpha;
-                    sample_pixel(bake, index, s, rgb, &alpha, tally);
+                    dwvb_shade_parts parts;
+                    sample_pixel(bake, index, s, &parts, rgb, &alpha, tally);
+                    for (uint32_t k = 0; k < bake->pass_count; ++k) {
+                        dwvb_pass_sums *q = &bake->pass_sums[(size_t)index * bake->pass_count + k];
+                        const double *v = dwvb_pass_value(&parts, bake->pass_list[k]);
+                        for (int c = 0; c < 3; ++c) {
+                            q->sum[c] += dwvb_to_fixed(v[c]);
+                            q->sum_squares[c] += dwvb_to_fixed(v[c] * v[c]);
+                        }
+                    }
                     for (int c = 0; c < 3; ++c) {
                         p->sum[c] += dwvb_to_fixed(rgb[c]);
                         p->sum_squares[c] += dwvb_to_fixed(rgb[c] * rgb[c]);
@@ -281,6 +308,7 @@ static void release_parts(dwvb_bake *bake)
     free(bake->needs_closest);
     free(bake->auto_choice);
     free(bake->sums);
+    free(bake->pass_sums);
     free(bake->counts);
     free(bake->tile_tallies);
     free(bake->tile_order);
@@ -356,7 +384,14 @@ dwv_result_t dwvb_bake_start(dwvb_scene *scene, const dwv_bake_options_t *option
     bake->tile_seconds = calloc(bake->tile_count, sizeof *bake->tile_seconds);
     bake->tile_ranking = malloc(bake->tile_count * sizeof *bake->tile_ranking);
     bake->image = dwvb_image_new(bake->width, bake->height);
-    if (!bake->guides || !bake->channel_guides || !bake->channel_walks || !bake->channel_counts || !bake->needs_closest || !bake->auto_choice || !bake->sums || !bake->counts ||
+    for (uint32_t pass = 1u; pass < DWV_PASS_COUNT; ++pass)
+        if (options->passes & DWV_PASS_BIT(pass)) bake->pass_list[bake->pass_count++] = pass;
+    int passes_ready = 1;
+    if (bake->pass_count > 0u) {
+        bake->pass_sums = calloc(pixels * bake->pass_count, sizeof *bake->pass_sums);
+        passes_ready = bake->pass_sums && bake->image && dwvb_image_add_passes(bake->image, options->passes) == 0;
+    }
+    if (!passes_ready || !bake->guides || !bake->channel_guides || !bake->channel_walks || !bake->channel_counts || !bake->needs_closest || !bake->auto_choice || !bake->sums || !bake->counts ||
         !bake->tile_tallies || !bake->tile_order || !bake->tile_seconds || !bake->tile_ranking || !bake->image) {
         release_parts(bake);
         snprintf(message, size, "out of memory for a %u x %u bake", options->width, options->height);

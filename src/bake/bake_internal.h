@@ -53,6 +53,21 @@ typedef struct dwvb_pixel_sums {
 } dwvb_pixel_sums;
 #define DWVB_PIXEL_SUM_FIELDS 10 /* fixed-point values per pixel, in the order above */
 
+/* A bake pass's sums at a pixel (dwv_bake_options_t.passes): per channel the sum of the samples'
+ * values and of their squares, exact as the combined image's (above); 96 bytes. */
+typedef struct dwvb_pass_sums {
+    dwvb_fixed sum[3], sum_squares[3];
+} dwvb_pass_sums;
+
+/* The value of pass `pass` (dwv_pass_t, not COMBINED) in one sample's parts. */
+static inline const double *dwvb_pass_value(const dwvb_shade_parts *parts, uint32_t pass)
+{
+    if (pass == DWV_PASS_EMISSION) return parts->emission;
+    if (pass == DWV_PASS_ENVIRONMENT) return parts->environment;
+    uint32_t lobe = (pass - 1u) / 3u, kind = (pass - 1u) % 3u;
+    return kind == 0u ? parts->direct[lobe] : kind == 1u ? parts->indirect[lobe] : parts->color[lobe];
+}
+
 struct dwvb_bake {
     const dwvb_scene *scene;
     dwv_bake_options_t options;
@@ -72,6 +87,11 @@ struct dwvb_bake {
     /* accumulation */
     dwvb_pixel_sums *sums;
     uint32_t *counts;
+    /* Bake passes beyond the combined image: how many, which (dwv_pass_t, ascending) and their
+     * sums, pass_count per pixel (NULL when none is asked for). */
+    uint32_t pass_count;
+    uint32_t pass_list[DWV_PASS_COUNT];
+    dwvb_pass_sums *pass_sums;
     uint32_t tiles_x, tile_count;
     dwvb_tally *tile_tallies;
     /* Tiles are handed out longest first, by the seconds each took in the previous pass, so that
@@ -135,8 +155,11 @@ static inline int dwvb_bake_must_stop(dwvb_bake *bake)
 
 /* Sample s of pixel `index` shaded by `shader`, with the random streams `stream` (pixel
  * position, entry, lights and the walk's first events) and `stream | WALK_STREAM` (the rest of
- * the walk); the mesh it saw (or UINT32_MAX) in *mesh_seen. */
+ * the walk): its passes in *parts, its combined radiance in rgb (dwvb_shade_parts_combined, less
+ * the environment where the camera sees a transparent background or for UV bakes, whose
+ * environment part is Cycles' Environment bake and is filled only when the bake asks for it);
+ * the mesh it saw (or UINT32_MAX) in *mesh_seen. */
 void dwvb_bake_sample(const dwvb_bake *bake, const dwvb_shader *shader, uint64_t stream, uint32_t index, uint64_t s,
-                      double rgb[3], double *alpha, uint32_t *mesh_seen, dwvb_tally *tally);
+                      dwvb_shade_parts *parts, double rgb[3], double *alpha, uint32_t *mesh_seen, dwvb_tally *tally);
 
 #endif

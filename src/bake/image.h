@@ -33,6 +33,13 @@ typedef struct dwvb_image {
      * (what the auto pilot's cost model counts). */
     uint64_t rays, point_queries, ray_free_steps, ray_free_misses, mixture_terms;
     dwvb_partial *partial; /* chunks of split bakes only; else NULL */
+    /* Bake passes (dwv_pass_t) beyond the combined RGBA: DWV_PASS_BIT of each held (COMBINED's
+     * always set), and per pass held, in ascending order, 3 x width x height floats of its mean
+     * (direct and indirect as the light itself, not yet divided by the colour) and of the
+     * variance of that mean. NULL when it holds none. */
+    uint32_t passes;
+    uint32_t pass_count;
+    float *pass_mean, *pass_variance;
 } dwvb_image;
 
 /* A zeroed image of the given size with reference count 1 (stats zeroed but struct_size set),
@@ -40,6 +47,12 @@ typedef struct dwvb_image {
 dwvb_image *dwvb_image_new(uint32_t width, uint32_t height);
 /* Appends a point to the error-against-time series; 0 on success, -1 out of memory. */
 int dwvb_image_add_error_point(dwvb_image *image, dwv_error_point_t point);
+/* Makes room (zeroed) for the passes of mask `passes` (DWV_PASS_BIT, COMBINED's ignored); 0, or
+ * -1 out of memory. */
+int dwvb_image_add_passes(dwvb_image *image, uint32_t passes);
+/* Where pass `pass`'s plane (3 floats per pixel) starts in pass_mean / pass_variance: its rank
+ * among the passes held; -1 when it is not held (or is COMBINED). */
+int dwvb_image_pass_rank(const dwvb_image *image, uint32_t pass);
 void dwvb_image_free(dwvb_image *image);
 
 #endif

@@ -279,16 +279,26 @@ void dwvb_specular_factor(const dwvb_material *m, dwvu_vec3 n, dwvu_vec3 L, dwvu
     for (int c = 0; c < 3; ++c) f[c] = common * (m->spec_f0[c] + (1.0 - m->spec_f0[c]) * s) * scale[c];
 }
 
+void dwvb_specular_color(const dwvb_material *m, double mu, double albedo[3])
+{
+    if (m->specular != DWV_SPECULAR_PRINCIPLED_V2) {
+        albedo[0] = albedo[1] = albedo[2] = m->specular ? 1.0 : 0.0;
+        return;
+    }
+    double s = spec_table(m->spec_s, mu), E = spec_table(m->spec_E, mu);
+    for (int c = 0; c < 3; ++c) {
+        albedo[c] = m->spec_f0[c] + (1.0 - m->spec_f0[c]) * s;
+        /* Multiscatter: Cycles' darkening (1 + Fms (1 - E) / E) E scales the layer's weight. */
+        if (m->spec_multiscatter) albedo[c] *= E + m->spec_Fms[c] * (1.0 - E);
+    }
+}
+
 double dwvb_specular_layer_weight(const dwvb_material *m, double mu)
 {
     if (m->specular != DWV_SPECULAR_PRINCIPLED_V2) return 1.0;
-    double s = spec_table(m->spec_s, mu), E = spec_table(m->spec_E, mu), worst = 0.0;
-    for (int c = 0; c < 3; ++c) {
-        double albedo = m->spec_f0[c] + (1.0 - m->spec_f0[c]) * s;
-        /* Multiscatter: Cycles' darkening (1 + Fms (1 - E) / E) E scales the layer's weight. */
-        if (m->spec_multiscatter) albedo *= E + m->spec_Fms[c] * (1.0 - E);
-        worst = fmax(worst, albedo);
-    }
+    double albedo[3];
+    dwvb_specular_color(m, mu, albedo);
+    double worst = fmax(albedo[0], fmax(albedo[1], albedo[2]));
     return fmin(fmax(1.0 - worst, 0.0), 1.0);
 }
 

@@ -114,6 +114,11 @@ void dwvb_specular_factor(const dwvb_material *m, dwvu_vec3 n, dwvu_vec3 L, dwvu
 /* The weight of the layers below the specular toward a viewer at cosine mu to n: 1 for v1 and no
  * layer; v2: 1 - max_c (albedo of the layer, with its multiscatter darkening). */
 double dwvb_specular_layer_weight(const dwvb_material *m, double mu);
+/* The specular layer's colour as Cycles' Glossy Color pass has it toward a viewer at cosine mu:
+ * 3.x, the closure's weight (1: its Fresnel colour lives in the BSDF, not the weight); 4.x+
+ * (closure_albedo), v2's albedo per channel, the one dwvb_specular_layer_weight takes the largest
+ * of; 0 without the layer. */
+void dwvb_specular_color(const dwvb_material *m, double mu, double albedo[3]);
 /* v2's GGX albedo with F = 1 and with the interpolation factor, by quadrature over visible
  * normals toward mu (what Cycles tabulates as ggx_E and ggx_gen_schlick_ior_s): the mean of
  * G2 / G1(wi) and of s(wi.h) x [wo above], over a midpoint grid of n x n uniform pairs. */

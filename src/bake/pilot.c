@@ -185,9 +185,10 @@ static void *pilot_worker(void *arg)
                 uint32_t index = (uint32_t)(dwvk_rng_u64(dwvk_rng_key(bake->options.seed, PILOT_STREAM, i), 0u) % pixels);
                 if (!dwvb_bake_pixel_active(bake, index)) continue;
                 double rgb[3], alpha;
+                dwvb_shade_parts parts;
                 uint32_t mesh;
                 dwvb_tally tally = {0};
-                dwvb_bake_sample(bake, &run->shaders[candidate], PILOT_STREAM, index, i, rgb, &alpha, &mesh, &tally);
+                dwvb_bake_sample(bake, &run->shaders[candidate], PILOT_STREAM, index, i, &parts, rgb, &alpha, &mesh, &tally);
                 if (mesh == UINT32_MAX || !bake->auto_choice[mesh]) continue;
                 pilot_sums *p = &sums[(size_t)candidate * run->meshes + mesh];
                 p->count += 1.0;

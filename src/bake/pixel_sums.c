@@ -125,6 +125,21 @@ dwv_result_t dwvb_bake_make_image(dwvb_bake *bake, double seconds)
     dwv_bake_stats_t *st = &image->stats;
     dwvb_sums_view view = bake_view(bake);
     dwvb_sums_fill_image(&view, image);
+    /* The passes: each pixel's mean and the variance of that mean, per channel (the combined
+     * image's estimator, mean_variance). */
+    for (uint32_t k = 0; k < bake->pass_count; ++k) {
+        float *mean = image->pass_mean + (size_t)k * 3u * pixels, *variance = image->pass_variance + (size_t)k * 3u * pixels;
+        for (size_t i = 0; i < pixels; ++i) {
+            uint32_t n = bake->counts[i];
+            if (n == 0u) continue;
+            const dwvb_pass_sums *q = &bake->pass_sums[i * bake->pass_count + k];
+            for (int c = 0; c < 3; ++c) {
+                double sum = dwvb_from_fixed(q->sum[c]);
+                mean[3 * i + c] = (float)(sum / n);
+                variance[3 * i + c] = (float)mean_variance(sum, dwvb_from_fixed(q->sum_squares[c]), n);
+            }
+        }
+    }
     uint64_t samples = st->samples;
     if (bake->options.sample_count > 0u) {
         /* A chunk: its image keeps the exact sums for dwv_image_write_partial. */

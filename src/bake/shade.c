@@ -188,7 +188,8 @@ typedef struct surface_lobes {
     dwvu_vec3 smooth_n;
 } surface_lobes;
 
-static void surface_factor(const void *context, dwvu_vec3 light, double f[3])
+/* The surface's glossy (f[0]: the specular layer) and diffuse (f[1]) lobes. */
+static void surface_factor(const void *context, dwvu_vec3 light, double f[2][3])
 {
     const surface_lobes *s = context;
     const dwvb_material *m = s->material;
@@ -202,8 +203,8 @@ static void surface_factor(const void *context, dwvu_vec3 light, double f[3])
     /* Cycles 3.x shadows its diffuse closures (the Lambertian, Principled diffuse and
      * retro-reflection), not the specular, where a normal map tilted them (textured.h). */
     double shadow = s->bumped ? dwvb_bump_shadowing(s->bumped, s->smooth_n, s->lobe.n, light) : 1.0;
-    dwvb_specular_factor(m, s->lobe.n, light, s->lobe.to_view, f);
-    for (int c = 0; c < 3; ++c) f[c] += (s->diffuse[c] * diffuse + m->retro_albedo[c] * retro) * shadow;
+    dwvb_specular_factor(m, s->lobe.n, light, s->lobe.to_view, f[0]);
+    for (int c = 0; c < 3; ++c) f[1][c] = (s->diffuse[c] * diffuse + m->retro_albedo[c] * retro) * shadow;
 }
 
 /* The exit weight of Blender 3.x's Principled BSDF; the context is the exit's shading normal. */
@@ -273,7 +274,7 @@ double dwvb_footprint(const dwvb_shader *shader, dwvu_vec3 view, double t)
 }
 
 void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, const dwvk_sampler *sampler,
-                uint32_t pair, uint64_t key_walk, double rgb[3], dwvb_tally *tally)
+                uint32_t pair, uint64_t key_walk, dwvb_shade_parts *parts, dwvb_tally *tally)
 {
     const dwvb_scene *scene = shader->scene;
     const dwvg_mesh *mesh = &scene->meshes[hit->mesh];
@@ -286,7 +287,8 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
         dwvb_textured_material(scene, hit->mesh, hit->prim, hit->u, hit->v, &textured);
         material = &textured;
     }
-    rgb[0] = rgb[1] = rgb[2] = 0.0;
+    *parts = (dwvb_shade_parts){0};
+    double *diffuse_light = parts->direct[DWVB_LOBE_DIFFUSE];
     dwvu_vec3 ng = dwvg_geometric_normal(mesh, hit->prim);
     if (ng.x == 0.0 && ng.y == 0.0 && ng.z == 0.0) {
         ++tally->warnings;
@@ -342,31 +344,44 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
     /* The layers under a 4.x+ specular keep 1 - its albedo toward the viewer (1 otherwise). */
     double cos_view = -dwvu_dot(n, view);
     double layer = material->specular ? dwvb_specular_layer_weight(material, cos_view) : 1.0;
+    /* The colour passes (Cycles' surface_shader_diffuse / _glossy): the diffuse closures' weights,
+     * the Lambertian's, the retro-reflection's (3.x: a diffuse BSDF of the BSSRDF's whole weight,
+     * beside the BSSRDF) and the walking channels' BSSRDF (w x subsurface colour, a channel that
+     * turned Lambertian by the footprint rule counted once, in diffuse_albedo); the specular
+     * layer's weight (3.x) or albedo (4.x+). */
+    for (int c = 0; c < 3; ++c) {
+        double bssrdf = material->subsurface && material->walk_scale[c] > 0.0 && keep[c] > 0.0 ? material->fallback_albedo[c] : 0.0;
+        parts->color[DWVB_LOBE_DIFFUSE][c] = layer * (diffuse_albedo[c] + bssrdf) + material->retro_albedo[c];
+    }
+    if (material->specular) dwvb_specular_color(material, cos_view, parts->color[DWVB_LOBE_GLOSSY]);
     if (material->specular || bumped) {
         /* (A tilted normal's shadowing goes through the general lobe too.) */
         surface_lobes lobes = {material, {n, dwvu_scale(view, -1.0), cos_view, material->roughness}, {0.0, 0.0, 0.0},
                                bumped, smooth_n};
         for (int c = 0; c < 3; ++c) lobes.diffuse[c] = layer * diffuse_albedo[c];
-        double surface[3];
-        dwvl_direct_rgb(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, surface_factor, &lobes,
-                        surface);
-        for (int c = 0; c < 3; ++c) rgb[c] += surface[c];
+        double surface[2][3];
+        dwvl_direct_split(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, surface_factor, &lobes,
+                          surface);
+        for (int c = 0; c < 3; ++c) {
+            parts->direct[DWVB_LOBE_GLOSSY][c] = surface[0][c];
+            diffuse_light[c] = surface[1][c];
+        }
     } else if (material->principled_v1) {
         /* The Lambertian lobe and the retro-reflection lobe from the same light samples. */
         retro_lobe lobe = {n, dwvu_scale(view, -1.0), -dwvu_dot(n, view), material->roughness};
         double direct[3], retro[3];
         dwvl_direct_lobe(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, retro_factor, &lobe, direct, retro);
-        for (int c = 0; c < 3; ++c) rgb[c] += material->diffuse_albedo[c] * direct[c] + material->retro_albedo[c] * retro[c];
+        for (int c = 0; c < 3; ++c) diffuse_light[c] += material->diffuse_albedo[c] * direct[c] + material->retro_albedo[c] * retro[c];
     } else if (material->principled_diffuse) {
         retro_lobe lobe = {n, dwvu_scale(view, -1.0), -dwvu_dot(n, view), material->roughness};
         double diffuse[3];
         dwvl_direct_lobe(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, principled_diffuse_factor, &lobe,
                          NULL, diffuse);
-        for (int c = 0; c < 3; ++c) rgb[c] += material->diffuse_albedo[c] * diffuse[c];
+        for (int c = 0; c < 3; ++c) diffuse_light[c] += material->diffuse_albedo[c] * diffuse[c];
     } else if (diffuse_albedo[0] > 0.0 || diffuse_albedo[1] > 0.0 || diffuse_albedo[2] > 0.0) {
         double direct[3];
         dwvl_direct(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, direct);
-        for (int c = 0; c < 3; ++c) rgb[c] += layer * diffuse_albedo[c] * direct[c];
+        for (int c = 0; c < 3; ++c) diffuse_light[c] += layer * diffuse_albedo[c] * direct[c];
     }
     if (!walks_left) return;
     /* Entry: cosine-weighted about -n, rejected (no contribution, as Cycles) where it would not
@@ -419,7 +434,7 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
                 if (walk.status == DWVW_TRUNCATED) tally->truncated[c] += walk.weight[0] * share;
                 if (!exited) continue;
                 exit_light(shader, hit->mesh, material, &walk, &exit, sampler, exit_pair, direct);
-                rgb[c] += walk.weight[0] * share * direct[c];
+                diffuse_light[c] += walk.weight[0] * share * direct[c];
             }
             tally->channel_walks[c] += tally->walks - walks;
             tally->channel_events[c] += tally->events - events;
@@ -434,5 +449,5 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
         for (int c = 0; c < 3; ++c) tally->truncated[c] += walk.weight[grey ? 0 : c] * material->walk_scale[c];
     if (!exited) return;
     exit_light(shader, hit->mesh, material, &walk, &exit, sampler, exit_pair, direct);
-    for (int c = 0; c < 3; ++c) rgb[c] += keep[c] * layer * walk.weight[grey ? 0 : c] * material->walk_scale[c] * direct[c];
+    for (int c = 0; c < 3; ++c) diffuse_light[c] += keep[c] * layer * walk.weight[grey ? 0 : c] * material->walk_scale[c] * direct[c];
 }

@@ -43,6 +43,32 @@ typedef struct dwvb_shader {
  * plane, D' = view). */
 double dwvb_footprint(const dwvb_shader *shader, dwvu_vec3 view, double t);
 
+/* Cycles' light passes (Blender's bake types Diffuse, Glossy, Transmission and Combined's pass
+ * filter); subsurface belongs to Diffuse, as in Cycles 3.0+. */
+enum { DWVB_LOBE_DIFFUSE = 0, DWVB_LOBE_GLOSSY = 1, DWVB_LOBE_TRANSMISSION = 2, DWVB_LOBE_COUNT = 3 };
+
+/* One sample's radiance split as Cycles splits its passes, by the lobe that scattered at the
+ * camera ray's (or the texel's) hit: direct, light from the lights and the world at that
+ * scattering (for a walk: at its exit); indirect, light that scattered at least once more after
+ * it; color, that lobe's weight (albedo) at the hit; emission, the surface's own; environment,
+ * the world seen directly (camera misses). Combined is the sum of direct, indirect, emission and
+ * environment. */
+typedef struct dwvb_shade_parts {
+    double direct[DWVB_LOBE_COUNT][3];
+    double indirect[DWVB_LOBE_COUNT][3];
+    double color[DWVB_LOBE_COUNT][3];
+    double emission[3];
+    double environment[3];
+} dwvb_shade_parts;
+
+static inline void dwvb_shade_parts_combined(const dwvb_shade_parts *parts, double rgb[3])
+{
+    for (int c = 0; c < 3; ++c) {
+        rgb[c] = parts->emission[c] + parts->environment[c];
+        for (int l = 0; l < DWVB_LOBE_COUNT; ++l) rgb[c] += parts->direct[l][c] + parts->indirect[l][c];
+    }
+}
+
 /* What samples met, summed by the caller in a fixed order. */
 typedef struct dwvb_tally {
     uint64_t events, walks, warnings;
@@ -73,9 +99,12 @@ typedef struct dwvb_tally {
 #define DWVB_MAX_CHANNEL_WALKS 3u
 
 /* The radiance leaving hit point `hit` along -view (view: unit direction of the ray that found
- * it, from the viewer). `sampler` drives entry and light sampling from pair `pair` on, then the
- * walk's first DWVB_STRATIFIED_EVENTS events; key_walk drives the rest of the walk. */
+ * it, from the viewer), split into `parts` (zeroed first): the specular layer's direct light is
+ * GLOSSY's; the Lambertian, Principled diffuse, retro-reflection and the walks' exits are
+ * DIFFUSE's; each lobe's colour is its closures' weight (3.x) or albedo (4.x+) as Cycles' colour
+ * passes. `sampler` drives entry and light sampling from pair `pair` on, then the walk's first
+ * DWVB_STRATIFIED_EVENTS events; key_walk drives the rest of the walk. */
 void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, const dwvk_sampler *sampler,
-                uint32_t pair, uint64_t key_walk, double rgb[3], dwvb_tally *tally);
+                uint32_t pair, uint64_t key_walk, dwvb_shade_parts *parts, dwvb_tally *tally);
 
 #endif

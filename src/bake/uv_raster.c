@@ -385,6 +385,11 @@ dwv_result_t dwvb_uv_dilate_image(const dwvb_uv_raster *raster, uint32_t margin,
     dwvb_uv_margin_apply(&plan, image->rgba, 4u * sizeof *image->rgba);
     dwvb_uv_margin_apply(&plan, image->variance, 3u * sizeof *image->variance);
     dwvb_uv_margin_apply(&plan, image->samples, sizeof *image->samples);
+    size_t plane = 3u * (size_t)image->width * image->height;
+    for (uint32_t k = 0; k < image->pass_count; ++k) {
+        dwvb_uv_margin_apply(&plan, image->pass_mean + k * plane, 3u * sizeof *image->pass_mean);
+        dwvb_uv_margin_apply(&plan, image->pass_variance + k * plane, 3u * sizeof *image->pass_variance);
+    }
     dwvb_uv_margin_free(&plan);
     return DWV_SUCCESS;
 }

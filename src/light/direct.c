@@ -68,6 +68,21 @@ static int world_visible(const dwvl_environment *env, shadow_origins *origins, d
     return clear_of(origins, origin, w) || !dwvg_occluded(env->geometry, origin, w, 0.0, INFINITY);
 }
 
+/* A lobe's factor: scalar (`factor`, the same in every channel, into f[0]), or two per-channel
+ * ones (`split`); f[1] is 0 for a scalar one, and both are 0 for none (Lambertian only). */
+typedef struct lobe_factors {
+    dwvl_lobe_factor factor;
+    dwvl_split_factor split;
+    const void *context;
+} lobe_factors;
+
+static void lobe_weights(const lobe_factors *lobes, dwvu_vec3 light, double f[2][3])
+{
+    for (int k = 0; k < 2; ++k) f[k][0] = f[k][1] = f[k][2] = 0.0;
+    if (lobes->split) lobes->split(lobes->context, light, f);
+    else if (lobes->factor) f[0][0] = f[0][1] = f[0][2] = lobes->factor(lobes->context, light);
+}
+
 /* An environment map's share of direct_core: two strategies, the cosine-weighted direction about
  * n (pdf p_c = cos / pi, pair `pair`) and the map's own (pdf p_e, pair `pair` + 1), each weighted
  * by the balance heuristic p_s / (p_c + p_e). With L the map's radiance and f the lobe's factor,
@@ -76,8 +91,7 @@ static int world_visible(const dwvl_environment *env, shadow_origins *origins, d
  *   map:     L f (cos/pi) / p_e x p_e / (p_c + p_e) = the same expression at its direction,
  * so both add L f (cos/pi) / (p_c + p_e) where the direction is above n and unshadowed. */
 static void envmap_light(const dwvl_environment *env, shadow_origins *origins, dwvu_vec3 n, const dwvk_sampler *sampler,
-                         uint32_t pair, dwvl_lobe_factor factor, dwvl_rgb_factor rgb, const void *context, double plain[3],
-                         double weighted[3])
+                         uint32_t pair, const lobe_factors *lobes, double plain[3], double weighted[2][3])
 {
     for (int strategy = 0; strategy < 2; ++strategy) {
         double u[2];
@@ -101,24 +115,22 @@ static void envmap_light(const dwvl_environment *env, shadow_origins *origins, d
         if (!(radiance[0] > 0.0 || radiance[1] > 0.0 || radiance[2] > 0.0)) continue;
         if (!world_visible(env, origins, w)) continue;
         double scale = p_c / (p_c + p_e);
-        double f[3] = {0.0, 0.0, 0.0};
-        if (rgb) rgb(context, w, f);
-        else if (factor) f[0] = f[1] = f[2] = factor(context, w);
+        double f[2][3];
+        lobe_weights(lobes, w, f);
         for (int c = 0; c < 3; ++c) {
             plain[c] += radiance[c] * scale;
-            weighted[c] += radiance[c] * scale * f[c];
+            for (int k = 0; k < 2; ++k) weighted[k][c] += radiance[c] * scale * f[k][c];
         }
     }
 }
 
-/* The estimator of dwvl_direct_lobe and dwvl_direct_rgb: a scalar factor (the same in every
- * channel) or a per-channel one (rgb, when not NULL). */
+/* The estimator of dwvl_direct_lobe and dwvl_direct_split: a scalar factor (the same in every
+ * channel) or two per-channel ones (split, when not NULL). */
 static void direct_core(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, dwvu_vec3 ng,
                         const dwvl_terminator *terminator, double top, const dwvk_sampler *sampler, uint32_t pair,
-                        dwvl_lobe_factor factor, dwvl_rgb_factor rgb, const void *context, double lambert[3],
-                        double lobe[3])
+                        const lobe_factors *lobes, double lambert[3], double lobe[2][3])
 {
-    double plain[3] = {0.0, 0.0, 0.0}, weighted[3] = {0.0, 0.0, 0.0};
+    double plain[3] = {0.0, 0.0, 0.0}, weighted[2][3] = {{0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}};
     double eps = env->geometry ? env->geometry->epsilon : 0.0;
     shadow_origins origins = {terminator, n, ng, dwvu_madd(x, ng, eps), dwvu_v(0.0, 0.0, 0.0), 0, INFINITY};
     if (top < INFINITY) {
@@ -154,16 +166,15 @@ static void direct_core(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, d
             if (!clear_of(&origins, origin, toward) && dwvg_occluded(env->geometry, origin, toward, 0.0, distance - 2.0 * eps))
                 continue;
         }
-        double f[3] = {0.0, 0.0, 0.0};
-        if (rgb) rgb(context, s.direction, f);
-        else if (factor) f[0] = f[1] = f[2] = factor(context, s.direction);
+        double f[2][3];
+        lobe_weights(lobes, s.direction, f);
         for (int c = 0; c < 3; ++c) {
             plain[c] += s.value[c] * cos_n * INV_PI;
-            weighted[c] += s.value[c] * cos_n * INV_PI * f[c];
+            for (int k = 0; k < 2; ++k) weighted[k][c] += s.value[c] * cos_n * INV_PI * f[k][c];
         }
     }
     if (env->world_lit && env->envmap) {
-        envmap_light(env, &origins, n, sampler, pair + env->light_count, factor, rgb, context, plain, weighted);
+        envmap_light(env, &origins, n, sampler, pair + env->light_count, lobes, plain, weighted);
     } else if (env->world_lit) {
         /* Cosine-weighted direction about n (pdf cos / pi): the estimate is L_world x visibility
          * (x the factor for the lobe). */
@@ -177,18 +188,18 @@ static void direct_core(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, d
             blocked = !clear_of(&origins, origin, w) && dwvg_occluded(env->geometry, origin, w, 0.0, INFINITY);
         }
         if (!blocked) {
-            double f[3] = {0.0, 0.0, 0.0};
-            if (rgb) rgb(context, w, f);
-            else if (factor) f[0] = f[1] = f[2] = factor(context, w);
+            double f[2][3];
+            lobe_weights(lobes, w, f);
             for (int c = 0; c < 3; ++c) {
                 plain[c] += env->world[c];
-                weighted[c] += env->world[c] * f[c];
+                for (int k = 0; k < 2; ++k) weighted[k][c] += env->world[c] * f[k][c];
             }
         }
     }
     for (int c = 0; c < 3; ++c) {
         if (lambert) lambert[c] = plain[c];
-        if (lobe) lobe[c] = weighted[c];
+        if (lobe)
+            for (int k = 0; k < 2; ++k) lobe[k][c] = weighted[k][c];
     }
 }
 
@@ -196,14 +207,19 @@ void dwvl_direct_lobe(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, dwv
                       const dwvl_terminator *terminator, double top, const dwvk_sampler *sampler, uint32_t pair,
                       dwvl_lobe_factor factor, const void *context, double lambert[3], double lobe[3])
 {
-    direct_core(env, x, n, ng, terminator, top, sampler, pair, factor, NULL, context, lambert, lobe);
+    lobe_factors lobes = {factor, NULL, context};
+    double weighted[2][3];
+    direct_core(env, x, n, ng, terminator, top, sampler, pair, &lobes, lambert, weighted);
+    if (lobe)
+        for (int c = 0; c < 3; ++c) lobe[c] = weighted[0][c];
 }
 
-void dwvl_direct_rgb(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, dwvu_vec3 ng,
-                     const dwvl_terminator *terminator, double top, const dwvk_sampler *sampler, uint32_t pair,
-                     dwvl_rgb_factor factor, const void *context, double out[3])
+void dwvl_direct_split(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, dwvu_vec3 ng,
+                       const dwvl_terminator *terminator, double top, const dwvk_sampler *sampler, uint32_t pair,
+                       dwvl_split_factor factor, const void *context, double out[2][3])
 {
-    direct_core(env, x, n, ng, terminator, top, sampler, pair, NULL, factor, context, NULL, out);
+    lobe_factors lobes = {NULL, factor, context};
+    direct_core(env, x, n, ng, terminator, top, sampler, pair, &lobes, NULL, out);
 }
 
 void dwvl_direct(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, dwvu_vec3 ng,

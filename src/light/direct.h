@@ -54,14 +54,16 @@ void dwvl_direct_lobe(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, dwv
                       const dwvl_terminator *terminator, double top, const dwvk_sampler *sampler, uint32_t pair,
                       dwvl_lobe_factor factor, const void *context, double lambert[3], double lobe[3]);
 
-/* A BRDF per colour channel beside the Lambertian 1/pi for light along unit `light`: the BRDF of
- * channel c is (1/pi) f[c]. */
-typedef void (*dwvl_rgb_factor)(const void *context, dwvu_vec3 light, double f[3]);
+/* Two BRDFs per colour channel beside the Lambertian 1/pi for light along unit `light` (a
+ * surface's glossy and diffuse layers, which bake passes keep apart): the BRDF of channel c of
+ * lobe k is (1/pi) f[k][c]. */
+typedef void (*dwvl_split_factor)(const void *context, dwvu_vec3 light, double f[2][3]);
 
-/* dwvl_direct_lobe with a per-channel BRDF: out[c] is the integral of L_in,c (1/pi) f[c] cos, from
- * the same light samples (pairs) as dwvl_direct. */
-void dwvl_direct_rgb(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, dwvu_vec3 ng,
-                     const dwvl_terminator *terminator, double top, const dwvk_sampler *sampler, uint32_t pair,
-                     dwvl_rgb_factor factor, const void *context, double out[3]);
+/* dwvl_direct_lobe with two per-channel BRDFs: out[k][c] is the integral of L_in,c (1/pi)
+ * f[k][c] cos, both lobes from the same light samples (pairs) as dwvl_direct, so their sum is
+ * the estimate of the summed BRDF with no extra random numbers. */
+void dwvl_direct_split(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, dwvu_vec3 ng,
+                       const dwvl_terminator *terminator, double top, const dwvk_sampler *sampler, uint32_t pair,
+                       dwvl_split_factor factor, const void *context, double out[2][3]);
 
 #endif

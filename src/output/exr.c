@@ -5,7 +5,10 @@
  *                                              says which)
  *   variance_R, variance_G, variance_B  FLOAT  the estimated variance of each pixel's mean
  *   samples                             UINT   samples that went into each pixel
- * No channel name has a dot: OpenEXR reads "x.R" as channel R of layer "x", and Blender 3.4 takes
+ * A multilayer file (bake passes, dwv_image_write_exr_layers) has instead Combined.R, .G, .B, .A
+ * and <pass>.R, .G, .B per pass: Blender's layout of a render's passes (layer "<view layer>.
+ * <pass>"), with no view layer name, which Blender reads as a render layer named "".
+ * Otherwise no channel name has a dot: OpenEXR reads "x.R" as channel R of layer "x", and Blender 3.4 takes
  * a file with any layer (or with more than one part) as multilayer, whose pixels it loads only
  * into render passes (bpy.data.images.load then has no pixels: size 0 x 0). With dotless names
  * Blender loads the file as a plain RGBA image and ignores the extra channels.
@@ -152,7 +155,7 @@ dwv_result_t dwvo_write_exr(const dwvo_exr_image *image, const char *path, char 
         return result;
     }
     const int32_t width = (int32_t)image->width, height = (int32_t)image->height;
-    const channel_source sources[] = {
+    const channel_source plain_sources[] = {
         /* The perceptual flag only steers lossy codecs; colour is "logarithmic" by convention. */
         {"R", EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LOGARITHMIC, (const uint8_t *)(image->rgba + 0), 16},
         {"G", EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LOGARITHMIC, (const uint8_t *)(image->rgba + 1), 16},
@@ -163,7 +166,32 @@ dwv_result_t dwvo_write_exr(const dwvo_exr_image *image, const char *path, char 
         {"variance_B", EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR, (const uint8_t *)(image->variance + 2), 12},
         {"samples", EXR_PIXEL_UINT, EXR_PERCEPTUALLY_LINEAR, (const uint8_t *)image->samples, 4},
     };
-    const size_t source_count = sizeof sources / sizeof *sources;
+    /* Multilayer: Combined.RGBA and 3 channels per layer, names kept in `names`. */
+    channel_source layered[4u + 3u * DWVO_EXR_MAX_LAYERS];
+    char names[4u + 3u * DWVO_EXR_MAX_LAYERS][64];
+    const channel_source *sources = plain_sources;
+    size_t source_count = sizeof plain_sources / sizeof *plain_sources;
+    if (image->multilayer) {
+        static const char rgba_names[4] = {'R', 'G', 'B', 'A'};
+        uint32_t layers = image->layer_count < DWVO_EXR_MAX_LAYERS ? image->layer_count : DWVO_EXR_MAX_LAYERS;
+        source_count = 0u;
+        for (uint32_t layer = 0; layer <= layers; ++layer) {
+            int channels = layer == 0u ? 4 : 3;
+            for (int c = 0; c < channels; ++c) {
+                channel_source *source = &layered[source_count];
+                snprintf(names[source_count], sizeof names[source_count], "%s.%c",
+                         layer == 0u ? "Combined" : image->layer_names[layer - 1u], rgba_names[c]);
+                source->name = names[source_count];
+                source->type = EXR_PIXEL_FLOAT;
+                source->percept = c == 3 ? EXR_PERCEPTUALLY_LINEAR : EXR_PERCEPTUALLY_LOGARITHMIC;
+                source->first = layer == 0u ? (const uint8_t *)(image->rgba + c)
+                                            : (const uint8_t *)(image->layer_rgb[layer - 1u] + c);
+                source->stride = 4 * channels;
+                ++source_count;
+            }
+        }
+        sources = layered;
+    }
 
     exr_context_t ctxt = NULL;
     exr_encode_pipeline_t encoder;

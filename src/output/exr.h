@@ -17,6 +17,13 @@ typedef struct dwvo_exr_image {
     const dwv_error_point_t *error_vs_time;
     const char *technique;               /* the technique's name ("none": caller-made pixels) */
     const char *features;                /* comma-separated feature names */
+    /* Multilayer files (multilayer 1): channels Combined.R/G/B/A from rgba and, per layer (up to
+     * DWVO_EXR_MAX_LAYERS), <name>.R/G/B from its 3 x width x height floats, instead of the
+     * channels above. */
+    int multilayer;
+    uint32_t layer_count;
+    const char *const *layer_names;
+    const float *const *layer_rgb;
 } dwvo_exr_image;
 
 /* Writes `image` to `path` atomically (atomic_file.h): one scanline part, ZIP compression, FLOAT
@@ -24,5 +31,7 @@ typedef struct dwvo_exr_image {
  * D65 white), variance_R/G/B (FLOAT: the variance of each pixel mean) and samples (UINT), and
  * the dwivedi:* metadata attributes listed in exr.c. On failure the message says why. */
 dwv_result_t dwvo_write_exr(const dwvo_exr_image *image, const char *path, char *message, size_t size);
+/* The layers a multilayer file holds at most beside Combined. */
+#define DWVO_EXR_MAX_LAYERS 16u
 
 #endif
