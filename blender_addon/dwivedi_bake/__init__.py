@@ -28,7 +28,7 @@ import traceback
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 
-from . import export, farm, libcheck
+from . import export, farm, libcheck, passes
 
 # The techniques (dwv_technique_t), named and explained for artists: what each is good for, in one
 # line; the research names (and papers) are in docs/ and the library's header.
@@ -546,13 +546,28 @@ class _Job:
                                          else "_uv_" + _safe_name(self.uv_object.name))
         self.exr = os.path.join(self.folder, stem + ".exr")
         self.png = os.path.join(self.folder, stem + ".png")
+        # Cycles' bake type and pass filter (passes.py): a UV bake writes that image into the
+        # active image; a camera bake writes the passes it needs, and the view layer's enabled
+        # light passes, as layers of a multilayer OpenEXR.
+        try:
+            self.bake_type, self.pass_filter = passes.bake_request(scene)
+            wanted = () if passes.is_full_combined(self.bake_type, self.pass_filter) else \
+                self.dwivedi.bake_type_passes(self.bake_type, self.pass_filter)
+        except (passes.UnsupportedBake, self.dwivedi.Error) as error:
+            raise export.ExportError(str(error)) from None
+        if settings.target == 'CAMERA':
+            wanted = tuple(wanted) + passes.view_layer_passes(context.view_layer)
+        self.passes = tuple(name for name in self.dwivedi.PASS_NAMES if name in wanted and name != "Combined")
+        if not passes.is_full_combined(self.bake_type, self.pass_filter):
+            self.notes.append("bake type " + passes.summary(self.bake_type, self.pass_filter))
         self.bake_settings = self.dwivedi.BakeSettings(
             target=settings.target.lower(), width=self.exported.width, height=self.exported.height,
             uv_mesh=self.exported.uv_mesh, uv_margin=settings.uv_margin, technique=settings.technique.lower(),
             channel_walks=settings.channel_walks.lower(), samples=settings.samples, time_limit=settings.time_limit,
             target_error=settings.target_error, threads=settings.threads, seed=settings.seed,
             max_events=settings.walk_event_cap,
-            transparent_background=settings.target == 'CAMERA' and scene.render.film_transparent)
+            transparent_background=settings.target == 'CAMERA' and scene.render.film_transparent,
+            passes=self.passes)
         self.display = display_settings(scene, self.dwivedi)
         self.bake = None
         self.result = None  # the Blender image that holds the result, once finished
@@ -571,7 +586,14 @@ class _Job:
                 self.result = file_image(self.exr)
                 where = self.exr
             else:
-                where = write_uv_image(image, self.uv_image, self.exr, self.dwivedi)
+                if passes.is_full_combined(self.bake_type, self.pass_filter):
+                    where = write_uv_image(image, self.uv_image, self.exr, self.dwivedi)
+                else:
+                    typed = image.bake_type(self.bake_type, self.pass_filter)
+                    try:
+                        where = write_uv_image(typed, self.uv_image, self.exr, self.dwivedi)
+                    finally:
+                        typed.close()
                 self.result = self.uv_image
         finally:
             image.close()
@@ -591,7 +613,12 @@ class _Job:
         """The camera bake's OpenEXR (scene linear, with the variance and sample layers) and PNG
         (the scene's colour management), the background as Film > Transparent says."""
         film_alpha(image, self.scene)
-        image.write_exr(self.exr)
+        if self.passes:
+            # Blender's layout of a render's passes, which its Image Editor shows as a multilayer
+            # image (a pass menu); the variance and sample channels are in single-layer files only.
+            image.write_exr_layers(self.exr)
+        else:
+            image.write_exr(self.exr)
         try:
             image.write_png(self.png, self.display)
         except self.dwivedi.Error as error:

@@ -20,7 +20,7 @@ import traceback
 import bpy
 from bpy.props import IntProperty, PointerProperty, StringProperty
 
-from . import export
+from . import export, passes
 
 SCENE_FILE = "dwivedi_scene.json"
 
@@ -118,6 +118,15 @@ class DWIVEDI_OT_farm_export(_FarmOperator, bpy.types.Operator):
         exported = export.export_scene(context, bake, _writer_module(dwivedi))
         for warning in exported.warnings:
             self.report({'WARNING'}, warning)
+        # Partial files carry the combined image's sums only (the library refuses passes in a chunk).
+        try:
+            bake_type, pass_filter = passes.bake_request(context.scene)
+        except passes.UnsupportedBake as error:
+            raise export.ExportError(str(error)) from None
+        if not passes.is_full_combined(bake_type, pass_filter) or passes.view_layer_passes(context.view_layer):
+            self.report({'WARNING'}, "a farm bake makes the Combined image only: the bake type "
+                                     f"{passes.summary(bake_type, pass_filter)} and the view layer's light passes "
+                                     "are not baked by its chunks (bake on this machine for passes)")
         if bake.time_limit > 0.0 or bake.target_error > 0.0:
             self.report({'WARNING'}, "Time Limit and Target Error do not apply to a farm bake: every chunk bakes "
                                      "all its samples")

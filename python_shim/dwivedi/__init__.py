@@ -42,7 +42,8 @@ from typing import NamedTuple, Tuple
 from . import _library
 from ._library import ABI_VERSION, LIBRARY_FUNCTIONS, Error, library_path, loaded_library_path, use_library
 from .baker import (AreaLight, Bake, BakeSettings, BakeStats, Camera, Cancelled, DisplaySettings, ErrorPoint, Image, merge_partials,
-                    Material, PointLight, Progress, Scene, SpotLight, SunLight, bake, feature_names, start_bake, techniques)
+                    Material, PointLight, Progress, Scene, SpotLight, SunLight, bake, feature_names, start_bake, techniques,
+                    PASS_NAMES, BAKE_TYPES, BAKE_FILTERS, bake_type_passes)
 
 __all__ = [
     "merge_partials",
@@ -71,6 +72,10 @@ __all__ = [
     "DisplaySettings",
     "techniques",
     "feature_names",
+    "PASS_NAMES",
+    "BAKE_TYPES",
+    "BAKE_FILTERS",
+    "bake_type_passes",
     "version",
     "methods",
     "diffusion_length",

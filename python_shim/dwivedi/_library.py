@@ -298,6 +298,8 @@ class BakeOptions(_SizedStructure):
         ("sample_count", ctypes.c_uint64),
         ("transparent_background", ctypes.c_int32),
         ("reserved", ctypes.c_uint32),
+        ("passes", ctypes.c_uint32),
+        ("reserved2", ctypes.c_uint32),
     ]
 
     def __init__(self) -> None:
@@ -433,6 +435,12 @@ _BAKER_PROTOTYPES: Dict[str, Tuple[object, Sequence[object]]] = {
     "dwv_image_create": (_result_t, (ctypes.c_uint32, ctypes.c_uint32, ctypes.c_void_p, _handle_pp)),
     "dwv_image_write_exr": (_result_t, (_handle_p, ctypes.c_char_p)),
     "dwv_image_write_partial": (_result_t, (_handle_p, ctypes.c_char_p)),
+    "dwv_pass_name": (ctypes.c_char_p, (ctypes.c_int32,)),
+    "dwv_bake_type_passes": (_result_t, (ctypes.c_int32, ctypes.c_uint32, _p(ctypes.c_uint32))),
+    "dwv_image_passes": (_result_t, (_handle_p, _p(ctypes.c_uint32))),
+    "dwv_image_pass": (_result_t, (_handle_p, ctypes.c_int32, _handle_pp)),
+    "dwv_image_bake_type": (_result_t, (_handle_p, ctypes.c_int32, ctypes.c_uint32, _handle_pp)),
+    "dwv_image_write_exr_layers": (_result_t, (_handle_p, ctypes.c_char_p)),
     "dwv_merge_partials": (_result_t, (ctypes.POINTER(ctypes.c_char_p), ctypes.c_uint32, ctypes.POINTER(_handle_p))),
     "dwv_image_write_display_png": (_result_t, (_handle_p, ctypes.c_char_p, _p(DisplayOptions))),
     "dwv_image_to_display": (_result_t, (_handle_p, _p(DisplayOptions), ctypes.c_void_p, ctypes.c_uint64)),

@@ -40,7 +40,7 @@ PathLike = Union[str, "os.PathLike[str]"]
 __all__ = [
     "Cancelled", "Material", "SunLight", "PointLight", "AreaLight", "SpotLight", "Camera", "Scene", "BakeSettings",
     "Progress", "Bake", "bake", "start_bake", "Image", "BakeStats", "ErrorPoint", "DisplaySettings",
-    "techniques", "feature_names",
+    "techniques", "feature_names", "PASS_NAMES", "BAKE_TYPES", "BAKE_FILTERS", "bake_type_passes",
 ]
 
 
@@ -382,6 +382,52 @@ def _normalize(v: Sequence[float], name: str) -> Vector:
 # ---------------------------------------------------------------------------------------------
 
 _TARGETS = {"camera": 0, "uv": 1}
+# dwv_pass_t by Blender's pass names (its multilayer EXR layers), in the enum's order.
+PASS_NAMES = ("Combined", "DiffDir", "DiffInd", "DiffCol", "GlossDir", "GlossInd", "GlossCol", "TransDir",
+              "TransInd", "TransCol", "Emit", "Env")
+# dwv_bake_type_t by Blender's bake types (scene.cycles.bake_type) that the library bakes.
+BAKE_TYPES = {"COMBINED": 0, "DIFFUSE": 1, "GLOSSY": 2, "TRANSMISSION": 3, "EMIT": 4, "ENVIRONMENT": 5}
+# DWV_BAKE_FILTER_* by the names of Blender's pass filter (scene.render.bake.use_pass_<name>).
+BAKE_FILTERS = {"direct": 1, "indirect": 2, "color": 4, "diffuse": 8, "glossy": 16, "transmission": 32, "emit": 64}
+
+
+def _pass_mask(passes: Any) -> int:
+    """DWV_PASS_BIT of each of Blender's pass names in `passes` (an iterable of names)."""
+    if isinstance(passes, (str, bytes)):
+        raise TypeError("passes must be a sequence of pass names such as ('DiffDir', 'DiffCol'), not one string")
+    mask = 0
+    for name in passes:
+        if name not in PASS_NAMES:
+            raise ValueError(f"unknown pass {name!r} (one of {', '.join(PASS_NAMES)})")
+        mask |= 1 << PASS_NAMES.index(name)
+    return mask
+
+
+def _pass_names(mask: int) -> Tuple[str, ...]:
+    return tuple(name for k, name in enumerate(PASS_NAMES) if mask & (1 << k))
+
+
+def _bake_type(bake_type: str, pass_filter: Any) -> Tuple[int, int]:
+    if bake_type not in BAKE_TYPES:
+        raise ValueError(f"unknown bake type {bake_type!r} (one of {', '.join(BAKE_TYPES)})")
+    if isinstance(pass_filter, str):
+        raise TypeError("pass_filter must be a set of filter names such as {'direct', 'color'}, not one string")
+    bits = 0
+    for name in pass_filter:
+        if name not in BAKE_FILTERS:
+            raise ValueError(f"unknown pass filter {name!r} (any of {', '.join(BAKE_FILTERS)})")
+        bits |= BAKE_FILTERS[name]
+    return BAKE_TYPES[bake_type], bits
+
+
+def bake_type_passes(bake_type: str, pass_filter: Any) -> Tuple[str, ...]:
+    """The passes (for BakeSettings.passes) that Blender's bake type (COMBINED, DIFFUSE, GLOSSY,
+    TRANSMISSION, EMIT, ENVIRONMENT) with its pass filter (names of BAKE_FILTERS) needs; Error
+    for a filter that selects nothing (dwv_bake_type_passes)."""
+    code, bits = _bake_type(bake_type, pass_filter)
+    mask = ctypes.c_uint32()
+    _call("dwv_bake_type_passes", code, bits, ctypes.byref(mask))
+    return _pass_names(mask.value)
 # dwv_channel_walks_t: how walks carry the colour channels (capi/dwivedi.h)
 _CHANNEL_WALKS = {"auto": 0, "shared": 1, "separate": 2}
 
@@ -416,6 +462,9 @@ class BakeSettings:
     # Camera bakes: the background as Cycles' Film > Transparent (RGBA 0 where no surface is seen,
     # pixels premultiplied by coverage); False: the world is seen there.
     transparent_background: bool = False
+    # Bake passes beside the combined image, by Blender's names (PASS_NAMES; docs/output.md):
+    # ("DiffDir", "DiffCol") and so on. A direct or indirect pass brings its colour.
+    passes: Tuple[str, ...] = ()
 
     def _to_c(self) -> _library.BakeOptions:
         out = _library.BakeOptions()
@@ -438,6 +487,7 @@ class BakeSettings:
         if not isinstance(self.transparent_background, bool):
             raise TypeError(f"transparent_background must be True or False, not {type(self.transparent_background).__name__}")
         out.transparent_background = int(self.transparent_background)
+        out.passes = _pass_mask(self.passes)
         return out
 
     @classmethod
@@ -447,7 +497,7 @@ class BakeSettings:
                    samples=c.samples, time_limit=c.time_limit, target_error=c.target_error, threads=c.threads,
                    max_events=c.max_events, seed=c.seed, tile_size=c.tile_size,
                    sample_first=c.sample_first, sample_count=c.sample_count,
-                   transparent_background=bool(c.transparent_background),
+                   transparent_background=bool(c.transparent_background), passes=_pass_names(c.passes),
                    channel_walks={v: k for k, v in _CHANNEL_WALKS.items()}.get(c.channel_walks, str(c.channel_walks)))
 
 
@@ -1134,6 +1184,33 @@ class Image:
         """Writes a float RGBA OpenEXR (with variance and sample layers and the bake's metadata);
         the file appears complete or not at all."""
         _call("dwv_image_write_exr", self._live(), os.fsencode(path))
+
+    @property
+    def passes(self) -> Tuple[str, ...]:
+        """Blender's names of the passes the image holds ("Combined" always)."""
+        mask = ctypes.c_uint32()
+        _call("dwv_image_passes", self._live(), ctypes.byref(mask))
+        return _pass_names(mask.value)
+
+    def pass_image(self, name: str) -> "Image":
+        """One pass as Blender shows it (direct and indirect divided by their colour), as an Image."""
+        code = _pass_mask([name]).bit_length() - 1
+        handle = _library._handle_p()
+        _call("dwv_image_pass", self._live(), code, ctypes.byref(handle))
+        return Image._adopt(handle.value)
+
+    def bake_type(self, bake_type: str, pass_filter: Any) -> "Image":
+        """The image Cycles' bake of `bake_type` with `pass_filter` makes (bake_type_passes), from
+        the passes this image holds."""
+        code, bits = _bake_type(bake_type, pass_filter)
+        handle = _library._handle_p()
+        _call("dwv_image_bake_type", self._live(), code, bits, ctypes.byref(handle))
+        return Image._adopt(handle.value)
+
+    def write_exr_layers(self, path: PathLike) -> None:
+        """Writes a multilayer OpenEXR as Blender's: Combined.RGBA and one RGB layer per pass
+        (DiffDir, DiffCol, ...), which Blender opens as a multilayer image."""
+        _call("dwv_image_write_exr_layers", self._live(), os.fsencode(path))
 
     def write_partial(self, path: PathLike) -> None:
         """Writes a chunk's exact sums (a bake with sample_count > 0) for merge_partials."""

@@ -67,7 +67,10 @@ void dwvb_bake_sample(const dwvb_bake *bake, const dwvb_shader *shader, uint64_t
             return;
         }
     } else {
-        /* The texel centre's surface point, seen along its normal: the radiance leaving along n. */
+        /* The texel centre's surface point, seen along its normal: the radiance leaving along n,
+         * the smooth normal where the mesh has normals (Cycles' integrator_init_from_bake:
+         * ray.D = -N, N = triangle_smooth_normal for smooth-shaded triangles; the view-dependent
+         * lobes, the specular layer above all, see the texel from there). */
         const dwvb_uv_texel *texel = &bake->raster.texels[index];
         hit.mesh = bake->options.uv_mesh;
         hit.prim = (uint32_t)texel->triangle;
@@ -75,7 +78,8 @@ void dwvb_bake_sample(const dwvb_bake *bake, const dwvb_shader *shader, uint64_t
         hit.v = texel->b2;
         hit.t = 0.0;
         const dwvg_mesh *mesh = &bake->scene->meshes[hit.mesh];
-        view = dwvu_scale(dwvg_geometric_normal(mesh, hit.prim), -1.0);
+        dwvu_vec3 ng = dwvg_geometric_normal(mesh, hit.prim);
+        view = dwvu_scale(dwvg_shading_normal(mesh, hit.prim, hit.u, hit.v, ng), -1.0);
     }
     *mesh_seen = hit.mesh;
     dwvb_shade(shader, &hit, view, &sampler, PIXEL_PAIR + 1u, key_walk, parts, tally);
