@@ -980,6 +980,8 @@ typedef enum dwv_pass_t {
 /* Blender's name of the pass, its layer's name in a multilayer OpenEXR ("Combined", "DiffDir",
  * "DiffInd", "DiffCol", "GlossDir", ..., "Emit", "Env"); NULL for an unknown value. */
 DWV_API const char *dwv_pass_name(dwv_pass_t pass);
+/* The pass of Blender's name (dwv_pass_name); DWV_ERROR_UNKNOWN_NAME listing the names otherwise. */
+DWV_API dwv_result_t dwv_pass_from_name(const char *name, dwv_pass_t *pass);
 
 /* Blender's bake types (bpy: scene.cycles.bake_type) that this library bakes, and the pass filter
  * bits (scene.render.bake.use_pass_*). */

@@ -20,6 +20,22 @@ const char *dwv_pass_name(dwv_pass_t pass)
     return (uint32_t)pass < DWV_PASS_COUNT ? pass_names[pass] : NULL;
 }
 
+dwv_result_t dwv_pass_from_name(const char *name, dwv_pass_t *pass)
+{
+    static const char fn[] = "dwv_pass_from_name";
+    DWV_TRY(dwv_check_pointer(fn, "name", name));
+    DWV_TRY(dwv_check_pointer(fn, "pass", pass));
+    for (uint32_t p = 0; p < DWV_PASS_COUNT; ++p) {
+        if (strcmp(name, pass_names[p]) == 0) {
+            *pass = (dwv_pass_t)p;
+            return DWV_SUCCESS;
+        }
+    }
+    return dwv_fail(DWV_ERROR_UNKNOWN_NAME,
+                    "%s: unknown pass '%.64s' (Blender's names: Combined, DiffDir, DiffInd, DiffCol, GlossDir, "
+                    "GlossInd, GlossCol, TransDir, TransInd, TransCol, Emit, Env)", fn, name);
+}
+
 /* The direct, indirect and colour passes of lobe `lobe` (0 diffuse, 1 glossy, 2 transmission). */
 static dwv_pass_t lobe_pass(uint32_t lobe, uint32_t kind)
 {

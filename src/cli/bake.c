@@ -24,7 +24,7 @@ static void help(FILE *out)
             "usage: dwivedi bake [SCENE.json] --out PREFIX [--spp N] [--time SECONDS] [--error REL]\n"
             "           [--technique T] [--channel-walks C] [--threads N] [--seed S] [--width W] [--height H]\n"
             "           [--ocio CONFIG] [--display NAME] [--view NAME] [--look NAME]\n"
-            "           [--exposure E] [--gamma G] [--samples FIRST:COUNT] [--quiet]\n"
+            "           [--exposure E] [--gamma G] [--samples FIRST:COUNT] [--passes NAMES] [--quiet]\n"
             "           [--mpi [--mpi-chunk N] [--mpi-timeout SECONDS]]\n\n"
             "Bakes SCENE.json (docs/scene-format.md), or without it the built-in default scene: a thin\n"
             "back-lit leaf-like shell beside a thick front-lit wax-like shape. Writes\n"
@@ -32,7 +32,9 @@ static void help(FILE *out)
             "  PREFIX.png   the display image through an OpenColorIO view\n"
             "  PREFIX.json  spp, seconds, estimated_relative_error, mean_rgb, events, features,\n"
             "               error_vs_time, texture_bytes_per_texel (textured scenes) and more\n"
-            "all three only when the bake completes: a failed or cancelled (Ctrl-C) bake exits non-zero\n"
+            "  PREFIX.layers.exr  with --passes (or the scene's bake.passes): a multilayer OpenEXR as\n"
+            "               Blender's, Combined and each pass (DiffDir, DiffCol, ...) a layer\n"
+            "all of them only when the bake completes: a failed or cancelled (Ctrl-C) bake exits non-zero\n"
             "and leaves earlier outputs untouched.\n\n"
             "  --spp N        samples per pixel (default: the scene's); the budgets --spp, --time and\n"
             "                 --error stop the bake at whichever comes first\n"
@@ -49,6 +51,9 @@ static void help(FILE *out)
             "  --samples FIRST:COUNT   a chunk of a split bake (docs/farm.md): sample indices FIRST to\n"
             "                 FIRST+COUNT-1 of the --spp in all, written to PREFIX.dwvpart only (exact sums\n"
             "                 for 'dwivedi merge'); no --time or --error\n"
+            "  --passes NAMES bake passes beside the combined image, Blender's names comma-separated:\n"
+            "                 DiffDir, DiffInd, DiffCol, GlossDir, GlossInd, GlossCol, TransDir, TransInd,\n"
+            "                 TransCol, Emit, Env (docs/output.md; a direct or indirect pass brings its colour)\n"
             "  --quiet        no progress bar (it is shown only on a terminal anyway)\n"
             "  --mpi          under mpirun (docs/farm.md): the ranks bake ranges of N samples each, handed\n"
             "                 out by rank 0, which merges them exactly and writes the outputs (bit for bit\n"
@@ -89,7 +94,7 @@ static int parse_overrides(int argc, char **argv, cli_bake_flags *f, dwv_bake_op
         static const char *const flags[] = {"--out",     "--spp",   "--time",    "--error",   "--technique",
                                             "--threads", "--seed",  "--width",   "--height",  "--ocio",
                                             "--display", "--view",  "--look",    "--exposure", "--gamma",
-                                            "--channel-walks", "--samples", "--mpi-chunk", "--mpi-timeout"};
+                                            "--channel-walks", "--samples", "--mpi-chunk", "--mpi-timeout", "--passes"};
         int known = 0;
         for (size_t k = 0; k < sizeof flags / sizeof flags[0]; ++k) known |= strcmp(flag, flags[k]) == 0;
         if (!known) return cli_usage_error(verb, "unknown argument '%.64s'", flag);
@@ -138,6 +143,23 @@ static int parse_overrides(int argc, char **argv, cli_bake_flags *f, dwv_bake_op
             if (dwv_technique_from_name(value, &technique) != DWV_SUCCESS)
                 return cli_usage_error(verb, "--technique: %s", dwv_last_error_message());
             if (apply) o->technique = technique;
+        } else if (strcmp(flag, "--passes") == 0) {
+            uint32_t mask = 0u;
+            for (const char *start = value; *start;) {
+                const char *end = strchr(start, ',');
+                size_t length = end ? (size_t)(end - start) : strlen(start);
+                char name[32];
+                if (length == 0u || length >= sizeof name)
+                    return cli_usage_error(verb, "--passes: '%.64s' is not a comma-separated list of pass names", value);
+                memcpy(name, start, length);
+                name[length] = '\0';
+                dwv_pass_t pass;
+                if (dwv_pass_from_name(name, &pass) != DWV_SUCCESS)
+                    return cli_usage_error(verb, "--passes: %s", dwv_last_error_message());
+                mask |= DWV_PASS_BIT(pass);
+                start = end ? end + 1 : start + length;
+            }
+            if (apply) o->passes = mask;
         } else if (strcmp(flag, "--channel-walks") == 0) {
             dwv_channel_walks_t channel_walks;
             if (dwv_channel_walks_from_name(value, &channel_walks) != DWV_SUCCESS)
@@ -331,17 +353,24 @@ static char *hidden_join(const char *prefix, const char *suffix)
     return path;
 }
 
-/* Writes the three outputs under temporary names, then renames them into place. */
+/* Writes the three outputs (four with bake passes: the multilayer PREFIX.layers.exr) under temporary
+ * names, then renames them into place. */
 int cli_bake_write_outputs(const char *prefix, const dwv_image_t *image, const dwv_bake_options_t *o,
                            const dwv_display_options_t *display, const char *scene_name, const dwv_scene_t *scene)
 {
-    static const char *const final_suffix[3] = {".exr", ".png", ".json"};
-    char temp_suffix[3][64];
-    for (int k = 0; k < 3; ++k)
+    static const char *const final_suffix[4] = {".exr", ".png", ".json", ".layers.exr"};
+    uint32_t passes = 0u;
+    if (dwv_image_passes(image, &passes) != DWV_SUCCESS) {
+        fprintf(stderr, "dwivedi %s: %s\n", verb_name, dwv_last_error_message());
+        return -1;
+    }
+    const int outputs = passes != DWV_PASS_BIT(DWV_PASS_COMBINED) ? 4 : 3;
+    char temp_suffix[4][64];
+    for (int k = 0; k < outputs; ++k)
         snprintf(temp_suffix[k], sizeof temp_suffix[k], "%s.partial-%ld", final_suffix[k], (long)getpid());
-    char *final_path[3] = {0}, *temp_path[3] = {0};
+    char *final_path[4] = {0}, *temp_path[4] = {0};
     int status = -1, written = 0;
-    for (int k = 0; k < 3; ++k) {
+    for (int k = 0; k < outputs; ++k) {
         if (!(final_path[k] = join(prefix, final_suffix[k])) || !(temp_path[k] = hidden_join(prefix, temp_suffix[k])))
             goto done;
     }
@@ -357,7 +386,14 @@ int cli_bake_write_outputs(const char *prefix, const dwv_image_t *image, const d
     written = 2;
     if (write_stats_json(temp_path[2], image, o, scene_name, scene) != 0) goto done;
     written = 3;
-    for (int k = 0; k < 3; ++k) {
+    if (outputs == 4) {
+        if (dwv_image_write_exr_layers(image, temp_path[3]) != DWV_SUCCESS) {
+            fprintf(stderr, "dwivedi %s: %s\n", verb_name, dwv_last_error_message());
+            goto done;
+        }
+        written = 4;
+    }
+    for (int k = 0; k < outputs; ++k) {
         if (rename(temp_path[k], final_path[k]) != 0) {
             fprintf(stderr, "dwivedi %s: cannot rename %s to %s: %s\n", verb_name, temp_path[k], final_path[k],
                     strerror(errno));
@@ -368,7 +404,7 @@ int cli_bake_write_outputs(const char *prefix, const dwv_image_t *image, const d
     status = 0;
 done:
     for (int k = 0; k < written; ++k) remove(temp_path[k]);
-    for (int k = 0; k < 3; ++k) {
+    for (int k = 0; k < outputs; ++k) {
         free(final_path[k]);
         free(temp_path[k]);
     }
@@ -533,7 +569,9 @@ static int run(int argc, char **argv)
     printf("baked %ux%u, %llu spp, %.2f s, estimated relative error %.3g%%, %.3g M events/s\n", o.width, o.height,
            (unsigned long long)s.samples_per_pixel, s.seconds, 100.0 * s.estimated_relative_error,
            s.seconds > 0.0 ? 1e-6 * (double)s.events / s.seconds : 0.0);
-    printf("wrote %s.exr, %s.png, %s.json\n", f.prefix, f.prefix, f.prefix);
+    printf("wrote %s.exr, %s.png, %s.json", f.prefix, f.prefix, f.prefix);
+    if (o.passes & ~DWV_PASS_BIT(DWV_PASS_COMBINED)) printf(", %s.layers.exr", f.prefix);
+    printf("\n");
     exit_code = CLI_OK;
 done:
     dwv_image_release(image);

@@ -1,6 +1,7 @@
 /* The scene file's bake settings, checked against the ranges of dwv_bake_options_t. */
 #include "scenefile/scene_json_internal.h"
 
+#include <stdio.h>
 #include <string.h>
 
 #include "util/error.h"
@@ -42,7 +43,7 @@ dwv_result_t dwvs_read_bake(dwvs_parser *ps, const cJSON *item)
     static const char *const keys[] = {"target",  "width",       "height",  "samples",   "technique",
                                        "channel_walks", "time_limit", "target_error", "seed", "threads",
                                        "max_events", "tile_size", "uv_mesh",     "uv_margin",
-                                       "transparent_background"};
+                                       "transparent_background", "passes"};
     static const char *const targets[] = {"camera", "uv"};
     DWV_TRY(dwvs_check_keys(item, "bake", keys, sizeof keys / sizeof keys[0]));
     dwv_bake_options_t *o = &ps->options;
@@ -91,6 +92,26 @@ dwv_result_t dwvs_read_bake(dwvs_parser *ps, const cJSON *item)
         if (!cJSON_IsBool(transparent))
             return dwvs_fail_at(DWV_ERROR_FORMAT, "bake.transparent_background", "must be true or false");
         o->transparent_background = cJSON_IsTrue(transparent) ? 1 : 0;
+    }
+    const cJSON *passes = dwvs_member(item, "passes");
+    if (passes) {
+        /* Blender's pass names (dwv_pass_from_name), each at most once. */
+        if (!cJSON_IsArray(passes))
+            return dwvs_fail_at(DWV_ERROR_FORMAT, "bake.passes", "must be an array of pass names such as [\"DiffDir\"]");
+        uint32_t mask = 0u;
+        int index = 0;
+        for (const cJSON *entry = passes->child; entry; entry = entry->next, ++index) {
+            char path[48];
+            snprintf(path, sizeof path, "bake.passes[%d]", index);
+            const char *name = NULL;
+            DWV_TRY(dwvs_read_string(entry, path, &name));
+            dwv_pass_t pass;
+            dwv_result_t r = dwv_pass_from_name(name, &pass);
+            if (r != DWV_SUCCESS) return dwvs_prefix_capi(r, path);
+            if (mask & DWV_PASS_BIT(pass)) return dwvs_fail_at(DWV_ERROR_FORMAT, path, "'%s' is listed twice", name);
+            mask |= DWV_PASS_BIT(pass);
+        }
+        o->passes = mask;
     }
 
     const cJSON *uv_mesh = dwvs_member(item, "uv_mesh"), *uv_margin = dwvs_member(item, "uv_margin");

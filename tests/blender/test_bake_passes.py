@@ -2,7 +2,7 @@
 
 A small UV bake (32 x 32, margin 0) of the default smooth sphere (scenes.default_sphere_scene) with
 this Blender's default Principled subsurface material (3.x: Subsurface 0.05, Specular 0.5; 4.x+:
-Weight 1, the dielectric layer) at Roughness 0.5, front-lit by a sun, in a grey world. The
+Weight 1, Scale 1, the dielectric layer) at Roughness 0.5, front-lit by a sun, in a grey world. The
 add-on honours Render > Bake's type and pass filter; for each of
   Diffuse (Direct + Color)   the diffuse and subsurface light,
   Diffuse (Direct)           that light divided by the diffuse colour (Blender's DiffDir),
@@ -58,7 +58,11 @@ CENTRE_CASES = ("glossy_direct_color",)  # per-texel noise against Cycles' unjit
 
 
 def make_scene():
-    scene = scenes.default_sphere_scene(SIZE, scenes.methods()[0], roughness=0.5)
+    # 4.x+: Subsurface Scale 1 (radius 1, 0.2, 0.1 m) keeps every channel above 4.0-4.4's
+    # quarter-footprint rule, which Cycles applies to UV bakes by the texel's footprint and the
+    # library to camera bakes only (docs/blender-compatibility.md).
+    scene = scenes.default_sphere_scene(SIZE, scenes.methods()[0], roughness=0.5,
+                                        amount=1.0 if scenes.blender4() else None)
     scenes.set_world(scene, (0.2, 0.2, 0.2), 1.0)
     sphere = bpy.data.objects["Sphere"]
     image = scenes.bake_image(sphere, (SIZE, SIZE))
