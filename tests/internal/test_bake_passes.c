@@ -1,5 +1,8 @@
 /* Bake passes (dwv_bake_options_t.passes, dwv_image_pass, dwv_image_bake_type,
  * dwv_image_write_exr_layers):
+ *   - the split against an outside reference: a 3.x material's diffuse light under its specular
+ *     layer is the combined image of the same material without the layer (same random numbers),
+ *     its glossy light the difference;
  *   - the parts add up to the combined image, pixel by pixel (camera bakes with misses and a
  *     subsurface object with a specular layer, 3.x and 4.x+ materials; a UV bake);
  *   - asking for passes changes no bit of the combined image, and a bake that asks for none holds
@@ -250,6 +253,41 @@ static void test_colours(void)
     dwv_scene_release(scene);
 }
 
+/* The split against an outside reference: a 3.x material with its specular layer (whose diffuse
+ * lobes keep weight 1 under it) and the same without the layer take the same random numbers, so
+ * the first's diffuse light (DiffDir x DiffCol) is the second's combined image, and its glossy
+ * light the difference of the two combined images, to float rounding. */
+static void test_split_against_no_specular(void)
+{
+    dwv_material_t with = subsurface_material(1), without = with;
+    without.specular = 0.0;
+    dwv_scene_t *a = sphere_scene(&with), *b = sphere_scene(&without);
+    const uint32_t size = 20u;
+    size_t pixels = (size_t)size * size;
+    dwv_image_t *layered = bake(a, DWV_BAKE_CAMERA, size, DWV_PASS_BIT(DWV_PASS_DIFFUSE_DIRECT) | DWV_PASS_BIT(DWV_PASS_GLOSSY_DIRECT), 2u);
+    dwv_image_t *plain = bake(b, DWV_BAKE_CAMERA, size, 0u, 2u);
+    const dwvb_image *l = object(layered), *p = object(plain);
+    const float *diffuse = l->pass_mean + (size_t)dwvb_image_pass_rank(l, DWV_PASS_DIFFUSE_DIRECT) * 3u * pixels;
+    const float *glossy = l->pass_mean + (size_t)dwvb_image_pass_rank(l, DWV_PASS_GLOSSY_DIRECT) * 3u * pixels;
+    double worst_diffuse = 0.0, worst_glossy = 0.0, glossy_sum = 0.0;
+    for (size_t i = 0; i < pixels; ++i) {
+        if (p->rgba[4 * i + 3] != 1.0f) continue; /* every sample met the sphere (misses: the world in Combined) */
+        for (int c = 0; c < 3; ++c) {
+            double plain_value = p->rgba[4 * i + c], layered_value = l->rgba[4 * i + c];
+            worst_diffuse = fmax(worst_diffuse, fabs(diffuse[3 * i + c] - plain_value) / (plain_value + 1e-3));
+            worst_glossy = fmax(worst_glossy, fabs(glossy[3 * i + c] - (layered_value - plain_value)) / (layered_value + 1e-3));
+            glossy_sum += glossy[3 * i + c];
+        }
+    }
+    CHECK(worst_diffuse < 1e-4, "DiffDir of the layered material differs from the unlayered combined image by %.3g", worst_diffuse);
+    CHECK(worst_glossy < 1e-4 && glossy_sum > 0.0, "GlossDir differs from the layer's share of Combined by %.3g (sum %g)",
+          worst_glossy, glossy_sum);
+    dwv_image_release(layered);
+    dwv_image_release(plain);
+    dwv_scene_release(a);
+    dwv_scene_release(b);
+}
+
 static int has_channel(const exr_attr_chlist_t *list, const char *name)
 {
     for (int k = 0; k < list->num_channels; ++k)
@@ -335,6 +373,7 @@ int main(void)
     test_sum_of_parts("4.x camera", scene_v2, DWV_BAKE_CAMERA);
     test_sum_of_parts("3.x UV", scene_v1, DWV_BAKE_UV);
     test_colours();
+    test_split_against_no_specular();
     test_exr_layers(scene_v2);
     test_refusals(scene_v2);
     dwv_scene_release(scene_v1);
