@@ -73,6 +73,18 @@ static void features_text(uint32_t bits, char *out, size_t size)
     }
 }
 
+/* What an EXR of `img` holds (single-layer; the caller sets the layers), its feature names
+ * written into `features`. */
+static dwvo_exr_image exr_image(const dwvb_image *img, char *features, size_t size)
+{
+    features_text(img->stats.features, features, size);
+    const char *technique = dwv_technique_name(img->stats.technique);
+    if (img->stats.samples_per_pixel == 0u) technique = "none"; /* caller-made pixels, not a bake */
+    dwvo_exr_image exr = {img->width, img->height, img->rgba, img->variance, img->samples, &img->stats,
+                          img->error_vs_time, technique ? technique : "unknown", features, 0, 0u, NULL, NULL};
+    return exr;
+}
+
 dwv_result_t dwv_image_write_exr(const dwv_image_t *image, const char *path)
 {
     static const char fn[] = "dwv_image_write_exr";
@@ -80,11 +92,7 @@ dwv_result_t dwv_image_write_exr(const dwv_image_t *image, const char *path)
     DWV_TRY(check_path(fn, path));
     const dwvb_image *img = dwv_image_object(image);
     char features[512];
-    features_text(img->stats.features, features, sizeof features);
-    const char *technique = dwv_technique_name(img->stats.technique);
-    if (img->stats.samples_per_pixel == 0u) technique = "none"; /* caller-made pixels, not a bake */
-    dwvo_exr_image exr = {img->width, img->height, img->rgba, img->variance, img->samples, &img->stats,
-                          img->error_vs_time, technique ? technique : "unknown", features, 0, 0u, NULL, NULL};
+    dwvo_exr_image exr = exr_image(img, features, sizeof features);
     char message[512];
     return io_result(fn, dwvo_write_exr(&exr, path, message, sizeof message), message);
 }
@@ -96,9 +104,7 @@ dwv_result_t dwv_image_write_exr_layers(const dwv_image_t *image, const char *pa
     DWV_TRY(check_path(fn, path));
     const dwvb_image *img = dwv_image_object(image);
     char features[512];
-    features_text(img->stats.features, features, sizeof features);
-    const char *technique = dwv_technique_name(img->stats.technique);
-    if (img->stats.samples_per_pixel == 0u) technique = "none";
+    dwvo_exr_image exr = exr_image(img, features, sizeof features);
     /* Each pass as Blender shows it (dwv_image_pass): direct and indirect divided by colour. */
     size_t plane = 3u * (size_t)img->width * img->height;
     const char *names[DWV_PASS_COUNT];
@@ -115,9 +121,10 @@ dwv_result_t dwv_image_write_exr_layers(const dwv_image_t *image, const char *pa
         planes[layers++] = rgb;
     }
     /* Without passes the file is still multilayer, with its one Combined layer. */
-    dwvo_exr_image exr = {img->width, img->height, img->rgba, img->variance, img->samples, &img->stats,
-                          img->error_vs_time, technique ? technique : "unknown", features, 1, layers,
-                          names, (const float *const *)planes};
+    exr.multilayer = 1;
+    exr.layer_count = layers;
+    exr.layer_names = names;
+    exr.layer_rgb = (const float *const *)planes;
     char message[512];
     dwv_result_t result = dwvo_write_exr(&exr, path, message, sizeof message);
     free(pixels);
