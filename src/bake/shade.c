@@ -228,10 +228,22 @@ static double bumped_exit_factor(const void *context, dwvu_vec3 light)
     return f * dwvb_bump_shadowing(e->mode, e->smooth_n, e->n, light);
 }
 
+/* A walk's exit as a point a path scatters at: its shading normal (bumped where a normal map
+ * tilts it) and geometric normal (outward), and its lobe (the Lambertian exit, 3.x Principled's
+ * weight, the bump shadowing). */
+typedef struct exit_point {
+    dwvu_vec3 x, n, ng, smooth_n;
+    double top;
+    int principled_v1;
+    int bump_mode; /* DWV_BUMP_SHADOWING_* where the normal is tilted, else 0 */
+} exit_point;
+
 /* The light a walk gathers where it left mesh `mesh` (exit: its hit), from the sampler's light
- * pairs from `pair` on: the Lambertian exit's (or Blender 3.x Principled's) direct light. */
+ * pairs from `pair` on: the Lambertian exit's (or Blender 3.x Principled's) direct light. The exit
+ * as a scattering point goes to `point` (for a path going on from there). */
 static void exit_light(const dwvb_shader *shader, uint32_t mesh_id, const dwvb_material *material, const dwvw_walk *walk,
-                       const dwvg_hit *exit, const dwvk_sampler *sampler, uint32_t pair, double direct[3])
+                       const dwvg_hit *exit, const dwvk_sampler *sampler, uint32_t pair, double direct[3],
+                       exit_point *point)
 {
     const dwvb_scene *scene = shader->scene;
     const dwvg_mesh *mesh = &scene->meshes[mesh_id];
@@ -249,6 +261,8 @@ static void exit_light(const dwvb_shader *shader, uint32_t mesh_id, const dwvb_m
     double exit_top = dwvg_world_top(&scene->geometry, mesh_id, exit->prim);
     int mode = dwvb_textured_bump_shadowing(scene, mesh_id);
     int tilted = exit_n.x != exit_smooth_n.x || exit_n.y != exit_smooth_n.y || exit_n.z != exit_smooth_n.z;
+    *point = (exit_point){walk->position, exit_n, exit_ng, exit_smooth_n, exit_top, material->principled_v1,
+                          mode && tilted ? mode : DWV_BUMP_SHADOWING_NONE};
     if (mode && tilted) {
         bumped_exit lobe = {exit_n, exit_smooth_n, material->principled_v1, mode};
         dwvl_direct_lobe(&shader->env, walk->position, exit_n, exit_ng, exit_smooth, exit_top, sampler, pair,
@@ -272,8 +286,196 @@ double dwvb_footprint(const dwvb_shader *shader, dwvu_vec3 view, double t)
     return t * 0.5 * (dwvu_length(dx) + dwvu_length(dy));
 }
 
-void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, const dwvk_sampler *sampler,
-                uint32_t pair, uint64_t key_walk, double rgb[3], dwvb_tally *tally)
+#define INV_PI 0.31830988618379067154
+
+/* Where a path stands (Cycles' path state): its bounces so far by kind, and whether one of them
+ * was diffuse (PATH_RAY_DIFFUSE_ANCESTOR). */
+typedef struct path_state {
+    uint32_t bounce, diffuse, glossy, transmission;
+    int diffuse_ancestor;
+} path_state;
+
+/* A path's next segment, sampled at a scattering point: the ray (from the point's offset
+ * origin), the factor f cos / pdf it multiplies the path's throughput by (times what the point
+ * itself weighs, a walk's estimate for an exit), the lobe that scattered it (DWVB_LOBE_*), and
+ * whether it is known to meet nothing (it rises from above the whole world: no ray needed). */
+typedef struct path_ray {
+    dwvu_vec3 origin, direction;
+    double weight[3];
+    int lobe;
+    int clear;
+} path_ray;
+
+/* Cycles' path_state_next for a bounce off `lobe`: counts it, or returns 0 where it would exceed
+ * a limit (Cycles' kernel limits are the scene's + 1 and end a path whose count reaches them;
+ * the path then only looks for emission, which dwivedi's surfaces have not). */
+static int path_state_next(path_state *s, int lobe, const dwvb_light_paths *limits)
+{
+    if (s->bounce + 1u > limits->max_bounces) return 0;
+    if (lobe == DWVB_LOBE_DIFFUSE) {
+        if (s->diffuse + 1u > limits->diffuse) return 0;
+        ++s->diffuse;
+        s->diffuse_ancestor = 1;
+    } else if (lobe == DWVB_LOBE_GLOSSY) {
+        if (s->glossy + 1u > limits->glossy) return 0;
+        ++s->glossy;
+    } else {
+        if (s->transmission + 1u > limits->transmission) return 0;
+        ++s->transmission;
+    }
+    ++s->bounce;
+    return 1;
+}
+
+/* Whether some bounce is left to a path (the lobe it samples is checked after). */
+static int path_can_go_on(const path_state *s, const dwvb_light_paths *limits)
+{
+    return s->bounce < limits->max_bounces && (s->diffuse < limits->diffuse || s->glossy < limits->glossy);
+}
+
+/* Cycles' path_state_continuation_probability at a path's hit after s->bounce bounces: 1 up to
+ * Min Light Bounces + 1 (the kernel's min_bounce), then min(1, sqrt(max channel |throughput|))
+ * (sqrt "to roughly match typical view transform": the same in 3.4, 4.3 and 5.x). */
+static double continuation_probability(const path_state *s, const double throughput[3], const dwvb_light_paths *limits)
+{
+    if (s->bounce <= limits->min_bounces + 1u) return 1.0;
+    double largest = fmax(fabs(throughput[0]), fmax(fabs(throughput[1]), fabs(throughput[2])));
+    return fmin(sqrt(largest), 1.0);
+}
+
+/* A ray from surface point x along unit d leaves from x + epsilon ng; it meets nothing where it
+ * starts above the world's highest point along ng (`top`, dwvg_world_top) and rises (the margin
+ * of direct.c's shadow rays, which leave from the same origin). */
+static void path_ray_from(const dwvb_shader *shader, dwvu_vec3 x, dwvu_vec3 ng, double top, dwvu_vec3 d, path_ray *ray)
+{
+    double eps = shader->scene->geometry.epsilon;
+    ray->origin = dwvu_madd(x, ng, eps);
+    ray->direction = d;
+    ray->clear = 0;
+    if (top < INFINITY && dwvu_dot(d, ng) > 0.0) {
+        double coordinate = fmax(fabs(x.x), fmax(fabs(x.y), fabs(x.z))) + eps;
+        ray->clear = dwvu_dot(ray->origin, ng) > top + 0.25 * eps + 0x1p-19 * coordinate;
+    }
+}
+
+/* The exit's lobe sampled by its cosine (pdf cos / pi): the weight is the lobe's factor beside
+ * 1/pi (1, 3.x Principled's 1 - F_L / 2, the bump shadowing). Directions below the exit's
+ * geometric surface end the path. */
+static int exit_path_ray(const dwvb_shader *shader, const exit_point *e, const double weight[3],
+                         const dwvk_sampler *sampler, uint32_t pair, path_ray *ray)
+{
+    double u[2];
+    dwvk_sampler_pair(sampler, pair, u);
+    double mu = sqrt(u[0]);
+    dwvu_vec3 w = dwvk_direction_about(e->n, mu, 1.0 - mu, 1.0 + mu, u[1]);
+    if (!(dwvu_dot(w, e->ng) > 0.0)) return 0;
+    double f = e->principled_v1 ? dwvb_principled_exit_factor(dwvu_dot(e->n, w)) : 1.0;
+    if (e->bump_mode) f *= dwvb_bump_shadowing(e->bump_mode, e->smooth_n, e->n, w);
+    path_ray_from(shader, e->x, e->ng, e->top, w, ray);
+    for (int c = 0; c < 3; ++c) ray->weight[c] = weight[c] * f;
+    ray->lobe = DWVB_LOBE_DIFFUSE;
+    return 1;
+}
+
+/* How often a surface point's specular layer is sampled against its diffuse lobes (Cycles picks
+ * a closure by its sample weight, the layer's by its albedo): the layer's albedo toward the
+ * viewer (4.x+: 1 - dwvb_specular_layer_weight; 3.x: Schlick's Fresnel of the mean F0); 0 where
+ * there is none or it is a mirror (its BRDF is then not evaluated: DWVB_GGX_MIN_ALPHA2). */
+static double specular_sample_weight(const dwvb_material *m, double cos_view)
+{
+    if (!m->specular || !(m->spec_alpha * m->spec_alpha > DWVB_GGX_MIN_ALPHA2) || !(cos_view > 0.0)) return 0.0;
+    if (m->specular == DWV_SPECULAR_PRINCIPLED_V2) return 1.0 - dwvb_specular_layer_weight(m, cos_view);
+    double f0 = (m->spec_f0[0] + m->spec_f0[1] + m->spec_f0[2]) / 3.0;
+    return f0 + (1.0 - f0) * dwvb_schlick_weight(cos_view);
+}
+
+/* A surface point's lobes sampled as one mixture (Cycles' closure sampling with MIS over the
+ * closures): the specular layer's GGX visible normals reflected (pdf D_wi(h) / (4 wi.h), Heitz
+ * 2018 Eq. 2 and the reflection Jacobian) with probability p_s, the cosine with 1 - p_s; the
+ * weight is the whole BRDF f (surface_factor) times cos over the mixture's pdf; the lobe drawn
+ * names the bounce (glossy or diffuse). */
+static int surface_path_ray(const dwvb_shader *shader, const surface_lobes *s, dwvu_vec3 x, dwvu_vec3 ng, double top,
+                            const dwvk_sampler *sampler, uint32_t pair, path_ray *ray)
+{
+    const dwvb_material *m = s->material;
+    double diffuse = 0.0;
+    for (int c = 0; c < 3; ++c) diffuse += (s->diffuse[c] + m->retro_albedo[c]) / 3.0;
+    double specular = specular_sample_weight(m, s->lobe.cos_view);
+    if (!(diffuse + specular > 0.0)) return 0;
+    double p_specular = specular / (diffuse + specular);
+    double u[2], v[2];
+    dwvk_sampler_pair(sampler, pair, u);
+    dwvk_sampler_pair(sampler, pair + 1u, v);
+    dwvu_frame frame = dwvu_frame_about(s->lobe.n);
+    dwvu_vec3 to_view = s->lobe.to_view;
+    dwvu_vec3 wi = dwvu_v(dwvu_dot(frame.t, to_view), dwvu_dot(frame.s, to_view), dwvu_dot(frame.n, to_view));
+    dwvu_vec3 w;
+    if (v[0] < p_specular) {
+        if (!(wi.z > 0.0)) return 0;
+        dwvu_vec3 h = dwvb_ggx_sample_vndf(wi, m->spec_alpha, u[0], u[1]);
+        dwvu_vec3 wo = dwvu_sub(dwvu_scale(h, 2.0 * dwvu_dot(wi, h)), wi);
+        w = dwvu_add(dwvu_add(dwvu_scale(frame.t, wo.x), dwvu_scale(frame.s, wo.y)), dwvu_scale(frame.n, wo.z));
+        ray->lobe = DWVB_LOBE_GLOSSY;
+    } else {
+        double mu = sqrt(u[0]);
+        w = dwvk_direction_about(s->lobe.n, mu, 1.0 - mu, 1.0 + mu, u[1]);
+        ray->lobe = DWVB_LOBE_DIFFUSE;
+    }
+    double cos_n = dwvu_dot(s->lobe.n, w);
+    if (!(cos_n > 0.0) || !(dwvu_dot(w, ng) > 0.0)) return 0;
+    double pdf = (1.0 - p_specular) * cos_n * INV_PI;
+    if (p_specular > 0.0 && wi.z > 0.0) {
+        dwvu_vec3 wo = dwvu_v(dwvu_dot(frame.t, w), dwvu_dot(frame.s, w), cos_n);
+        dwvu_vec3 h = dwvu_normalize(dwvu_add(wi, wo));
+        double wi_h = dwvu_dot(wi, h);
+        if (wi_h > 0.0 && h.z > 0.0) pdf += p_specular * dwvb_ggx_vndf_pdf(wi, h, m->spec_alpha) / (4.0 * wi_h);
+    }
+    if (!(pdf > 0.0) || !isfinite(pdf)) return 0;
+    double f[3];
+    surface_factor(s, w, f);
+    for (int c = 0; c < 3; ++c) ray->weight[c] = f[c] * INV_PI * cos_n / pdf;
+    path_ray_from(shader, x, ng, top, w, ray);
+    return 1;
+}
+
+/* Whether a subsurface material walks where a path meets it after a diffuse bounce. */
+static int walks_after_diffuse(const dwvb_shader *shader, const dwvb_material *material)
+{
+    if (shader->paths.after_diffuse == DWV_SUBSURFACE_AFTER_DIFFUSE_WALK) return 1;
+    if (shader->paths.after_diffuse == DWV_SUBSURFACE_AFTER_DIFFUSE_LAMBERT) return 0;
+    return material->model >= DWV_SUBSURFACE_MODEL_BLENDER52_RANDOM_WALK;
+}
+
+/* Cycles up to 4.x after a diffuse bounce (bssrdf_setup; 3.x svm_node_closure_bsdf): the walking
+ * channels become diffuse of their subsurface colour, Lambertian, or (3.x Principled) the
+ * Principled diffuse of the mixed colour, retro-reflection included. */
+static void lambert_after_diffuse(const dwvb_material *material, dwvb_material *out)
+{
+    *out = *material;
+    out->subsurface = 0;
+    for (int c = 0; c < 3; ++c)
+        if (material->walk_scale[c] > 0.0) out->diffuse_albedo[c] += material->fallback_albedo[c];
+    if (material->principled_v1) {
+        out->principled_v1 = 0;
+        out->principled_diffuse = 1;
+        for (int c = 0; c < 3; ++c) out->retro_albedo[c] = 0.0;
+    }
+}
+
+/* The pairs a point's paths going on take in its `onward` sampler: two per ray, at fixed places
+ * (the surface's first, then walk j of channel c's at 1 + c + 3 j, the one walk's at 1), so that
+ * whether one ray was made never moves another's numbers. */
+#define ONWARD_PAIRS 2u
+
+/* Shades hit point `hit` seen along `view` by a path in `state` (camera: the camera ray's or the
+ * texel's hit, whose walks may be channel walks and obey the footprint rule): its direct light
+ * into rgb and, where `rays` is not NULL, the rays its lobes and walks' exits send on (at most
+ * 1 + 3 DWVB_MAX_CHANNEL_WALKS; 2 away from the camera), drawn from `onward` from pair
+ * `onward_pair` on. */
+static void shade_point(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, const dwvk_sampler *sampler,
+                        uint32_t pair, uint64_t key_walk, const path_state *state, int camera, double rgb[3],
+                        path_ray *rays, const dwvk_sampler *onward, uint32_t onward_pair, uint32_t *ray_count,
+                        dwvb_tally *tally)
 {
     const dwvb_scene *scene = shader->scene;
     const dwvg_mesh *mesh = &scene->meshes[hit->mesh];
@@ -281,11 +483,16 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
     const dwvb_material *material = &scene->shading[material_id];
     /* Textured inputs: the material as the textures make it here, once, for the surface lobes and
      * for the whole walk from here (Cycles' homogeneous medium from the entry's closure). */
-    dwvb_material textured;
+    dwvb_material textured, lambert;
     if (dwvb_textured_inputs(scene, hit->mesh)) {
         dwvb_textured_material(scene, hit->mesh, hit->prim, hit->u, hit->v, &textured);
         material = &textured;
     }
+    if (material->subsurface && state->diffuse_ancestor && !walks_after_diffuse(shader, material)) {
+        lambert_after_diffuse(material, &lambert);
+        material = &lambert;
+    }
+    *ray_count = 0u;
     rgb[0] = rgb[1] = rgb[2] = 0.0;
     dwvu_vec3 ng = dwvg_geometric_normal(mesh, hit->prim);
     if (ng.x == 0.0 && ng.y == 0.0 && ng.z == 0.0) {
@@ -295,9 +502,10 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
     int ng_flipped = 0;
     if (dwvu_dot(view, ng) > 0.0) {
         /* The back of a face. A diffuse surface is two-sided; a subsurface one is seen from inside
-         * its medium (an open or inside-out mesh): no walk is defined there. */
+         * its medium (an open or inside-out mesh): no walk is defined there (a path that meets
+         * one ends there: the camera's is what the warning is for). */
         if (material->subsurface) {
-            ++tally->warnings;
+            if (camera) ++tally->warnings;
             return;
         }
         ng = dwvu_scale(ng, -1.0);
@@ -321,7 +529,7 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
     double diffuse_albedo[3], keep[3] = {1.0, 1.0, 1.0};
     int walks_left = material->subsurface;
     for (int c = 0; c < 3; ++c) diffuse_albedo[c] = material->diffuse_albedo[c];
-    if (material->subsurface && material->min_footprint > 0.0 && shader->footprint) {
+    if (camera && material->subsurface && material->min_footprint > 0.0 && shader->footprint) {
         double limit = material->min_footprint * dwvb_footprint(shader, view, hit->t);
         walks_left = 0;
         for (int c = 0; c < 3; ++c) {
@@ -342,11 +550,11 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
     /* The layers under a 4.x+ specular keep 1 - its albedo toward the viewer (1 otherwise). */
     double cos_view = -dwvu_dot(n, view);
     double layer = material->specular ? dwvb_specular_layer_weight(material, cos_view) : 1.0;
+    surface_lobes lobes = {material, {n, dwvu_scale(view, -1.0), cos_view, material->roughness}, {0.0, 0.0, 0.0},
+                           bumped, smooth_n};
+    for (int c = 0; c < 3; ++c) lobes.diffuse[c] = layer * diffuse_albedo[c];
     if (material->specular || bumped) {
         /* (A tilted normal's shadowing goes through the general lobe too.) */
-        surface_lobes lobes = {material, {n, dwvu_scale(view, -1.0), cos_view, material->roughness}, {0.0, 0.0, 0.0},
-                               bumped, smooth_n};
-        for (int c = 0; c < 3; ++c) lobes.diffuse[c] = layer * diffuse_albedo[c];
         double surface[3];
         dwvl_direct_rgb(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, surface_factor, &lobes,
                         surface);
@@ -368,6 +576,8 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
         dwvl_direct(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, direct);
         for (int c = 0; c < 3; ++c) rgb[c] += layer * diffuse_albedo[c] * direct[c];
     }
+    /* The surface's lobes send a path on (the same BRDF as their direct light above). */
+    if (rays && surface_path_ray(shader, &lobes, x, ng, top, onward, onward_pair, &rays[*ray_count])) ++*ray_count;
     if (!walks_left) return;
     /* Entry: cosine-weighted about -n, rejected (no contribution, as Cycles) where it would not
      * go below the geometric surface. The pdf cos/pi cancels the diffuse transmission f = 1/pi. */
@@ -393,8 +603,9 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
     uint32_t exit_pair = pair + DWVB_SHADE_PAIRS + light_pairs;
     dwvw_walk walk;
     dwvg_hit exit = {0};
+    exit_point point;
     double direct[3];
-    if (shader->channel_walks && shader->channel_walks[hit->mesh]) {
+    if (camera && shader->channel_walks && shader->channel_walks[hit->mesh]) {
         /* Channel walks: each channel's estimate is its own walk's (its own extinction, albedo and
          * Dwivedi distribution), so no channel's weight carries another's sampling pdf. They
          * share the entry and the pixel's stratified numbers (each channel is stratified over the
@@ -418,8 +629,13 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
                 double share = layer * material->walk_scale[c] / (double)count;
                 if (walk.status == DWVW_TRUNCATED) tally->truncated[c] += walk.weight[0] * share;
                 if (!exited) continue;
-                exit_light(shader, hit->mesh, material, &walk, &exit, sampler, exit_pair, direct);
+                exit_light(shader, hit->mesh, material, &walk, &exit, sampler, exit_pair, direct, &point);
                 rgb[c] += walk.weight[0] * share * direct[c];
+                /* This channel's walk sends a path on in its channel alone. */
+                double weight[3] = {0.0, 0.0, 0.0};
+                weight[c] = walk.weight[0] * share;
+                uint32_t exit_pairs = onward_pair + ONWARD_PAIRS * (1u + (uint32_t)c + 3u * j);
+                if (rays && exit_path_ray(shader, &point, weight, onward, exit_pairs, &rays[*ray_count])) ++*ray_count;
             }
             tally->channel_walks[c] += tally->walks - walks;
             tally->channel_events[c] += tally->events - events;
@@ -430,9 +646,97 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
     int exited = run_walk(shader, hit->mesh, &material->medium, &shader->guides[hit->mesh], hit->prim, x, inward, n,
                           key_walk, sampler, walk_pair, NULL, &walk, &exit, tally);
     int grey = material->medium.channels == 1;
-    if (walk.status == DWVW_TRUNCATED)
+    if (camera && walk.status == DWVW_TRUNCATED)
         for (int c = 0; c < 3; ++c) tally->truncated[c] += walk.weight[grey ? 0 : c] * material->walk_scale[c];
     if (!exited) return;
-    exit_light(shader, hit->mesh, material, &walk, &exit, sampler, exit_pair, direct);
-    for (int c = 0; c < 3; ++c) rgb[c] += keep[c] * layer * walk.weight[grey ? 0 : c] * material->walk_scale[c] * direct[c];
+    exit_light(shader, hit->mesh, material, &walk, &exit, sampler, exit_pair, direct, &point);
+    double weight[3];
+    for (int c = 0; c < 3; ++c) {
+        weight[c] = keep[c] * layer * walk.weight[grey ? 0 : c] * material->walk_scale[c];
+        rgb[c] += weight[c] * direct[c];
+    }
+    if (rays && exit_path_ray(shader, &point, weight, onward, onward_pair + ONWARD_PAIRS, &rays[*ray_count])) ++*ray_count;
+}
+
+/* Salts of the counter-based keys of the paths after the camera vertex: the vertex's sampler,
+ * its walk, the camera vertex's onward rays (any constants; dwvk_mix64 decorrelates them). */
+#define PATH_VERTEX_SALT 0x5851f42d4c957f2dull
+#define PATH_WALK_SALT 0x14057b7ef767814full
+#define PATH_ONWARD_SALT 0xda942042e4dd58b5ull
+/* The pairs of an indirect vertex's sampler: 0 Russian roulette and the choice of ray, from 1 on
+ * the shading (dwvb_shade's layout), its rays from ONWARD_PAIR on (far past both). */
+#define ONWARD_PAIR (1u << 20)
+
+/* Follows a path from its first ray on (the camera vertex in `state`), iteratively: at each hit
+ * Russian roulette (Cycles' continuation probability, dividing the throughput by it), the hit's
+ * direct light (next-event estimation for lights and world, which covers them wholly: no light is
+ * geometry, and a ray that leaves the world adds nothing), then one of the rays its lobes and its
+ * walk's exit send on, chosen in proportion to their mean weights (the chosen one divided by its
+ * probability). `key`: the path's counter-based numbers. */
+static void follow_path(const dwvb_shader *shader, const path_ray *first, path_state state, uint64_t key, double out[3],
+                        dwvb_tally *tally)
+{
+    double throughput[3] = {1.0, 1.0, 1.0};
+    out[0] = out[1] = out[2] = 0.0;
+    path_ray ray = *first;
+    for (uint64_t vertex = 1;; ++vertex) {
+        if (!path_state_next(&state, ray.lobe, &shader->paths)) return;
+        int alive = 0;
+        for (int c = 0; c < 3; ++c) {
+            throughput[c] *= ray.weight[c];
+            alive |= throughput[c] > 0.0;
+        }
+        dwvg_hit hit;
+        if (!alive || ray.clear ||
+            !dwvg_intersect(&shader->scene->geometry, ray.origin, ray.direction, 0.0, INFINITY, &hit))
+            return;
+        uint64_t vertex_key = dwvk_mix64(key ^ (PATH_VERTEX_SALT + vertex));
+        dwvk_sampler sampler = {vertex_key, 0u, 0};
+        double u[2];
+        dwvk_sampler_pair(&sampler, 0u, u);
+        double p = continuation_probability(&state, throughput, &shader->paths);
+        if (p < 1.0) {
+            if (!(u[0] < p)) return;
+            for (int c = 0; c < 3; ++c) throughput[c] /= p;
+        }
+        double direct[3];
+        path_ray rays[2];
+        uint32_t count = 0u;
+        int onward = path_can_go_on(&state, &shader->paths);
+        shade_point(shader, &hit, ray.direction, &sampler, 1u, dwvk_mix64(vertex_key ^ PATH_WALK_SALT), &state, 0, direct,
+                    onward ? rays : NULL, &sampler, ONWARD_PAIR, &count, tally);
+        for (int c = 0; c < 3; ++c) out[c] += throughput[c] * direct[c];
+        if (count == 0u) return;
+        ray = rays[0];
+        if (count == 2u) {
+            double m0 = rays[0].weight[0] + rays[0].weight[1] + rays[0].weight[2];
+            double m1 = rays[1].weight[0] + rays[1].weight[1] + rays[1].weight[2];
+            if (!(m0 + m1 > 0.0)) return;
+            double p0 = m0 / (m0 + m1);
+            double chosen = u[1] < p0 ? p0 : 1.0 - p0;
+            ray = u[1] < p0 ? rays[0] : rays[1];
+            for (int c = 0; c < 3; ++c) ray.weight[c] /= chosen;
+        }
+    }
+}
+
+void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, const dwvk_sampler *sampler,
+                uint32_t pair, uint64_t key_walk, dwvb_shade_parts *parts, dwvb_tally *tally)
+{
+    *parts = (dwvb_shade_parts){0};
+    path_state state = {0u, 0u, 0u, 0u, 0};
+    path_ray rays[1u + 3u * DWVB_MAX_CHANNEL_WALKS];
+    uint32_t count = 0u;
+    /* No ray goes on where the limits leave no bounce: the one-bounce image, bit for bit. */
+    int onward = path_can_go_on(&state, &shader->paths);
+    dwvk_sampler onward_sampler = {dwvk_mix64(key_walk ^ PATH_ONWARD_SALT), 0u, 0};
+    shade_point(shader, hit, view, sampler, pair, key_walk, &state, 1, parts->direct[DWVB_LOBE_DIFFUSE],
+                onward ? rays : NULL, &onward_sampler, 0u, &count, tally);
+    /* Each ray the camera vertex sends on is a path of its own (splitting: each estimates its
+     * lobe's or its walk's share), whose light is indirect light of the lobe that sent it. */
+    for (uint32_t j = 0; j < count; ++j) {
+        double gathered[3];
+        follow_path(shader, &rays[j], state, dwvk_mix64(key_walk ^ (PATH_ONWARD_SALT + 1u + j)), gathered, tally);
+        for (int c = 0; c < 3; ++c) parts->indirect[rays[j].lobe][c] += gathered[c];
+    }
 }

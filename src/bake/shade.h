@@ -3,8 +3,9 @@
  * enter by cosine-weighted diffuse transmission, walk in the mesh's own Embree scene with the
  * step machine of src/walk, leave through a Lambertian exit that gathers direct light and the
  * world. For DWV_SUBSURFACE_EXIT_PRINCIPLED_V1 the exit is weighted by 1 - F_L/2 and a
- * retro-reflection lobe joins the Lambertian one (material.h). One bounce: surfaces do not light
- * each other. */
+ * retro-reflection lobe joins the Lambertian one (material.h). Paths go on after the walk's exit
+ * and after the surface lobes up to Cycles' light-path limits (dwvb_light_paths), with Russian
+ * roulette as Cycles, so that surfaces light each other (indirect light). */
 #ifndef DWV_BAKE_SHADE_H
 #define DWV_BAKE_SHADE_H
 
@@ -14,6 +15,19 @@
 #include "geom/embree.h"
 #include "light/direct.h"
 #include "walk/walk.h"
+
+/* Cycles' light-path limits (scene.cycles: Max Bounces Total, Diffuse, Glossy, Transmission,
+ * Min Light Bounces), counted as Cycles' path_state_next counts them: a reflection off a diffuse
+ * lobe (Lambertian, Principled diffuse, retro-reflection, a walk's exit) is one diffuse and one
+ * total bounce, off the specular layer one glossy and one total bounce; a walk itself is none
+ * (subsurface_bounce does not call path_state_next). A path whose next bounce would exceed a limit
+ * ends there (Cycles then only looks for emission, which no dwivedi surface has). All zero: the
+ * one-bounce image. `after_diffuse`: DWV_SUBSURFACE_AFTER_DIFFUSE_*, what a subsurface surface met
+ * after a diffuse bounce does. */
+typedef struct dwvb_light_paths {
+    uint32_t max_bounces, diffuse, glossy, transmission, min_bounces;
+    int after_diffuse;
+} dwvb_light_paths;
 
 typedef struct dwvb_shader {
     const dwvb_scene *scene;
@@ -30,6 +44,7 @@ typedef struct dwvb_shader {
      * where a channel's variance is worth more walks than its cost (pilot.c). */
     const uint8_t *channel_counts;
     uint32_t max_events;
+    dwvb_light_paths paths;
     /* Camera bakes: the camera ray's footprint at a hit (Cycles' sd->dP, for
      * dwvb_material.min_footprint): 1 perspective (eye, forward, and right / up one pixel apart on
      * the plane at unit distance), 2 orthographic (pixel: a pixel's width); 0 none (UV bakes). */
@@ -72,10 +87,37 @@ typedef struct dwvb_tally {
  * pairs DWVW_PAIRS_PER_EVENT x DWVB_STRATIFIED_EVENTS x j after the first's. */
 #define DWVB_MAX_CHANNEL_WALKS 3u
 
+/* Cycles' light passes (Blender's bake types Diffuse, Glossy, Transmission and Combined's pass
+ * filter); subsurface belongs to Diffuse, as in Cycles 3.0+. */
+enum { DWVB_LOBE_DIFFUSE = 0, DWVB_LOBE_GLOSSY = 1, DWVB_LOBE_TRANSMISSION = 2, DWVB_LOBE_COUNT = 3 };
+
+/* One sample's radiance split as Cycles splits its passes, by the lobe that scattered at the
+ * camera ray's (or the texel's) hit: direct, light from the lights and the world at that
+ * scattering (for a walk: at its exit); indirect, light that scattered at least once more after
+ * it; color, that lobe's weight (albedo) at the hit; emission, the surface's own; environment,
+ * the world seen directly (camera misses). Combined is the sum of direct, indirect, emission and
+ * environment. */
+typedef struct dwvb_shade_parts {
+    double direct[DWVB_LOBE_COUNT][3];
+    double indirect[DWVB_LOBE_COUNT][3];
+    double color[DWVB_LOBE_COUNT][3];
+    double emission[3];
+    double environment[3];
+} dwvb_shade_parts;
+
+static inline void dwvb_shade_parts_combined(const dwvb_shade_parts *parts, double rgb[3])
+{
+    for (int c = 0; c < 3; ++c) {
+        rgb[c] = parts->emission[c] + parts->environment[c];
+        for (int l = 0; l < DWVB_LOBE_COUNT; ++l) rgb[c] += parts->direct[l][c] + parts->indirect[l][c];
+    }
+}
+
 /* The radiance leaving hit point `hit` along -view (view: unit direction of the ray that found
- * it, from the viewer). `sampler` drives entry and light sampling from pair `pair` on, then the
- * walk's first DWVB_STRATIFIED_EVENTS events; key_walk drives the rest of the walk. */
+ * it, from the viewer), into `parts` (zeroed first). `sampler` drives entry and light sampling
+ * from pair `pair` on, then the walk's first DWVB_STRATIFIED_EVENTS events; key_walk drives the
+ * rest of the walk, and (mixed) the paths that go on from there (counter-based numbers). */
 void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, const dwvk_sampler *sampler,
-                uint32_t pair, uint64_t key_walk, double rgb[3], dwvb_tally *tally);
+                uint32_t pair, uint64_t key_walk, dwvb_shade_parts *parts, dwvb_tally *tally);
 
 #endif
