@@ -552,7 +552,8 @@ class _Job:
             channel_walks=settings.channel_walks.lower(), samples=settings.samples, time_limit=settings.time_limit,
             target_error=settings.target_error, threads=settings.threads, seed=settings.seed,
             max_events=settings.walk_event_cap,
-            transparent_background=settings.target == 'CAMERA' and scene.render.film_transparent)
+            transparent_background=settings.target == 'CAMERA' and scene.render.film_transparent,
+            **export.light_paths(scene))
         self.display = display_settings(scene, self.dwivedi)
         self.bake = None
         self.result = None  # the Blender image that holds the result, once finished

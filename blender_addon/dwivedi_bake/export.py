@@ -689,6 +689,27 @@ def world_from_blender(scene: Any, warnings: List[str], render_width: int = 1024
     return out
 
 
+# Blender's defaults of scene.cycles' Light Paths (used where Cycles' settings are absent).
+_LIGHT_PATH_DEFAULTS = {"max_bounces": 12, "diffuse_bounces": 4, "glossy_bounces": 4, "transmission_bounces": 12,
+                        "min_light_bounces": 0}
+
+
+def light_paths(scene: Any, version: Optional[Tuple[int, ...]] = None) -> Dict[str, Any]:
+    """Cycles' Light Paths of the scene (scene.cycles: Max Bounces Total, Diffuse, Glossy,
+    Transmission, Min Light Bounces) as dwivedi.BakeSettings keys, and what a subsurface surface
+    met after a diffuse bounce does in that Blender's Cycles: Lambertian up to 4.x (bssrdf_setup's
+    fallback after a diffuse ancestor), a walk from 5.0 on (multi-bounce random walk)."""
+    if version is None:
+        version = tuple(bpy.app.version) if bpy is not None else (3, 4, 0)
+    cycles = getattr(scene, "cycles", None)
+    out: Dict[str, Any] = {}
+    for key, default in _LIGHT_PATH_DEFAULTS.items():
+        value = getattr(cycles, key, default) if cycles is not None else default
+        out[key] = max(0, min(1024, int(value)))
+    out["subsurface_after_diffuse"] = "walk" if tuple(version) >= (5, 0, 0) else "lambert"
+    return out
+
+
 def render_size(scene: Any) -> Tuple[int, int]:
     """The render resolution times its percentage, as Blender renders it."""
     r = scene.render
