@@ -422,6 +422,13 @@ def spot_falloff(version: Tuple[int, ...]) -> str:
     return "cycles3" if tuple(version) < (4, 0, 0) else "cycles4"
 
 
+def area_power_scale(version: Tuple[int, ...]) -> float:
+    """dwivedi's area light has Cycles 3.x's radiance P / (4 A) (kernel/light/light.h: eval_fac =
+    0.25 invarea); Cycles 4.0 onward gives a Lambertian emitter of power P its radiance P / (pi A)
+    (kernel/light/area.h: eval_fac = M_1_PI_F invarea): the power is scaled by 4 / pi there."""
+    return 4.0 / math.pi if tuple(version) >= (4, 0, 0) else 1.0
+
+
 def _light(obj: Any, matrix: Any, dwivedi: Any, warnings: List[str]) -> Any:
     data = obj.data
     node_color, node_strength = _light_emission(obj, warnings)
@@ -447,7 +454,8 @@ def _light(obj: Any, matrix: Any, dwivedi: Any, warnings: List[str]) -> Any:
         sy = (data.size_y if data.shape in {'RECTANGLE', 'ELLIPSE'} else data.size) * abs(scale[1])
         shape = "disk" if data.shape in {'DISK', 'ELLIPSE'} else "rectangle"
         rigid = _rigid(location, rot)
-        return dwivedi.AreaLight(transform=rigid, size_x=sx, size_y=sy, power=energy, color=color, shape=shape)
+        return dwivedi.AreaLight(transform=rigid, size_x=sx, size_y=sy, power=energy * area_power_scale(bpy.app.version),
+                                 color=color, shape=shape)
     warnings.append(f"light '{obj.name}' of type {data.type} is not supported (left out)")
     return None
 

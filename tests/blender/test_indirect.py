@@ -51,20 +51,22 @@ if os.environ.get("DWIVEDI_INDIRECT_PLANTED") == "one_bounce":
     export.light_paths = one_bounce
 
 
-def blender_light_paths(scene):
-    """Blender's default Light Paths (scenes._reset sets fewer for its one-object scenes)."""
+def empty_scene(resolution, samples):
+    """scenes._reset's Cycles settings with Blender's default Light Paths (it sets fewer for its
+    one-object scenes)."""
+    scene = scenes._reset()
     scene.cycles.max_bounces = 12
     scene.cycles.diffuse_bounces = 4
     scene.cycles.glossy_bounces = 4
     scene.cycles.transmission_bounces = 12
     scene.cycles.min_light_bounces = 0
+    scene.render.resolution_x = scene.render.resolution_y = resolution
+    scene.cycles.samples = samples
+    return scene
 
 
 def torus_scene(resolution, samples):
-    scene = scenes._reset()
-    blender_light_paths(scene)
-    scene.render.resolution_x = scene.render.resolution_y = resolution
-    scene.cycles.samples = samples
+    scene = empty_scene(resolution, samples)
     material = scenes.principled_material("Pale wax", (0.9, 0.85, 0.75), (0.3, 0.2, 0.12), scale=0.1)
     bpy.ops.mesh.primitive_torus_add(major_radius=1.0, minor_radius=0.45, major_segments=48, minor_segments=16)
     torus = bpy.context.active_object
@@ -82,10 +84,7 @@ def torus_scene(resolution, samples):
 
 
 def ground_scene(resolution, samples):
-    scene = scenes._reset()
-    blender_light_paths(scene)
-    scene.render.resolution_x = scene.render.resolution_y = resolution
-    scene.cycles.samples = samples
+    scene = empty_scene(resolution, samples)
     wax = scenes.sss_node_material("Wax", (0.9, 0.6, 0.4), (0.5, 0.25, 0.1), scale=0.3)
     bpy.ops.mesh.primitive_uv_sphere_add(segments=48, ring_count=24, radius=0.6, location=(0.0, 0.0, 0.6))
     sphere = bpy.context.active_object
@@ -101,13 +100,7 @@ def ground_scene(resolution, samples):
 
 def compare(name, build):
     scene = build(RESOLUTION, CYCLES_SAMPLES)
-    c1, tc1 = harness.cycles_render(scene, 1, CYCLES_SAMPLES, WORK / f"{name}_cycles_1.exr")
-    c2, tc2 = harness.cycles_render(scene, 2, CYCLES_SAMPLES, WORK / f"{name}_cycles_2.exr")
-    # Cycles' cap of 256 events per walk (BSSRDF_MAX_BOUNCES), as test_fidelity.py.
-    o1, to1 = harness.dwivedi_bake(scene, 1, DWIVEDI_SAMPLES, WORK / f"{name}_dwivedi_1", 256)
-    o2, to2 = harness.dwivedi_bake(scene, 2, DWIVEDI_SAMPLES, WORK / f"{name}_dwivedi_2", 256)
-    figures = {**harness.compare_two_seeds((c1, c2), (o1, o2)), "cycles_seconds": tc1 + tc2,
-               "cycles_samples": 2 * CYCLES_SAMPLES, "dwivedi_seconds": to1 + to2, "dwivedi_samples": 2 * DWIVEDI_SAMPLES,
+    figures = {**harness.render_and_bake(name, scene, CYCLES_SAMPLES, DWIVEDI_SAMPLES, WORK),
                "resolution": RESOLUTION, "planted": os.environ.get("DWIVEDI_INDIRECT_PLANTED", "")}
     FIGURES[name] = figures
     print(f"\n{name}: " + json.dumps(figures, indent=1), flush=True)
