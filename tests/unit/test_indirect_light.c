@@ -10,6 +10,8 @@
  *   5 standard errors plus 0.05% for the UV sphere's facets (measured: -0.005% to -0.007%). Limited by diffuse_bounces and by max_bounces alike.
  * - Russian roulette is unbiased: 6 bounces with roulette from the second bounce (Cycles' default)
  *   against none (min_light_bounces 1024) within 5 standard errors of the difference.
+ * - Glossy and diffuse bounces limited apart (a limit of 0 for the only kind a scene scatters is
+ *   the one-bounce image, bit for bit).
  * - The same image for 1 and 2 threads with indirect light; no NaN anywhere; bad limits refused. */
 #include <math.h>
 #include <stddef.h>
@@ -211,6 +213,58 @@ static void test_furnace(void)
     dwv_scene_release(scene);
 }
 
+/* Each kind of bounce is counted and limited apart: the furnace's walls made a pure specular
+ * layer (4.x+ Principled, black base colour, IOR 4 at Specular IOR Level 1, roughness 0.3) scatter only glossy bounces, the
+ * Lambertian walls only diffuse ones. A limit of 0 for the kind they scatter leaves the one-bounce
+ * image bit for bit (a path ray is drawn but ends before it is traced); 2 adds light. */
+static void test_bounce_kinds(void)
+{
+    for (int glossy = 0; glossy < 2; ++glossy) {
+        dwv_scene_t *scene;
+        dwv_scene_create(&scene);
+        dwv_material_t wall = DWV_MATERIAL_INIT;
+        wall.kind = DWV_MATERIAL_DIFFUSE;
+        wall.base_color[0] = wall.base_color[1] = wall.base_color[2] = glossy ? 0.0 : ALBEDO;
+        if (glossy) {
+            wall.specular_model = DWV_SPECULAR_PRINCIPLED_V2;
+            wall.specular = 1.0; /* F0 = 2 x ((4 - 1) / (4 + 1))^2 = 0.72: a bright glossy wall */
+            wall.ior = 4.0;
+            wall.roughness = 0.3;
+        }
+        test_mesh sphere = test_sphere(0.0, 0.0, 0.0, 1.0, 24, 48);
+        test_add(scene, &sphere, &wall);
+        test_mesh_free(&sphere);
+        dwv_light_desc_t point = DWV_LIGHT_DESC_INIT;
+        point.kind = DWV_LIGHT_POINT;
+        point.strength = 100.0;
+        point.position[0] = 0.3;
+        point.radius = 0.05;
+        dwv_scene_add_light(scene, &point);
+        dwv_camera_t camera = DWV_CAMERA_INIT;
+        dwv_scene_set_camera(scene, &camera);
+        CHECK(dwv_scene_commit(scene) == DWV_SUCCESS, "commit: %s", dwv_last_error_message());
+        dwv_bake_options_t o = furnace_options(12, 4, 0);
+        o.samples = 64;
+        o.max_bounces = 0;
+        baked one = bake(scene, &o);
+        o.max_bounces = 12;
+        if (glossy) o.glossy_bounces = 0;
+        else o.diffuse_bounces = 0;
+        baked none = bake(scene, &o);
+        if (glossy) o.glossy_bounces = 2;
+        else o.diffuse_bounces = 2;
+        baked two = bake(scene, &o);
+        const char *kind = glossy ? "glossy" : "diffuse";
+        printf("%s walls: one bounce %.6f, %s_bounces 0 %.6f, 2 %.6f +- %.6f\n", kind, one.mean, kind, none.mean, two.mean,
+               two.sigma);
+        CHECK(one.hash == none.hash, "%s walls: %s_bounces 0 is not the one-bounce image", kind, kind);
+        CHECK(two.finite && two.mean > one.mean + 5.0 * hypot(two.sigma, one.sigma), "%s walls: 2 %s bounces add nothing",
+              kind, kind);
+        free(one.rgba), free(none.rgba), free(two.rgba);
+        dwv_scene_release(scene);
+    }
+}
+
 static void test_bad_limits(void)
 {
     dwv_scene_t *scene = furnace();
@@ -230,6 +284,7 @@ int main(void)
 {
     test_one_bounce_kept();
     test_furnace();
+    test_bounce_kinds();
     test_bad_limits();
     return check_report("test_indirect_light");
 }
