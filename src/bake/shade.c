@@ -304,6 +304,7 @@ typedef struct path_ray {
     double weight[3];
     int lobe;
     int clear;
+    int exit; /* sent on from a walk's exit (else from the surface's lobes) */
 } path_ray;
 
 /* Cycles' path_state_next for a bounce off `lobe`: counts it, or returns 0 where it would exceed
@@ -374,6 +375,7 @@ static int exit_path_ray(const dwvb_shader *shader, const exit_point *e, const d
     path_ray_from(shader, e->x, e->ng, e->top, w, ray);
     for (int c = 0; c < 3; ++c) ray->weight[c] = weight[c] * f;
     ray->lobe = DWVB_LOBE_DIFFUSE;
+    ray->exit = 1;
     return 1;
 }
 
@@ -435,6 +437,7 @@ static int surface_path_ray(const dwvb_shader *shader, const surface_lobes *s, d
     surface_factor(s, w, f);
     for (int c = 0; c < 3; ++c) ray->weight[c] = f[c] * INV_PI * cos_n / pdf;
     path_ray_from(shader, x, ng, top, w, ray);
+    ray->exit = 0;
     return 1;
 }
 
@@ -666,6 +669,32 @@ static void shade_point(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec
 /* The pairs of an indirect vertex's sampler: 0 Russian roulette and the choice of ray, from 1 on
  * the shading (dwvb_shade's layout), its rays from ONWARD_PAIR on (far past both). */
 #define ONWARD_PAIR (1u << 20)
+/* The camera vertex's choice among its walks' exits (past their rays' pairs in `onward`). */
+#define ONWARD_CHOICE_PAIR (ONWARD_PAIRS * (1u + 3u * DWVB_MAX_CHANNEL_WALKS))
+
+/* One of rays[0..count) chosen with probability in proportion to its mean weight by uniform u,
+ * its weight divided by that probability (one-sample estimation of their sum); returns 0 where
+ * none has weight. */
+static int choose_ray(const path_ray *rays, uint32_t count, double u, path_ray *chosen)
+{
+    double total = 0.0;
+    for (uint32_t j = 0; j < count; ++j) total += rays[j].weight[0] + rays[j].weight[1] + rays[j].weight[2];
+    if (!(total > 0.0)) return 0;
+    double target = u * total, sum = 0.0;
+    uint32_t pick = count - 1u;
+    for (uint32_t j = 0; j < count; ++j) {
+        sum += rays[j].weight[0] + rays[j].weight[1] + rays[j].weight[2];
+        if (target < sum) {
+            pick = j;
+            break;
+        }
+    }
+    double p = (rays[pick].weight[0] + rays[pick].weight[1] + rays[pick].weight[2]) / total;
+    if (!(p > 0.0)) return 0;
+    *chosen = rays[pick];
+    for (int c = 0; c < 3; ++c) chosen->weight[c] /= p;
+    return 1;
+}
 
 /* Follows a path from its first ray on (the camera vertex in `state`), iteratively: at each hit
  * Russian roulette (Cycles' continuation probability, dividing the throughput by it), the hit's
@@ -706,17 +735,7 @@ static void follow_path(const dwvb_shader *shader, const path_ray *first, path_s
         shade_point(shader, &hit, ray.direction, &sampler, 1u, dwvk_mix64(vertex_key ^ PATH_WALK_SALT), &state, 0, direct,
                     onward ? rays : NULL, &sampler, ONWARD_PAIR, &count, tally);
         for (int c = 0; c < 3; ++c) out[c] += throughput[c] * direct[c];
-        if (count == 0u) return;
-        ray = rays[0];
-        if (count == 2u) {
-            double m0 = rays[0].weight[0] + rays[0].weight[1] + rays[0].weight[2];
-            double m1 = rays[1].weight[0] + rays[1].weight[1] + rays[1].weight[2];
-            if (!(m0 + m1 > 0.0)) return;
-            double p0 = m0 / (m0 + m1);
-            double chosen = u[1] < p0 ? p0 : 1.0 - p0;
-            ray = u[1] < p0 ? rays[0] : rays[1];
-            for (int c = 0; c < 3; ++c) ray.weight[c] /= chosen;
-        }
+        if (count == 0u || !choose_ray(rays, count, u[1], &ray)) return;
     }
 }
 
@@ -732,11 +751,22 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
     dwvk_sampler onward_sampler = {dwvk_mix64(key_walk ^ PATH_ONWARD_SALT), 0u, 0};
     shade_point(shader, hit, view, sampler, pair, key_walk, &state, 1, parts->direct[DWVB_LOBE_DIFFUSE],
                 onward ? rays : NULL, &onward_sampler, 0u, &count, tally);
-    /* Each ray the camera vertex sends on is a path of its own (splitting: each estimates its
-     * lobe's or its walk's share), whose light is indirect light of the lobe that sent it. */
+    /* The surface lobes' ray is a path of its own, and one of the walks' exits' rays (chosen by
+     * their mean weights: channel walks send up to 3 DWVB_MAX_CHANNEL_WALKS, and tracing every one
+     * on cost the report's bowl twice its time per sample) another; each path's light is indirect
+     * light of the lobe that sent it. */
+    path_ray exits[3u * DWVB_MAX_CHANNEL_WALKS], paths[2];
+    uint32_t exit_count = 0u, path_count = 0u;
     for (uint32_t j = 0; j < count; ++j) {
+        if (rays[j].exit) exits[exit_count++] = rays[j];
+        else paths[path_count++] = rays[j];
+    }
+    double u[2];
+    dwvk_sampler_pair(&onward_sampler, ONWARD_CHOICE_PAIR, u);
+    if (exit_count && choose_ray(exits, exit_count, u[0], &paths[path_count])) ++path_count;
+    for (uint32_t j = 0; j < path_count; ++j) {
         double gathered[3];
-        follow_path(shader, &rays[j], state, dwvk_mix64(key_walk ^ (PATH_ONWARD_SALT + 1u + j)), gathered, tally);
-        for (int c = 0; c < 3; ++c) parts->indirect[rays[j].lobe][c] += gathered[c];
+        follow_path(shader, &paths[j], state, dwvk_mix64(key_walk ^ (PATH_ONWARD_SALT + 1u + j)), gathered, tally);
+        for (int c = 0; c < 3; ++c) parts->indirect[paths[j].lobe][c] += gathered[c];
     }
 }
