@@ -379,59 +379,79 @@ static int exit_path_ray(const dwvb_shader *shader, const exit_point *e, const d
     return 1;
 }
 
-/* How often a surface point's specular layer is sampled against its diffuse lobes (Cycles picks
- * a closure by its sample weight, the layer's by its albedo): the layer's albedo toward the
- * viewer (4.x+: 1 - dwvb_specular_layer_weight; 3.x: Schlick's Fresnel of the mean F0); 0 where
- * there is none or it is a mirror (its BRDF is then not evaluated: DWVB_GGX_MIN_ALPHA2). */
-static double specular_sample_weight(const dwvb_material *m, double cos_view)
+double dwvb_surface_specular_probability(const dwvb_material *m, const double diffuse[3], double cos_view)
 {
-    if (!m->specular || !(m->spec_alpha * m->spec_alpha > DWVB_GGX_MIN_ALPHA2) || !(cos_view > 0.0)) return 0.0;
-    if (m->specular == DWV_SPECULAR_PRINCIPLED_V2) return 1.0 - dwvb_specular_layer_weight(m, cos_view);
-    double f0 = (m->spec_f0[0] + m->spec_f0[1] + m->spec_f0[2]) / 3.0;
-    return f0 + (1.0 - f0) * dwvb_schlick_weight(cos_view);
+    double weight = 0.0, specular = 0.0;
+    for (int c = 0; c < 3; ++c) weight += (diffuse[c] + m->retro_albedo[c]) / 3.0;
+    if (m->specular && m->spec_alpha * m->spec_alpha > DWVB_GGX_MIN_ALPHA2 && cos_view > 0.0) {
+        if (m->specular == DWV_SPECULAR_PRINCIPLED_V2) {
+            specular = 1.0 - dwvb_specular_layer_weight(m, cos_view);
+        } else {
+            double f0 = (m->spec_f0[0] + m->spec_f0[1] + m->spec_f0[2]) / 3.0;
+            specular = f0 + (1.0 - f0) * dwvb_schlick_weight(cos_view);
+        }
+    }
+    if (!(weight + specular > 0.0)) return -1.0;
+    return specular / (weight + specular);
 }
 
-/* A surface point's lobes sampled as one mixture (Cycles' closure sampling with MIS over the
- * closures): the specular layer's GGX visible normals reflected (pdf D_wi(h) / (4 wi.h), Heitz
- * 2018 Eq. 2 and the reflection Jacobian) with probability p_s, the cosine with 1 - p_s; the
- * weight is the whole BRDF f (surface_factor) times cos over the mixture's pdf; the lobe drawn
- * names the bounce (glossy or diffuse). */
+/* to_view in the frame about n (z the normal). */
+static dwvu_vec3 local_of(dwvu_frame frame, dwvu_vec3 d)
+{
+    return dwvu_v(dwvu_dot(frame.t, d), dwvu_dot(frame.s, d), dwvu_dot(frame.n, d));
+}
+
+int dwvb_surface_sample(const dwvb_material *m, double p_specular, dwvu_vec3 n, dwvu_vec3 to_view, double u0, double u1,
+                        double choice, dwvu_vec3 *w, int *lobe)
+{
+    if (choice < p_specular) {
+        dwvu_frame frame = dwvu_frame_about(n);
+        dwvu_vec3 wi = local_of(frame, to_view);
+        if (!(wi.z > 0.0)) return 0;
+        dwvu_vec3 h = dwvb_ggx_sample_vndf(wi, m->spec_alpha, u0, u1);
+        dwvu_vec3 wo = dwvu_sub(dwvu_scale(h, 2.0 * dwvu_dot(wi, h)), wi);
+        *w = dwvu_add(dwvu_add(dwvu_scale(frame.t, wo.x), dwvu_scale(frame.s, wo.y)), dwvu_scale(frame.n, wo.z));
+        *lobe = DWVB_LOBE_GLOSSY;
+    } else {
+        double mu = sqrt(u0);
+        *w = dwvk_direction_about(n, mu, 1.0 - mu, 1.0 + mu, u1);
+        *lobe = DWVB_LOBE_DIFFUSE;
+    }
+    return 1;
+}
+
+double dwvb_surface_pdf(const dwvb_material *m, double p_specular, dwvu_vec3 n, dwvu_vec3 to_view, dwvu_vec3 w)
+{
+    double cos_n = dwvu_dot(n, w);
+    if (!(cos_n > 0.0)) return 0.0;
+    double pdf = (1.0 - p_specular) * cos_n * INV_PI;
+    if (p_specular > 0.0) {
+        dwvu_frame frame = dwvu_frame_about(n);
+        dwvu_vec3 wi = local_of(frame, to_view), wo = local_of(frame, w);
+        dwvu_vec3 h = dwvu_normalize(dwvu_add(wi, wo));
+        double wi_h = dwvu_dot(wi, h);
+        if (wi.z > 0.0 && wi_h > 0.0 && h.z > 0.0) pdf += p_specular * dwvb_ggx_vndf_pdf(wi, h, m->spec_alpha) / (4.0 * wi_h);
+    }
+    return pdf;
+}
+
+/* A surface point's path ray from the mixture of its lobes (dwvb_surface_sample); the weight is
+ * the whole BRDF f (surface_factor) times cos over the mixture's pdf; the lobe drawn names the
+ * bounce (glossy or diffuse). */
 static int surface_path_ray(const dwvb_shader *shader, const surface_lobes *s, dwvu_vec3 x, dwvu_vec3 ng, double top,
                             const dwvk_sampler *sampler, uint32_t pair, path_ray *ray)
 {
     const dwvb_material *m = s->material;
-    double diffuse = 0.0;
-    for (int c = 0; c < 3; ++c) diffuse += (s->diffuse[c] + m->retro_albedo[c]) / 3.0;
-    double specular = specular_sample_weight(m, s->lobe.cos_view);
-    if (!(diffuse + specular > 0.0)) return 0;
-    double p_specular = specular / (diffuse + specular);
+    double p_specular = dwvb_surface_specular_probability(m, s->diffuse, s->lobe.cos_view);
+    if (p_specular < 0.0) return 0;
     double u[2], v[2];
     dwvk_sampler_pair(sampler, pair, u);
     dwvk_sampler_pair(sampler, pair + 1u, v);
-    dwvu_frame frame = dwvu_frame_about(s->lobe.n);
-    dwvu_vec3 to_view = s->lobe.to_view;
-    dwvu_vec3 wi = dwvu_v(dwvu_dot(frame.t, to_view), dwvu_dot(frame.s, to_view), dwvu_dot(frame.n, to_view));
     dwvu_vec3 w;
-    if (v[0] < p_specular) {
-        if (!(wi.z > 0.0)) return 0;
-        dwvu_vec3 h = dwvb_ggx_sample_vndf(wi, m->spec_alpha, u[0], u[1]);
-        dwvu_vec3 wo = dwvu_sub(dwvu_scale(h, 2.0 * dwvu_dot(wi, h)), wi);
-        w = dwvu_add(dwvu_add(dwvu_scale(frame.t, wo.x), dwvu_scale(frame.s, wo.y)), dwvu_scale(frame.n, wo.z));
-        ray->lobe = DWVB_LOBE_GLOSSY;
-    } else {
-        double mu = sqrt(u[0]);
-        w = dwvk_direction_about(s->lobe.n, mu, 1.0 - mu, 1.0 + mu, u[1]);
-        ray->lobe = DWVB_LOBE_DIFFUSE;
-    }
+    if (!dwvb_surface_sample(m, p_specular, s->lobe.n, s->lobe.to_view, u[0], u[1], v[0], &w, &ray->lobe)) return 0;
     double cos_n = dwvu_dot(s->lobe.n, w);
     if (!(cos_n > 0.0) || !(dwvu_dot(w, ng) > 0.0)) return 0;
-    double pdf = (1.0 - p_specular) * cos_n * INV_PI;
-    if (p_specular > 0.0 && wi.z > 0.0) {
-        dwvu_vec3 wo = dwvu_v(dwvu_dot(frame.t, w), dwvu_dot(frame.s, w), cos_n);
-        dwvu_vec3 h = dwvu_normalize(dwvu_add(wi, wo));
-        double wi_h = dwvu_dot(wi, h);
-        if (wi_h > 0.0 && h.z > 0.0) pdf += p_specular * dwvb_ggx_vndf_pdf(wi, h, m->spec_alpha) / (4.0 * wi_h);
-    }
+    double pdf = dwvb_surface_pdf(m, p_specular, s->lobe.n, s->lobe.to_view, w);
     if (!(pdf > 0.0) || !isfinite(pdf)) return 0;
     double f[3];
     surface_factor(s, w, f);

@@ -87,6 +87,20 @@ typedef struct dwvb_tally {
  * pairs DWVW_PAIRS_PER_EVENT x DWVB_STRATIFIED_EVENTS x j after the first's. */
 #define DWVB_MAX_CHANNEL_WALKS 3u
 
+/* The mixture a surface point's path rays are drawn from (Cycles picks a closure by its sample
+ * weight and weighs the direction by MIS over all closures): the specular layer's GGX visible
+ * normals reflected (Heitz 2018), pdf D_wi(h) / (4 wi.h) (Eq. 2 there and the reflection's
+ * Jacobian), with probability p_s; the cosine about n, pdf cos / pi, with 1 - p_s. p_s is the
+ * layer's albedo toward the viewer (4.x+: 1 - dwvb_specular_layer_weight; 3.x: Schlick's Fresnel
+ * of the mean F0) against the diffuse lobes' mean weight `diffuse` (+ the retro-reflection's);
+ * 0 where the layer is absent or a mirror (alpha^2 <= DWVB_GGX_MIN_ALPHA2); -1 where nothing
+ * scatters. dwvb_surface_sample draws a direction (uniforms u0, u1 and `choice`) and its lobe
+ * (DWVB_LOBE_*), 0 where none is drawn; dwvb_surface_pdf is the mixture's pdf of any direction. */
+double dwvb_surface_specular_probability(const dwvb_material *m, const double diffuse[3], double cos_view);
+int dwvb_surface_sample(const dwvb_material *m, double p_specular, dwvu_vec3 n, dwvu_vec3 to_view, double u0, double u1,
+                        double choice, dwvu_vec3 *w, int *lobe);
+double dwvb_surface_pdf(const dwvb_material *m, double p_specular, dwvu_vec3 n, dwvu_vec3 to_view, dwvu_vec3 w);
+
 /* Cycles' light passes (Blender's bake types Diffuse, Glossy, Transmission and Combined's pass
  * filter); subsurface belongs to Diffuse, as in Cycles 3.0+. */
 enum { DWVB_LOBE_DIFFUSE = 0, DWVB_LOBE_GLOSSY = 1, DWVB_LOBE_TRANSMISSION = 2, DWVB_LOBE_COUNT = 3 };
