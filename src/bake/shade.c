@@ -304,7 +304,7 @@ typedef struct path_ray {
     double weight[3];
     int lobe;
     int clear;
-    int exit; /* sent on from a walk's exit (else from the surface's lobes) */
+    int exit; /* sent on from a walk's exit: 1 + the channel of a channel walk, 4 the one walk; 0 the lobes */
 } path_ray;
 
 /* Cycles' path_state_next for a bounce off `lobe`: counts it, or returns 0 where it would exceed
@@ -375,7 +375,9 @@ static int exit_path_ray(const dwvb_shader *shader, const exit_point *e, const d
     path_ray_from(shader, e->x, e->ng, e->top, w, ray);
     for (int c = 0; c < 3; ++c) ray->weight[c] = weight[c] * f;
     ray->lobe = DWVB_LOBE_DIFFUSE;
-    ray->exit = 1;
+    ray->exit = 4;
+    for (int c = 0; c < 3; ++c)
+        if (weight[c] > 0.0 && weight[(c + 1) % 3] == 0.0 && weight[(c + 2) % 3] == 0.0) ray->exit = 1 + c;
     return 1;
 }
 
@@ -689,7 +691,8 @@ static void shade_point(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec
 /* The pairs of an indirect vertex's sampler: 0 Russian roulette and the choice of ray, from 1 on
  * the shading (dwvb_shade's layout), its rays from ONWARD_PAIR on (far past both). */
 #define ONWARD_PAIR (1u << 20)
-/* The camera vertex's choice among its walks' exits (past their rays' pairs in `onward`). */
+/* The camera vertex's choices among its walks' exits, one per channel (past their rays' pairs in
+ * `onward`). */
 #define ONWARD_CHOICE_PAIR (ONWARD_PAIRS * (1u + 3u * DWVB_MAX_CHANNEL_WALKS))
 
 /* One of rays[0..count) chosen with probability in proportion to its mean weight by uniform u,
@@ -771,19 +774,25 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
     dwvk_sampler onward_sampler = {dwvk_mix64(key_walk ^ PATH_ONWARD_SALT), 0u, 0};
     shade_point(shader, hit, view, sampler, pair, key_walk, &state, 1, parts->direct[DWVB_LOBE_DIFFUSE],
                 onward ? rays : NULL, &onward_sampler, 0u, &count, tally);
-    /* The surface lobes' ray is a path of its own, and one of the walks' exits' rays (chosen by
-     * their mean weights: channel walks send up to 3 DWVB_MAX_CHANNEL_WALKS, and tracing every one
-     * on cost the report's bowl twice its time per sample) another; each path's light is indirect
-     * light of the lobe that sent it. */
-    path_ray exits[3u * DWVB_MAX_CHANNEL_WALKS], paths[2];
-    uint32_t exit_count = 0u, path_count = 0u;
-    for (uint32_t j = 0; j < count; ++j) {
-        if (rays[j].exit) exits[exit_count++] = rays[j];
-        else paths[path_count++] = rays[j];
+    /* The surface lobes' ray is a path of its own, and so is, per channel of channel walks (or
+     * for the one walk), one of its walks' exits' rays, chosen by their weights where the pilot
+     * gave a channel several walks: tracing all of those cost the report's bowl twice its time
+     * per sample, while one exit for the three channels' walks tripled the torus's variance. Each
+     * path's light is indirect light of the lobe that sent it. */
+    path_ray paths[5];
+    uint32_t path_count = 0u;
+    for (uint32_t j = 0; j < count; ++j)
+        if (!rays[j].exit) paths[path_count++] = rays[j];
+    for (int group = 1; group <= 4; ++group) {
+        path_ray exits[DWVB_MAX_CHANNEL_WALKS];
+        uint32_t exit_count = 0u;
+        for (uint32_t j = 0; j < count; ++j)
+            if (rays[j].exit == group && exit_count < DWVB_MAX_CHANNEL_WALKS) exits[exit_count++] = rays[j];
+        double u[2];
+        dwvk_sampler_pair(&onward_sampler, ONWARD_CHOICE_PAIR + (uint32_t)group, u);
+        if (exit_count == 1u) paths[path_count++] = exits[0];
+        else if (exit_count && choose_ray(exits, exit_count, u[0], &paths[path_count])) ++path_count;
     }
-    double u[2];
-    dwvk_sampler_pair(&onward_sampler, ONWARD_CHOICE_PAIR, u);
-    if (exit_count && choose_ray(exits, exit_count, u[0], &paths[path_count])) ++path_count;
     for (uint32_t j = 0; j < path_count; ++j) {
         double gathered[3];
         follow_path(shader, &paths[j], state, dwvk_mix64(key_walk ^ (PATH_ONWARD_SALT + 1u + j)), gathered, tally);
