@@ -138,22 +138,20 @@ static void test_one_bounce_kept(void)
 
 #define ALBEDO 0.6
 
-/* The inside of a sphere (radius 1, albedo ALBEDO, Lambertian) around a point light at its centre,
- * seen from the centre toward +x. */
-static dwv_scene_t *furnace(void)
+/* The inside of a sphere (radius 1, `rings` x 2 `rings` quads) of material `wall` around a point
+ * light at (light_x, 0, 0) of radius light_radius, seen from the centre toward +x. */
+static dwv_scene_t *sphere_room(const dwv_material_t *wall, uint32_t rings, double light_x, double light_radius)
 {
     dwv_scene_t *scene;
     dwv_scene_create(&scene);
-    dwv_material_t wall = DWV_MATERIAL_INIT;
-    wall.kind = DWV_MATERIAL_DIFFUSE;
-    wall.base_color[0] = wall.base_color[1] = wall.base_color[2] = ALBEDO;
-    test_mesh sphere = test_sphere(0.0, 0.0, 0.0, 1.0, 48, 96);
-    test_add(scene, &sphere, &wall);
+    test_mesh sphere = test_sphere(0.0, 0.0, 0.0, 1.0, rings, 2u * rings);
+    test_add(scene, &sphere, wall);
     test_mesh_free(&sphere);
     dwv_light_desc_t point = DWV_LIGHT_DESC_INIT;
     point.kind = DWV_LIGHT_POINT;
     point.strength = 100.0;
-    point.radius = 0.01;
+    point.position[0] = light_x;
+    point.radius = light_radius;
     dwv_scene_add_light(scene, &point);
     dwv_camera_t camera = DWV_CAMERA_INIT;
     /* camera -z toward world +x */
@@ -162,6 +160,15 @@ static dwv_scene_t *furnace(void)
     dwv_scene_set_camera(scene, &camera);
     CHECK(dwv_scene_commit(scene) == DWV_SUCCESS, "commit: %s", dwv_last_error_message());
     return scene;
+}
+
+/* The furnace: Lambertian walls of albedo ALBEDO, the light at the centre. */
+static dwv_scene_t *furnace(void)
+{
+    dwv_material_t wall = DWV_MATERIAL_INIT;
+    wall.kind = DWV_MATERIAL_DIFFUSE;
+    wall.base_color[0] = wall.base_color[1] = wall.base_color[2] = ALBEDO;
+    return sphere_room(&wall, 48, 0.0, 0.01);
 }
 
 static dwv_bake_options_t furnace_options(uint32_t max, uint32_t diffuse, uint32_t min_light)
@@ -214,14 +221,12 @@ static void test_furnace(void)
 }
 
 /* Each kind of bounce is counted and limited apart: the furnace's walls made a pure specular
- * layer (4.x+ Principled, black base colour, IOR 4 at Specular IOR Level 1, roughness 0.3) scatter only glossy bounces, the
- * Lambertian walls only diffuse ones. A limit of 0 for the kind they scatter leaves the one-bounce
+ * layer (4.x+ Principled, black base colour, IOR 4 at Specular IOR Level 1, roughness 0.3)
+ * scatter only glossy bounces, the Lambertian walls only diffuse ones. A limit of 0 for the kind they scatter leaves the one-bounce
  * image bit for bit (a path ray is drawn but ends before it is traced); 2 adds light. */
 static void test_bounce_kinds(void)
 {
     for (int glossy = 0; glossy < 2; ++glossy) {
-        dwv_scene_t *scene;
-        dwv_scene_create(&scene);
         dwv_material_t wall = DWV_MATERIAL_INIT;
         wall.kind = DWV_MATERIAL_DIFFUSE;
         wall.base_color[0] = wall.base_color[1] = wall.base_color[2] = glossy ? 0.0 : ALBEDO;
@@ -231,18 +236,7 @@ static void test_bounce_kinds(void)
             wall.ior = 4.0;
             wall.roughness = 0.3;
         }
-        test_mesh sphere = test_sphere(0.0, 0.0, 0.0, 1.0, 24, 48);
-        test_add(scene, &sphere, &wall);
-        test_mesh_free(&sphere);
-        dwv_light_desc_t point = DWV_LIGHT_DESC_INIT;
-        point.kind = DWV_LIGHT_POINT;
-        point.strength = 100.0;
-        point.position[0] = 0.3;
-        point.radius = 0.05;
-        dwv_scene_add_light(scene, &point);
-        dwv_camera_t camera = DWV_CAMERA_INIT;
-        dwv_scene_set_camera(scene, &camera);
-        CHECK(dwv_scene_commit(scene) == DWV_SUCCESS, "commit: %s", dwv_last_error_message());
+        dwv_scene_t *scene = sphere_room(&wall, 24, 0.3, 0.05);
         dwv_bake_options_t o = furnace_options(12, 4, 0);
         o.samples = 64;
         o.max_bounces = 0;
