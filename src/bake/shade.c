@@ -397,7 +397,7 @@ double dwvb_surface_specular_probability(const dwvb_material *m, const double di
     return specular / (weight + specular);
 }
 
-/* to_view in the frame about n (z the normal). */
+/* Direction d in `frame` (z its normal). */
 static dwvu_vec3 local_of(dwvu_frame frame, dwvu_vec3 d)
 {
     return dwvu_v(dwvu_dot(frame.t, d), dwvu_dot(frame.s, d), dwvu_dot(frame.n, d));
