@@ -904,6 +904,16 @@ enum {
 DWV_API const char *dwv_channel_walks_name(dwv_channel_walks_t channel_walks);
 DWV_API dwv_result_t dwv_channel_walks_from_name(const char *name, dwv_channel_walks_t *channel_walks);
 
+/* What a subsurface surface that a path meets after a diffuse bounce does (issue 18). Cycles up
+ * to 4.x makes it a Lambertian surface of the walk's colour there (bssrdf_setup: "always fall back
+ * to diffuse after a diffuse ancestor"); 5.0 and later walk it (multi-bounce random walk). */
+typedef enum dwv_subsurface_after_diffuse_t {
+    /* by each material's subsurface_model: the BLENDER52_* models walk, the others fall back */
+    DWV_SUBSURFACE_AFTER_DIFFUSE_BY_MODEL = 0,
+    DWV_SUBSURFACE_AFTER_DIFFUSE_LAMBERT = 1,  /* Cycles 3.x, 4.x */
+    DWV_SUBSURFACE_AFTER_DIFFUSE_WALK = 2      /* Cycles 5.0+ */
+} dwv_subsurface_after_diffuse_t;
+
 typedef struct dwv_bake_options_t {
     uint32_t struct_size;     /* sizeof(dwv_bake_options_t): set by DWV_BAKE_OPTIONS_INIT */
     dwv_bake_target_t target;
@@ -943,10 +953,24 @@ typedef struct dwv_bake_options_t {
      * in the image. */
     uint32_t passes;
     uint32_t reserved2;       /* 0 */
+    /* Added after 0.3 (issue 18; a caller whose struct_size ends before them gets 0s: the one-bounce
+     * image it always got). Indirect light as Cycles' Light Paths (Blender's scene.cycles
+     * max_bounces, diffuse_bounces, glossy_bounces, transmission_bounces, min_light_bounces):
+     * a path goes on after a walk's exit and after the diffuse and specular lobes of a surface,
+     * until its bounces of that kind or in total would exceed their limit, each 0 to 1024; after
+     * min_light_bounces + 1 bounces, Russian roulette as Cycles (continuation probability
+     * min(1, sqrt(max channel of the path's throughput))). max_bounces = 0: the one-bounce
+     * image, bit for bit. dwivedi's materials have no transmission lobe (a walk's entry is no
+     * transmission bounce in Cycles either): transmission_bounces never limits a path today. */
+    uint32_t max_bounces, diffuse_bounces, glossy_bounces, transmission_bounces;
+    uint32_t min_light_bounces;
+    dwv_subsurface_after_diffuse_t subsurface_after_diffuse; /* DWV_SUBSURFACE_AFTER_DIFFUSE_* */
 } dwv_bake_options_t;
+/* Blender's default Light Paths (12 total, 4 diffuse, 4 glossy, 12 transmission, min 0). */
 #define DWV_BAKE_OPTIONS_INIT                                                                       \
     {sizeof(dwv_bake_options_t), DWV_BAKE_CAMERA, 256u, 256u, 0u, 16u, DWV_TECHNIQUE_AUTO, 64u, 0.0,  \
-     0.0, 0u, 0u, 0u, 0u, 0u, NULL, NULL, 0u, 0u, 0, 0u, 0u, 0u}
+     0.0, 0u, 0u, 0u, 0u, 0u, NULL, NULL, 0u, 0u, 0, 0u, 0u, 0u, 12u, 4u, 4u, 12u, 0u,                \
+     DWV_SUBSURFACE_AFTER_DIFFUSE_BY_MODEL}
 
 /* Bake passes as Cycles' (Blender's render passes and its bake types' pass filter). Direct:
  * light from the lights and the world at the first scattering, the one at the camera ray's hit

@@ -320,6 +320,10 @@ def mesh_of(name: str) -> Tuple[List[Vec], List[Tri], bool]:
     return points, tris, smooth
 
 
+# The light paths of build()'s Blender scenes (tests/blender/scenes.py's _reset), for the scene files.
+LIGHT_PATHS = {"max_bounces": 4, "diffuse_bounces": 4, "glossy_bounces": 0, "transmission_bounces": 0}
+
+
 def scene_json(name: str, size: int, samples: int) -> Dict:
     """The scene as a scene file (docs/scene-format.md)."""
     s = SCENES[name]
@@ -347,7 +351,7 @@ def scene_json(name: str, size: int, samples: int) -> Dict:
             "meshes": [mesh], "lights": lights, "world": {"color": list(color), "strength": strength},
             "camera": {"kind": "perspective", "focal_length": 50.0, "sensor_width": 36.0,
                        "transform": {"look_at": {"eye": list(eye), "target": list(target)}}},
-            "bake": {"width": size, "height": size, "samples": samples}}
+            "bake": {"width": size, "height": size, "samples": samples, **LIGHT_PATHS}}
 
 
 def build(name: str, resolution: int = 48, samples: int = 64):
@@ -362,11 +366,10 @@ def build(name: str, resolution: int = 48, samples: int = 64):
     scene.render.resolution_x = resolution
     scene.render.resolution_y = resolution
     scene.cycles.samples = samples
-    # No diffuse bounce after the walk's exit: dwivedi bakes camera -> entry -> walk -> exit ->
-    # light, and on the concave scenes (bowl, torus) Cycles' light reflected from one part of the
-    # surface onto another would be light dwivedi does not bake (the bowl was 17% brighter in
-    # Cycles with 4 diffuse bounces, within the noise of dwivedi's image with none).
-    scene.cycles.diffuse_bounces = 0
+    # Light paths: tests/blender/scenes.py's (4 total, 4 diffuse, no glossy or transmission), which
+    # the add-on passes to dwivedi too (export.light_paths): on the concave scenes (bowl, torus)
+    # both renderers bake the light one part of the surface reflects onto another (indirect light,
+    # issue 18; before it Cycles ran with diffuse_bounces 0 here, the bowl being 17% brighter with 4).
     points, tris, smooth = mesh_of(name)
     mesh = bpy.data.meshes.new(name)
     mesh.from_pydata(points, [], tris)

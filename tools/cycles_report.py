@@ -252,11 +252,13 @@ for name in args["scenes_list"]:
     entry = {"reference_samples": ref_spp, "reference_seconds": ref_seconds, "sync_seconds": overhead,
              "repeats": args["repeats"], "cycles": [], "dwivedi": []}
     exported = export.export_scene(bpy.context, Props, dwivedi)
+    # Both renderers with the scene's Light Paths (indirect light, issue 18).
+    paths = export.light_paths(scene)
     # dwivedi's own converged image (4x its largest count, another seed): its noise is measured
     # against it, as Cycles' is against Cycles' own; the two converged images are compared apart.
     own_spp = 4 * args["dwivedi_counts"][-1]
     own = dwivedi.bake(exported.scene, width=exported.width, height=exported.height, samples=own_spp, threads=2,
-                       seed=1234)
+                       seed=1234, **paths)
     own_ref = flip(list(own.pixels()), own.width, own.height)
     entry["dwivedi_reference_samples"] = own_spp
     entry["dwivedi_reference_seconds"] = own.stats.seconds
@@ -277,7 +279,7 @@ for name in args["scenes_list"]:
                 entry["cycles"][i]["render_seconds"] = min(entry["cycles"][i]["render_seconds"], seconds)
         for i, spp in enumerate(args["dwivedi_counts"]):
             image = dwivedi.bake(exported.scene, width=exported.width, height=exported.height, samples=spp,
-                                 threads=2, seed=7)
+                                 threads=2, seed=7, **paths)
             if turn == 0:
                 ours = flip(list(image.pixels()), image.width, image.height)
                 n = len(ours) // 4

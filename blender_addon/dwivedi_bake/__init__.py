@@ -567,7 +567,8 @@ class _Job:
             target_error=settings.target_error, threads=settings.threads, seed=settings.seed,
             max_events=settings.walk_event_cap,
             transparent_background=settings.target == 'CAMERA' and scene.render.film_transparent,
-            passes=self.passes)
+            passes=self.passes,
+            **export.light_paths(scene))
         self.display = display_settings(scene, self.dwivedi)
         self.bake = None
         self.result = None  # the Blender image that holds the result, once finished

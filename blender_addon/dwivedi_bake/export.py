@@ -422,6 +422,13 @@ def spot_falloff(version: Tuple[int, ...]) -> str:
     return "cycles3" if tuple(version) < (4, 0, 0) else "cycles4"
 
 
+def area_power_scale(version: Tuple[int, ...]) -> float:
+    """dwivedi's area light has Cycles 3.x's radiance P / (4 A) (kernel/light/light.h: eval_fac =
+    0.25 invarea); Cycles 4.0 onward gives a Lambertian emitter of power P its radiance P / (pi A)
+    (kernel/light/area.h: eval_fac = M_1_PI_F invarea): the power is scaled by 4 / pi there."""
+    return 4.0 / math.pi if tuple(version) >= (4, 0, 0) else 1.0
+
+
 def _light(obj: Any, matrix: Any, dwivedi: Any, warnings: List[str]) -> Any:
     data = obj.data
     node_color, node_strength = _light_emission(obj, warnings)
@@ -447,7 +454,8 @@ def _light(obj: Any, matrix: Any, dwivedi: Any, warnings: List[str]) -> Any:
         sy = (data.size_y if data.shape in {'RECTANGLE', 'ELLIPSE'} else data.size) * abs(scale[1])
         shape = "disk" if data.shape in {'DISK', 'ELLIPSE'} else "rectangle"
         rigid = _rigid(location, rot)
-        return dwivedi.AreaLight(transform=rigid, size_x=sx, size_y=sy, power=energy, color=color, shape=shape)
+        return dwivedi.AreaLight(transform=rigid, size_x=sx, size_y=sy, power=energy * area_power_scale(bpy.app.version),
+                                 color=color, shape=shape)
     warnings.append(f"light '{obj.name}' of type {data.type} is not supported (left out)")
     return None
 
@@ -686,6 +694,27 @@ def world_from_blender(scene: Any, warnings: List[str], render_width: int = 1024
         "the world's nodes are not an Environment Texture dwivedi reads as it is"
     warnings.append(f"{what}: Cycles rendered the world into a {out.width} x {out.height} equirectangular image, "
                     "which is baked (World Resolution sets its width)")
+    return out
+
+
+# Blender's defaults of scene.cycles' Light Paths (used where Cycles' settings are absent).
+_LIGHT_PATH_DEFAULTS = {"max_bounces": 12, "diffuse_bounces": 4, "glossy_bounces": 4, "transmission_bounces": 12,
+                        "min_light_bounces": 0}
+
+
+def light_paths(scene: Any, version: Optional[Tuple[int, ...]] = None) -> Dict[str, Any]:
+    """Cycles' Light Paths of the scene (scene.cycles: Max Bounces Total, Diffuse, Glossy,
+    Transmission, Min Light Bounces) as dwivedi.BakeSettings keys, and what a subsurface surface
+    met after a diffuse bounce does in that Blender's Cycles: Lambertian up to 4.x (bssrdf_setup's
+    fallback after a diffuse ancestor), a walk from 5.0 on (multi-bounce random walk)."""
+    if version is None:
+        version = tuple(bpy.app.version) if bpy is not None else (3, 4, 0)
+    cycles = getattr(scene, "cycles", None)
+    out: Dict[str, Any] = {}
+    for key, default in _LIGHT_PATH_DEFAULTS.items():
+        value = getattr(cycles, key, default) if cycles is not None else default
+        out[key] = max(0, min(1024, int(value)))
+    out["subsurface_after_diffuse"] = "walk" if tuple(version) >= (5, 0, 0) else "lambert"
     return out
 
 

@@ -300,6 +300,12 @@ class BakeOptions(_SizedStructure):
         ("reserved", ctypes.c_uint32),
         ("passes", ctypes.c_uint32),
         ("reserved2", ctypes.c_uint32),
+        ("max_bounces", ctypes.c_uint32),
+        ("diffuse_bounces", ctypes.c_uint32),
+        ("glossy_bounces", ctypes.c_uint32),
+        ("transmission_bounces", ctypes.c_uint32),
+        ("min_light_bounces", ctypes.c_uint32),
+        ("subsurface_after_diffuse", ctypes.c_int32),
     ]
 
     def __init__(self) -> None:
@@ -308,6 +314,10 @@ class BakeOptions(_SizedStructure):
         self.height = 256
         self.uv_margin = 16
         self.samples = 64
+        self.max_bounces = 12
+        self.diffuse_bounces = 4
+        self.glossy_bounces = 4
+        self.transmission_bounces = 12
 
 
 class ImageInfo(_SizedStructure):

@@ -430,6 +430,8 @@ def bake_type_passes(bake_type: str, pass_filter: Any) -> Tuple[str, ...]:
     return _pass_names(mask.value)
 # dwv_channel_walks_t: how walks carry the colour channels (capi/dwivedi.h)
 _CHANNEL_WALKS = {"auto": 0, "shared": 1, "separate": 2}
+# dwv_subsurface_after_diffuse_t: a subsurface surface met after a diffuse bounce
+_AFTER_DIFFUSE = {"by_model": 0, "lambert": 1, "walk": 2}
 
 
 @dataclass
@@ -465,6 +467,15 @@ class BakeSettings:
     # Bake passes beside the combined image, by Blender's names (PASS_NAMES; docs/output.md):
     # ("DiffDir", "DiffCol") and so on. A direct or indirect pass brings its colour.
     passes: Tuple[str, ...] = ()
+    # Indirect light as Cycles' Light Paths (Blender's defaults; max_bounces 0: one bounce, the
+    # image of before indirect light). subsurface_after_diffuse: "by_model" (the blender52_*
+    # models walk, the others turn Lambertian, as Cycles 3.x/4.x), "lambert" or "walk" (5.0+).
+    max_bounces: int = 12
+    diffuse_bounces: int = 4
+    glossy_bounces: int = 4
+    transmission_bounces: int = 12
+    min_light_bounces: int = 0
+    subsurface_after_diffuse: str = "by_model"
 
     def _to_c(self) -> _library.BakeOptions:
         out = _library.BakeOptions()
@@ -488,6 +499,13 @@ class BakeSettings:
             raise TypeError(f"transparent_background must be True or False, not {type(self.transparent_background).__name__}")
         out.transparent_background = int(self.transparent_background)
         out.passes = _pass_mask(self.passes)
+        out.max_bounces = _uint("max_bounces", self.max_bounces)
+        out.diffuse_bounces = _uint("diffuse_bounces", self.diffuse_bounces)
+        out.glossy_bounces = _uint("glossy_bounces", self.glossy_bounces)
+        out.transmission_bounces = _uint("transmission_bounces", self.transmission_bounces)
+        out.min_light_bounces = _uint("min_light_bounces", self.min_light_bounces)
+        out.subsurface_after_diffuse = _name_code("subsurface_after_diffuse", self.subsurface_after_diffuse,
+                                                  _AFTER_DIFFUSE)
         return out
 
     @classmethod
@@ -498,6 +516,10 @@ class BakeSettings:
                    max_events=c.max_events, seed=c.seed, tile_size=c.tile_size,
                    sample_first=c.sample_first, sample_count=c.sample_count,
                    transparent_background=bool(c.transparent_background), passes=_pass_names(c.passes),
+                   max_bounces=c.max_bounces, diffuse_bounces=c.diffuse_bounces, glossy_bounces=c.glossy_bounces,
+                   transmission_bounces=c.transmission_bounces, min_light_bounces=c.min_light_bounces,
+                   subsurface_after_diffuse={v: k for k, v in _AFTER_DIFFUSE.items()}.get(
+                       c.subsurface_after_diffuse, str(c.subsurface_after_diffuse)),
                    channel_walks={v: k for k, v in _CHANNEL_WALKS.items()}.get(c.channel_walks, str(c.channel_walks)))
 
 

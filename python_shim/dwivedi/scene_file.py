@@ -10,7 +10,8 @@ it to its export in place of dwivedi.Scene.
 
     writer = SceneFileWriter()
     writer.add_material(Material(...)); writer.add_mesh(positions, indices, 0); ...
-    writer.write("scene.json", bake={"width": 640, "height": 360, "samples": 256})
+    writer.write("scene.json", bake={"width": 640, "height": 360, "samples": 256,
+                                     **light_path_keys(BakeSettings(max_bounces=8))})
 
 Meshes are written inline, so a scene file holds at most the 2^22 JSON values the reader takes;
 write() refuses a larger scene with a message (too big for a file without mesh files).
@@ -26,8 +27,8 @@ from typing import Any, Dict, List, Optional
 
 from ._buffers import as_c_array, real_tuple, transform12
 from . import _library
-from .baker import (SPECULAR_MODELS, SUBSURFACE_MODELS, AreaLight, Camera, Error, Material, PointLight, SpotLight,
-                    SunLight)
+from .baker import (SPECULAR_MODELS, SUBSURFACE_MODELS, AreaLight, BakeSettings, Camera, Error, Material, PointLight,
+                    SpotLight, SunLight)
 
 MAX_JSON_VALUES = 1 << 22  # docs/scene-format.md: "at most 2^22 JSON values"
 _RADIANS_PER_DEGREE = 3.14159265358979323846 / 180.0  # as src/scenefile/scene_json_lights.c
@@ -52,6 +53,17 @@ def degrees_for(radians: float) -> float:
         if candidate * _RADIANS_PER_DEGREE == radians:
             return candidate
     return d  # no double maps back exactly (not seen): the nearest
+
+
+LIGHT_PATH_KEYS = ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces", "min_light_bounces",
+                   "subsurface_after_diffuse")
+
+
+def light_path_keys(settings: BakeSettings) -> Dict[str, Any]:
+    """The "bake" keys of a BakeSettings' light paths (docs/scene-format.md), checked as the
+    library will check them (dwivedi.Error where a value is out of range)."""
+    settings._to_c()  # the same checks as a bake's
+    return {key: getattr(settings, key) for key in LIGHT_PATH_KEYS}
 
 
 class SceneFileWriter:

@@ -23,6 +23,7 @@
 #define SMALLEST_DEFAULT_TILE 8u
 #define TILES_PER_THREAD 16u /* enough that the last tiles of a pass even out between workers */
 #define DEFAULT_MAX_EVENTS 1000000u
+#define MAX_BOUNCES 1024u /* Blender's Light Paths fields stop there */
 
 static const char *const channel_walks_names[] = {"auto", "shared", "separate"};
 #define CHANNEL_WALKS_COUNT ((uint32_t)(sizeof channel_walks_names / sizeof channel_walks_names[0]))
@@ -95,6 +96,18 @@ static dwv_result_t check_options(const char *fn, const dwvb_scene *s, const dwv
         return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
                         "%s: a chunk of a split bake (sample_count > 0) cannot bake passes (passes = 0x%x): partial "
                         "files carry the combined image's sums only; bake the passes whole", fn, o->passes);
+    const uint32_t limits[] = {o->max_bounces, o->diffuse_bounces, o->glossy_bounces, o->transmission_bounces,
+                               o->min_light_bounces};
+    static const char *const limit_names[] = {"max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces",
+                                              "min_light_bounces"};
+    for (int i = 0; i < 5; ++i)
+        if (limits[i] > MAX_BOUNCES)
+            return dwv_fail(DWV_ERROR_OUT_OF_RANGE, "%s: %s = %u is above %u (Blender's largest)", fn, limit_names[i],
+                            limits[i], MAX_BOUNCES);
+    if (o->subsurface_after_diffuse > DWV_SUBSURFACE_AFTER_DIFFUSE_WALK)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
+                        "%s: subsurface_after_diffuse %u is not known (0 by model, 1 Lambert, 2 walk)", fn,
+                        (unsigned)o->subsurface_after_diffuse);
     DWV_TRY(dwv_check_range(fn, "time_limit", o->time_limit, 0.0, HUGE_VAL));
     DWV_TRY(dwv_check_range(fn, "target_error", o->target_error, 0.0, HUGE_VAL));
     if (o->threads > MAX_THREADS)

@@ -208,6 +208,14 @@ uint64_t dwv_options_hash(const dwv_bake_options_t *o)
     ADD(&f, o->max_events);
     ADD(&f, o->channel_walks);
     if (o->transparent_background) ADD(&f, o->transparent_background); /* other bakes hash as before it */
+    if (o->max_bounces) { /* one-bounce bakes hash as before indirect light */
+        ADD(&f, o->max_bounces);
+        ADD(&f, o->diffuse_bounces);
+        ADD(&f, o->glossy_bounces);
+        ADD(&f, o->transmission_bounces);
+        ADD(&f, o->min_light_bounces);
+        ADD(&f, o->subsurface_after_diffuse);
+    }
     return f.h;
 }
 

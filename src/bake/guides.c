@@ -1,10 +1,11 @@
 /* A bake's guides per mesh (guides.h): techniques, channel walks, closest-point needs, features. */
 #include "bake/guides.h"
 
-/* Which meshes' walks the bake can reach: all for a camera, the one mesh for a UV bake. */
+/* Which meshes' walks the bake can reach: all for a camera, the one mesh for a UV bake (every
+ * mesh where indirect light can reach it). */
 static int mesh_used(const dwvb_bake *bake, uint32_t m)
 {
-    return bake->options.target == DWV_BAKE_CAMERA || m == bake->options.uv_mesh;
+    return bake->options.target == DWV_BAKE_CAMERA || m == bake->options.uv_mesh || bake->options.max_bounces > 0u;
 }
 
 void dwvb_bake_update_features(dwvb_bake *bake)

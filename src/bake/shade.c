@@ -229,10 +229,22 @@ static double bumped_exit_factor(const void *context, dwvu_vec3 light)
     return f * dwvb_bump_shadowing(e->mode, e->smooth_n, e->n, light);
 }
 
+/* A walk's exit as a point a path scatters at: its shading normal (bumped where a normal map
+ * tilts it) and geometric normal (outward), and its lobe (the Lambertian exit, 3.x Principled's
+ * weight, the bump shadowing). */
+typedef struct exit_point {
+    dwvu_vec3 x, n, ng, smooth_n;
+    double top;
+    int principled_v1;
+    int bump_mode; /* DWV_BUMP_SHADOWING_* where the normal is tilted, else 0 */
+} exit_point;
+
 /* The light a walk gathers where it left mesh `mesh` (exit: its hit), from the sampler's light
- * pairs from `pair` on: the Lambertian exit's (or Blender 3.x Principled's) direct light. */
+ * pairs from `pair` on: the Lambertian exit's (or Blender 3.x Principled's) direct light. The exit
+ * as a scattering point goes to `point` (for a path going on from there). */
 static void exit_light(const dwvb_shader *shader, uint32_t mesh_id, const dwvb_material *material, const dwvw_walk *walk,
-                       const dwvg_hit *exit, const dwvk_sampler *sampler, uint32_t pair, double direct[3])
+                       const dwvg_hit *exit, const dwvk_sampler *sampler, uint32_t pair, double direct[3],
+                       exit_point *point)
 {
     const dwvb_scene *scene = shader->scene;
     const dwvg_mesh *mesh = &scene->meshes[mesh_id];
@@ -250,6 +262,8 @@ static void exit_light(const dwvb_shader *shader, uint32_t mesh_id, const dwvb_m
     double exit_top = dwvg_world_top(&scene->geometry, mesh_id, exit->prim);
     int mode = dwvb_textured_bump_shadowing(scene, mesh_id);
     int tilted = exit_n.x != exit_smooth_n.x || exit_n.y != exit_smooth_n.y || exit_n.z != exit_smooth_n.z;
+    *point = (exit_point){walk->position, exit_n, exit_ng, exit_smooth_n, exit_top, material->principled_v1,
+                          mode && tilted ? mode : DWV_BUMP_SHADOWING_NONE};
     if (mode && tilted) {
         bumped_exit lobe = {exit_n, exit_smooth_n, material->principled_v1, mode};
         dwvl_direct_lobe(&shader->env, walk->position, exit_n, exit_ng, exit_smooth, exit_top, sampler, pair,
@@ -273,8 +287,223 @@ double dwvb_footprint(const dwvb_shader *shader, dwvu_vec3 view, double t)
     return t * 0.5 * (dwvu_length(dx) + dwvu_length(dy));
 }
 
-void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, const dwvk_sampler *sampler,
-                uint32_t pair, uint64_t key_walk, dwvb_shade_parts *parts, dwvb_tally *tally)
+#define INV_PI 0.31830988618379067154
+
+/* Where a path stands (Cycles' path state): its bounces so far by kind, and whether one of them
+ * was diffuse (PATH_RAY_DIFFUSE_ANCESTOR). */
+typedef struct path_state {
+    uint32_t bounce, diffuse, glossy, transmission;
+    int diffuse_ancestor;
+} path_state;
+
+/* A path's next segment, sampled at a scattering point: the ray (from the point's offset
+ * origin), the factor f cos / pdf it multiplies the path's throughput by (times what the point
+ * itself weighs, a walk's estimate for an exit), the lobe that scattered it (DWVB_LOBE_*), and
+ * whether it is known to meet nothing (it rises from above the whole world: no ray needed). */
+typedef struct path_ray {
+    dwvu_vec3 origin, direction;
+    double weight[3];
+    int lobe;
+    int clear;
+    int exit; /* sent on from a walk's exit: 1 + the channel of a channel walk, 4 the one walk; 0 the lobes */
+} path_ray;
+
+/* Cycles' path_state_next for a bounce off `lobe`: counts it, or returns 0 where it would exceed
+ * a limit (Cycles' kernel limits are the scene's + 1 and end a path whose count reaches them;
+ * the path then only looks for emission, which dwivedi's surfaces have not). */
+static int path_state_next(path_state *s, int lobe, const dwvb_light_paths *limits)
+{
+    if (s->bounce + 1u > limits->max_bounces) return 0;
+    if (lobe == DWVB_LOBE_DIFFUSE) {
+        if (s->diffuse + 1u > limits->diffuse) return 0;
+        ++s->diffuse;
+        s->diffuse_ancestor = 1;
+    } else if (lobe == DWVB_LOBE_GLOSSY) {
+        if (s->glossy + 1u > limits->glossy) return 0;
+        ++s->glossy;
+    } else {
+        if (s->transmission + 1u > limits->transmission) return 0;
+        ++s->transmission;
+    }
+    ++s->bounce;
+    return 1;
+}
+
+/* Whether some bounce is left to a path (the lobe it samples is checked after). */
+static int path_can_go_on(const path_state *s, const dwvb_light_paths *limits)
+{
+    return s->bounce < limits->max_bounces && (s->diffuse < limits->diffuse || s->glossy < limits->glossy);
+}
+
+/* Cycles' path_state_continuation_probability at a path's hit after s->bounce bounces: 1 up to
+ * Min Light Bounces + 1 (the kernel's min_bounce), then min(1, sqrt(max channel |throughput|))
+ * (sqrt "to roughly match typical view transform": the same in 3.4, 4.3 and 5.x). */
+static double continuation_probability(const path_state *s, const double throughput[3], const dwvb_light_paths *limits)
+{
+    if (s->bounce <= limits->min_bounces + 1u) return 1.0;
+    double largest = fmax(fabs(throughput[0]), fmax(fabs(throughput[1]), fabs(throughput[2])));
+    return fmin(sqrt(largest), 1.0);
+}
+
+/* A ray from surface point x along unit d leaves from x + epsilon ng; it meets nothing where it
+ * starts above the world's highest point along ng (`top`, dwvg_world_top) and rises (the margin
+ * of direct.c's shadow rays, which leave from the same origin). */
+static void path_ray_from(const dwvb_shader *shader, dwvu_vec3 x, dwvu_vec3 ng, double top, dwvu_vec3 d, path_ray *ray)
+{
+    double eps = shader->scene->geometry.epsilon;
+    ray->origin = dwvu_madd(x, ng, eps);
+    ray->direction = d;
+    ray->clear = 0;
+    if (top < INFINITY && dwvu_dot(d, ng) > 0.0) {
+        double coordinate = fmax(fabs(x.x), fmax(fabs(x.y), fabs(x.z))) + eps;
+        ray->clear = dwvu_dot(ray->origin, ng) > top + 0.25 * eps + 0x1p-19 * coordinate;
+    }
+}
+
+/* The exit's lobe sampled by its cosine (pdf cos / pi): the weight is the lobe's factor beside
+ * 1/pi (1, 3.x Principled's 1 - F_L / 2, the bump shadowing). Directions below the exit's
+ * geometric surface end the path. */
+static int exit_path_ray(const dwvb_shader *shader, const exit_point *e, const double weight[3],
+                         const dwvk_sampler *sampler, uint32_t pair, path_ray *ray)
+{
+    double u[2];
+    dwvk_sampler_pair(sampler, pair, u);
+    double mu = sqrt(u[0]);
+    dwvu_vec3 w = dwvk_direction_about(e->n, mu, 1.0 - mu, 1.0 + mu, u[1]);
+    if (!(dwvu_dot(w, e->ng) > 0.0)) return 0;
+    double f = e->principled_v1 ? dwvb_principled_exit_factor(dwvu_dot(e->n, w)) : 1.0;
+    if (e->bump_mode) f *= dwvb_bump_shadowing(e->bump_mode, e->smooth_n, e->n, w);
+    path_ray_from(shader, e->x, e->ng, e->top, w, ray);
+    for (int c = 0; c < 3; ++c) ray->weight[c] = weight[c] * f;
+    ray->lobe = DWVB_LOBE_DIFFUSE;
+    ray->exit = 4;
+    for (int c = 0; c < 3; ++c)
+        if (weight[c] > 0.0 && weight[(c + 1) % 3] == 0.0 && weight[(c + 2) % 3] == 0.0) ray->exit = 1 + c;
+    return 1;
+}
+
+double dwvb_surface_specular_probability(const dwvb_material *m, const double diffuse[3], double cos_view)
+{
+    double weight = 0.0, specular = 0.0;
+    for (int c = 0; c < 3; ++c) weight += (diffuse[c] + m->retro_albedo[c]) / 3.0;
+    if (m->specular && m->spec_alpha * m->spec_alpha > DWVB_GGX_MIN_ALPHA2 && cos_view > 0.0) {
+        if (m->specular == DWV_SPECULAR_PRINCIPLED_V2) {
+            specular = 1.0 - dwvb_specular_layer_weight(m, cos_view);
+        } else {
+            double f0 = (m->spec_f0[0] + m->spec_f0[1] + m->spec_f0[2]) / 3.0;
+            specular = f0 + (1.0 - f0) * dwvb_schlick_weight(cos_view);
+        }
+    }
+    if (!(weight + specular > 0.0)) return -1.0;
+    return specular / (weight + specular);
+}
+
+/* Direction d in `frame` (z its normal). */
+static dwvu_vec3 local_of(dwvu_frame frame, dwvu_vec3 d)
+{
+    return dwvu_v(dwvu_dot(frame.t, d), dwvu_dot(frame.s, d), dwvu_dot(frame.n, d));
+}
+
+int dwvb_surface_sample(const dwvb_material *m, double p_specular, dwvu_vec3 n, dwvu_vec3 to_view, double u0, double u1,
+                        double choice, dwvu_vec3 *w, int *lobe)
+{
+    if (choice < p_specular) {
+        dwvu_frame frame = dwvu_frame_about(n);
+        dwvu_vec3 wi = local_of(frame, to_view);
+        if (!(wi.z > 0.0)) return 0;
+        dwvu_vec3 h = dwvb_ggx_sample_vndf(wi, m->spec_alpha, u0, u1);
+        dwvu_vec3 wo = dwvu_sub(dwvu_scale(h, 2.0 * dwvu_dot(wi, h)), wi);
+        *w = dwvu_add(dwvu_add(dwvu_scale(frame.t, wo.x), dwvu_scale(frame.s, wo.y)), dwvu_scale(frame.n, wo.z));
+        *lobe = DWVB_LOBE_GLOSSY;
+    } else {
+        double mu = sqrt(u0);
+        *w = dwvk_direction_about(n, mu, 1.0 - mu, 1.0 + mu, u1);
+        *lobe = DWVB_LOBE_DIFFUSE;
+    }
+    return 1;
+}
+
+double dwvb_surface_pdf(const dwvb_material *m, double p_specular, dwvu_vec3 n, dwvu_vec3 to_view, dwvu_vec3 w)
+{
+    double cos_n = dwvu_dot(n, w);
+    if (!(cos_n > 0.0)) return 0.0;
+    double pdf = (1.0 - p_specular) * cos_n * INV_PI;
+    if (p_specular > 0.0) {
+        dwvu_frame frame = dwvu_frame_about(n);
+        dwvu_vec3 wi = local_of(frame, to_view), wo = local_of(frame, w);
+        dwvu_vec3 h = dwvu_normalize(dwvu_add(wi, wo));
+        double wi_h = dwvu_dot(wi, h);
+        if (wi.z > 0.0 && wi_h > 0.0 && h.z > 0.0) pdf += p_specular * dwvb_ggx_vndf_pdf(wi, h, m->spec_alpha) / (4.0 * wi_h);
+    }
+    return pdf;
+}
+
+/* A surface point's path ray from the mixture of its lobes (dwvb_surface_sample); the weight is
+ * the whole BRDF f (surface_factor) times cos over the mixture's pdf; the lobe drawn names the
+ * bounce (glossy or diffuse). */
+static int surface_path_ray(const dwvb_shader *shader, const surface_lobes *s, dwvu_vec3 x, dwvu_vec3 ng, double top,
+                            const dwvk_sampler *sampler, uint32_t pair, path_ray *ray)
+{
+    const dwvb_material *m = s->material;
+    double p_specular = dwvb_surface_specular_probability(m, s->diffuse, s->lobe.cos_view);
+    if (p_specular < 0.0) return 0;
+    double u[2], v[2];
+    dwvk_sampler_pair(sampler, pair, u);
+    dwvk_sampler_pair(sampler, pair + 1u, v);
+    dwvu_vec3 w;
+    if (!dwvb_surface_sample(m, p_specular, s->lobe.n, s->lobe.to_view, u[0], u[1], v[0], &w, &ray->lobe)) return 0;
+    double cos_n = dwvu_dot(s->lobe.n, w);
+    if (!(cos_n > 0.0) || !(dwvu_dot(w, ng) > 0.0)) return 0;
+    double pdf = dwvb_surface_pdf(m, p_specular, s->lobe.n, s->lobe.to_view, w);
+    if (!(pdf > 0.0) || !isfinite(pdf)) return 0;
+    double f[2][3];
+    surface_factor(s, w, f);
+    for (int c = 0; c < 3; ++c) ray->weight[c] = (f[0][c] + f[1][c]) * INV_PI * cos_n / pdf;
+    path_ray_from(shader, x, ng, top, w, ray);
+    ray->exit = 0;
+    return 1;
+}
+
+/* Whether a subsurface material walks where a path meets it after a diffuse bounce. */
+static int walks_after_diffuse(const dwvb_shader *shader, const dwvb_material *material)
+{
+    if (shader->paths.after_diffuse == DWV_SUBSURFACE_AFTER_DIFFUSE_WALK) return 1;
+    if (shader->paths.after_diffuse == DWV_SUBSURFACE_AFTER_DIFFUSE_LAMBERT) return 0;
+    return material->model >= DWV_SUBSURFACE_MODEL_BLENDER52_RANDOM_WALK;
+}
+
+/* Cycles up to 4.x after a diffuse bounce (bssrdf_setup; 3.x svm_node_closure_bsdf): the walking
+ * channels become diffuse of their subsurface colour, Lambertian, or (3.x Principled) the
+ * Principled diffuse of the mixed colour, retro-reflection included. */
+static void lambert_after_diffuse(const dwvb_material *material, dwvb_material *out)
+{
+    *out = *material;
+    out->subsurface = 0;
+    for (int c = 0; c < 3; ++c)
+        if (material->walk_scale[c] > 0.0) out->diffuse_albedo[c] += material->fallback_albedo[c];
+    if (material->principled_v1) {
+        out->principled_v1 = 0;
+        out->principled_diffuse = 1;
+        for (int c = 0; c < 3; ++c) out->retro_albedo[c] = 0.0;
+    }
+}
+
+/* The pairs a point's paths going on take in its `onward` sampler: two per ray, at fixed places
+ * (the surface's first, then walk j of channel c's at 1 + c + 3 j, the one walk's at 1), so that
+ * whether one ray was made never moves another's numbers. */
+#define ONWARD_PAIRS 2u
+
+/* Shades hit point `hit` seen along `view` by a path in `state` (camera: the camera ray's or the
+ * texel's hit, whose walks may be channel walks and obey the footprint rule): its direct light
+ * into `light` by lobe (the specular layer's GLOSSY, the rest DIFFUSE), the lobes' colours into
+ * `color` where it is not NULL (Cycles' colour passes), and, where `rays` is not NULL, the rays its lobes and walks' exits send on (at most
+ * 1 + 3 DWVB_MAX_CHANNEL_WALKS; 2 away from the camera), drawn from `onward` from pair
+ * `onward_pair` on. */
+static void shade_point(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, const dwvk_sampler *sampler,
+                        uint32_t pair, uint64_t key_walk, const path_state *state, int camera,
+                        double light[DWVB_LOBE_COUNT][3], double color[DWVB_LOBE_COUNT][3],
+                        path_ray *rays, const dwvk_sampler *onward, uint32_t onward_pair, uint32_t *ray_count,
+                        dwvb_tally *tally)
 {
     const dwvb_scene *scene = shader->scene;
     const dwvg_mesh *mesh = &scene->meshes[hit->mesh];
@@ -282,13 +511,18 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
     const dwvb_material *material = &scene->shading[material_id];
     /* Textured inputs: the material as the textures make it here, once, for the surface lobes and
      * for the whole walk from here (Cycles' homogeneous medium from the entry's closure). */
-    dwvb_material textured;
+    dwvb_material textured, lambert;
     if (dwvb_textured_inputs(scene, hit->mesh)) {
         dwvb_textured_material(scene, hit->mesh, hit->prim, hit->u, hit->v, &textured);
         material = &textured;
     }
-    *parts = (dwvb_shade_parts){0};
-    double *diffuse_light = parts->direct[DWVB_LOBE_DIFFUSE];
+    if (material->subsurface && state->diffuse_ancestor && !walks_after_diffuse(shader, material)) {
+        lambert_after_diffuse(material, &lambert);
+        material = &lambert;
+    }
+    *ray_count = 0u;
+    for (int l = 0; l < DWVB_LOBE_COUNT; ++l) light[l][0] = light[l][1] = light[l][2] = 0.0;
+    double *rgb = light[DWVB_LOBE_DIFFUSE];
     dwvu_vec3 ng = dwvg_geometric_normal(mesh, hit->prim);
     if (ng.x == 0.0 && ng.y == 0.0 && ng.z == 0.0) {
         ++tally->warnings;
@@ -297,9 +531,10 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
     int ng_flipped = 0;
     if (dwvu_dot(view, ng) > 0.0) {
         /* The back of a face. A diffuse surface is two-sided; a subsurface one is seen from inside
-         * its medium (an open or inside-out mesh): no walk is defined there. */
+         * its medium (an open or inside-out mesh): no walk is defined there (a path that meets
+         * one ends there: the camera's is what the warning is for). */
         if (material->subsurface) {
-            ++tally->warnings;
+            if (camera) ++tally->warnings;
             return;
         }
         ng = dwvu_scale(ng, -1.0);
@@ -323,7 +558,7 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
     double diffuse_albedo[3], keep[3] = {1.0, 1.0, 1.0};
     int walks_left = material->subsurface;
     for (int c = 0; c < 3; ++c) diffuse_albedo[c] = material->diffuse_albedo[c];
-    if (material->subsurface && material->min_footprint > 0.0 && shader->footprint) {
+    if (camera && material->subsurface && material->min_footprint > 0.0 && shader->footprint) {
         double limit = material->min_footprint * dwvb_footprint(shader, view, hit->t);
         walks_left = 0;
         for (int c = 0; c < 3; ++c) {
@@ -349,40 +584,46 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
      * beside the BSSRDF) and the walking channels' BSSRDF (w x subsurface colour, a channel that
      * turned Lambertian by the footprint rule counted once, in diffuse_albedo); the specular
      * layer's weight (3.x) or albedo (4.x+). */
-    for (int c = 0; c < 3; ++c) {
-        double bssrdf = material->subsurface && material->walk_scale[c] > 0.0 && keep[c] > 0.0 ? material->fallback_albedo[c] : 0.0;
-        parts->color[DWVB_LOBE_DIFFUSE][c] = layer * (diffuse_albedo[c] + bssrdf) + material->retro_albedo[c];
+    if (color) {
+        for (int c = 0; c < 3; ++c) {
+            double bssrdf = material->subsurface && material->walk_scale[c] > 0.0 && keep[c] > 0.0
+                                ? material->fallback_albedo[c]
+                                : 0.0;
+            color[DWVB_LOBE_DIFFUSE][c] = layer * (diffuse_albedo[c] + bssrdf) + material->retro_albedo[c];
+        }
+        if (material->specular) dwvb_specular_color(material, cos_view, color[DWVB_LOBE_GLOSSY]);
     }
-    if (material->specular) dwvb_specular_color(material, cos_view, parts->color[DWVB_LOBE_GLOSSY]);
+    surface_lobes lobes = {material, {n, dwvu_scale(view, -1.0), cos_view, material->roughness}, {0.0, 0.0, 0.0},
+                           bumped, smooth_n};
+    for (int c = 0; c < 3; ++c) lobes.diffuse[c] = layer * diffuse_albedo[c];
     if (material->specular || bumped) {
         /* (A tilted normal's shadowing goes through the general lobe too.) */
-        surface_lobes lobes = {material, {n, dwvu_scale(view, -1.0), cos_view, material->roughness}, {0.0, 0.0, 0.0},
-                               bumped, smooth_n};
-        for (int c = 0; c < 3; ++c) lobes.diffuse[c] = layer * diffuse_albedo[c];
         double surface[2][3];
         dwvl_direct_split(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, surface_factor, &lobes,
                           surface);
         for (int c = 0; c < 3; ++c) {
-            parts->direct[DWVB_LOBE_GLOSSY][c] = surface[0][c];
-            diffuse_light[c] = surface[1][c];
+            light[DWVB_LOBE_GLOSSY][c] = surface[0][c];
+            rgb[c] = surface[1][c];
         }
     } else if (material->principled_v1) {
         /* The Lambertian lobe and the retro-reflection lobe from the same light samples. */
         retro_lobe lobe = {n, dwvu_scale(view, -1.0), -dwvu_dot(n, view), material->roughness};
         double direct[3], retro[3];
         dwvl_direct_lobe(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, retro_factor, &lobe, direct, retro);
-        for (int c = 0; c < 3; ++c) diffuse_light[c] += material->diffuse_albedo[c] * direct[c] + material->retro_albedo[c] * retro[c];
+        for (int c = 0; c < 3; ++c) rgb[c] += material->diffuse_albedo[c] * direct[c] + material->retro_albedo[c] * retro[c];
     } else if (material->principled_diffuse) {
         retro_lobe lobe = {n, dwvu_scale(view, -1.0), -dwvu_dot(n, view), material->roughness};
         double diffuse[3];
         dwvl_direct_lobe(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, principled_diffuse_factor, &lobe,
                          NULL, diffuse);
-        for (int c = 0; c < 3; ++c) diffuse_light[c] += material->diffuse_albedo[c] * diffuse[c];
+        for (int c = 0; c < 3; ++c) rgb[c] += material->diffuse_albedo[c] * diffuse[c];
     } else if (diffuse_albedo[0] > 0.0 || diffuse_albedo[1] > 0.0 || diffuse_albedo[2] > 0.0) {
         double direct[3];
         dwvl_direct(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, direct);
-        for (int c = 0; c < 3; ++c) diffuse_light[c] += layer * diffuse_albedo[c] * direct[c];
+        for (int c = 0; c < 3; ++c) rgb[c] += layer * diffuse_albedo[c] * direct[c];
     }
+    /* The surface's lobes send a path on (the same BRDF as their direct light above). */
+    if (rays && surface_path_ray(shader, &lobes, x, ng, top, onward, onward_pair, &rays[*ray_count])) ++*ray_count;
     if (!walks_left) return;
     /* Entry: cosine-weighted about -n, rejected (no contribution, as Cycles) where it would not
      * go below the geometric surface. The pdf cos/pi cancels the diffuse transmission f = 1/pi. */
@@ -408,8 +649,9 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
     uint32_t exit_pair = pair + DWVB_SHADE_PAIRS + light_pairs;
     dwvw_walk walk;
     dwvg_hit exit = {0};
+    exit_point point;
     double direct[3];
-    if (shader->channel_walks && shader->channel_walks[hit->mesh]) {
+    if (camera && shader->channel_walks && shader->channel_walks[hit->mesh]) {
         /* Channel walks: each channel's estimate is its own walk's (its own extinction, albedo and
          * Dwivedi distribution), so no channel's weight carries another's sampling pdf. They
          * share the entry and the pixel's stratified numbers (each channel is stratified over the
@@ -433,8 +675,13 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
                 double share = layer * material->walk_scale[c] / (double)count;
                 if (walk.status == DWVW_TRUNCATED) tally->truncated[c] += walk.weight[0] * share;
                 if (!exited) continue;
-                exit_light(shader, hit->mesh, material, &walk, &exit, sampler, exit_pair, direct);
-                diffuse_light[c] += walk.weight[0] * share * direct[c];
+                exit_light(shader, hit->mesh, material, &walk, &exit, sampler, exit_pair, direct, &point);
+                rgb[c] += walk.weight[0] * share * direct[c];
+                /* This channel's walk sends a path on in its channel alone. */
+                double weight[3] = {0.0, 0.0, 0.0};
+                weight[c] = walk.weight[0] * share;
+                uint32_t exit_pairs = onward_pair + ONWARD_PAIRS * (1u + (uint32_t)c + 3u * j);
+                if (rays && exit_path_ray(shader, &point, weight, onward, exit_pairs, &rays[*ray_count])) ++*ray_count;
             }
             tally->channel_walks[c] += tally->walks - walks;
             tally->channel_events[c] += tally->events - events;
@@ -445,9 +692,132 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
     int exited = run_walk(shader, hit->mesh, &material->medium, &shader->guides[hit->mesh], hit->prim, x, inward, n,
                           key_walk, sampler, walk_pair, NULL, &walk, &exit, tally);
     int grey = material->medium.channels == 1;
-    if (walk.status == DWVW_TRUNCATED)
+    if (camera && walk.status == DWVW_TRUNCATED)
         for (int c = 0; c < 3; ++c) tally->truncated[c] += walk.weight[grey ? 0 : c] * material->walk_scale[c];
     if (!exited) return;
-    exit_light(shader, hit->mesh, material, &walk, &exit, sampler, exit_pair, direct);
-    for (int c = 0; c < 3; ++c) diffuse_light[c] += keep[c] * layer * walk.weight[grey ? 0 : c] * material->walk_scale[c] * direct[c];
+    exit_light(shader, hit->mesh, material, &walk, &exit, sampler, exit_pair, direct, &point);
+    double weight[3];
+    for (int c = 0; c < 3; ++c) {
+        weight[c] = keep[c] * layer * walk.weight[grey ? 0 : c] * material->walk_scale[c];
+        rgb[c] += weight[c] * direct[c];
+    }
+    if (rays && exit_path_ray(shader, &point, weight, onward, onward_pair + ONWARD_PAIRS, &rays[*ray_count])) ++*ray_count;
+}
+
+/* Salts of the counter-based keys of the paths after the camera vertex: the vertex's sampler,
+ * its walk, the camera vertex's onward rays (any constants; dwvk_mix64 decorrelates them). */
+#define PATH_VERTEX_SALT 0x5851f42d4c957f2dull
+#define PATH_WALK_SALT 0x14057b7ef767814full
+#define PATH_ONWARD_SALT 0xda942042e4dd58b5ull
+/* The pairs of an indirect vertex's sampler: 0 Russian roulette and the choice of ray, from 1 on
+ * the shading (dwvb_shade's layout), its rays from ONWARD_PAIR on (far past both). */
+#define ONWARD_PAIR (1u << 20)
+/* The camera vertex's choices among its walks' exits, one per channel (past their rays' pairs in
+ * `onward`). */
+#define ONWARD_CHOICE_PAIR (ONWARD_PAIRS * (1u + 3u * DWVB_MAX_CHANNEL_WALKS))
+
+/* One of rays[0..count) chosen with probability in proportion to its mean weight by uniform u,
+ * its weight divided by that probability (one-sample estimation of their sum); returns 0 where
+ * none has weight. */
+static int choose_ray(const path_ray *rays, uint32_t count, double u, path_ray *chosen)
+{
+    double total = 0.0;
+    for (uint32_t j = 0; j < count; ++j) total += rays[j].weight[0] + rays[j].weight[1] + rays[j].weight[2];
+    if (!(total > 0.0)) return 0;
+    double target = u * total, sum = 0.0;
+    uint32_t pick = count - 1u;
+    for (uint32_t j = 0; j < count; ++j) {
+        sum += rays[j].weight[0] + rays[j].weight[1] + rays[j].weight[2];
+        if (target < sum) {
+            pick = j;
+            break;
+        }
+    }
+    double p = (rays[pick].weight[0] + rays[pick].weight[1] + rays[pick].weight[2]) / total;
+    if (!(p > 0.0)) return 0;
+    *chosen = rays[pick];
+    for (int c = 0; c < 3; ++c) chosen->weight[c] /= p;
+    return 1;
+}
+
+/* Follows a path from its first ray on (the camera vertex in `state`), iteratively: at each hit
+ * Russian roulette (Cycles' continuation probability, dividing the throughput by it), the hit's
+ * direct light (next-event estimation for lights and world, which covers them wholly: no light is
+ * geometry, and a ray that leaves the world adds nothing), then one of the rays its lobes and its
+ * walk's exit send on, chosen in proportion to their mean weights (the chosen one divided by its
+ * probability). `key`: the path's counter-based numbers. */
+static void follow_path(const dwvb_shader *shader, const path_ray *first, path_state state, uint64_t key, double out[3],
+                        dwvb_tally *tally)
+{
+    double throughput[3] = {1.0, 1.0, 1.0};
+    out[0] = out[1] = out[2] = 0.0;
+    path_ray ray = *first;
+    for (uint64_t vertex = 1;; ++vertex) {
+        if (!path_state_next(&state, ray.lobe, &shader->paths)) return;
+        int alive = 0;
+        for (int c = 0; c < 3; ++c) {
+            throughput[c] *= ray.weight[c];
+            alive |= throughput[c] > 0.0;
+        }
+        dwvg_hit hit;
+        if (!alive || ray.clear ||
+            !dwvg_intersect(&shader->scene->geometry, ray.origin, ray.direction, 0.0, INFINITY, &hit))
+            return;
+        uint64_t vertex_key = dwvk_mix64(key ^ (PATH_VERTEX_SALT + vertex));
+        dwvk_sampler sampler = {vertex_key, 0u, 0};
+        double u[2];
+        dwvk_sampler_pair(&sampler, 0u, u);
+        double p = continuation_probability(&state, throughput, &shader->paths);
+        if (p < 1.0) {
+            if (!(u[0] < p)) return;
+            for (int c = 0; c < 3; ++c) throughput[c] /= p;
+        }
+        double direct[DWVB_LOBE_COUNT][3];
+        path_ray rays[2];
+        uint32_t count = 0u;
+        int onward = path_can_go_on(&state, &shader->paths);
+        shade_point(shader, &hit, ray.direction, &sampler, 1u, dwvk_mix64(vertex_key ^ PATH_WALK_SALT), &state, 0, direct, NULL,
+                    onward ? rays : NULL, &sampler, ONWARD_PAIR, &count, tally);
+        for (int c = 0; c < 3; ++c)
+            out[c] += throughput[c] * (direct[DWVB_LOBE_DIFFUSE][c] + direct[DWVB_LOBE_GLOSSY][c]);
+        if (count == 0u || !choose_ray(rays, count, u[1], &ray)) return;
+    }
+}
+
+void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, const dwvk_sampler *sampler,
+                uint32_t pair, uint64_t key_walk, dwvb_shade_parts *parts, dwvb_tally *tally)
+{
+    *parts = (dwvb_shade_parts){0};
+    path_state state = {0u, 0u, 0u, 0u, 0};
+    path_ray rays[1u + 3u * DWVB_MAX_CHANNEL_WALKS];
+    uint32_t count = 0u;
+    /* No ray goes on where the limits leave no bounce: the one-bounce image, bit for bit. */
+    int onward = path_can_go_on(&state, &shader->paths);
+    dwvk_sampler onward_sampler = {dwvk_mix64(key_walk ^ PATH_ONWARD_SALT), 0u, 0};
+    shade_point(shader, hit, view, sampler, pair, key_walk, &state, 1, parts->direct, parts->color,
+                onward ? rays : NULL, &onward_sampler, 0u, &count, tally);
+    /* The surface lobes' ray is a path of its own, and so is, per channel of channel walks (or
+     * for the one walk), one of its walks' exits' rays, chosen by their weights where the pilot
+     * gave a channel several walks: tracing all of those cost the report's bowl twice its time
+     * per sample, while one exit for the three channels' walks tripled the torus's variance. Each
+     * path's light is indirect light of the lobe that sent it. */
+    path_ray paths[5];
+    uint32_t path_count = 0u;
+    for (uint32_t j = 0; j < count; ++j)
+        if (!rays[j].exit) paths[path_count++] = rays[j];
+    for (int group = 1; group <= 4; ++group) {
+        path_ray exits[DWVB_MAX_CHANNEL_WALKS];
+        uint32_t exit_count = 0u;
+        for (uint32_t j = 0; j < count; ++j)
+            if (rays[j].exit == group && exit_count < DWVB_MAX_CHANNEL_WALKS) exits[exit_count++] = rays[j];
+        double u[2];
+        dwvk_sampler_pair(&onward_sampler, ONWARD_CHOICE_PAIR + (uint32_t)group, u);
+        if (exit_count == 1u) paths[path_count++] = exits[0];
+        else if (exit_count && choose_ray(exits, exit_count, u[0], &paths[path_count])) ++path_count;
+    }
+    for (uint32_t j = 0; j < path_count; ++j) {
+        double gathered[3];
+        follow_path(shader, &paths[j], state, dwvk_mix64(key_walk ^ (PATH_ONWARD_SALT + 1u + j)), gathered, tally);
+        for (int c = 0; c < 3; ++c) parts->indirect[paths[j].lobe][c] += gathered[c];
+    }
 }

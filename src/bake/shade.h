@@ -3,8 +3,9 @@
  * enter by cosine-weighted diffuse transmission, walk in the mesh's own Embree scene with the
  * step machine of src/walk, leave through a Lambertian exit that gathers direct light and the
  * world. For DWV_SUBSURFACE_EXIT_PRINCIPLED_V1 the exit is weighted by 1 - F_L/2 and a
- * retro-reflection lobe joins the Lambertian one (material.h). One bounce: surfaces do not light
- * each other. */
+ * retro-reflection lobe joins the Lambertian one (material.h). Paths go on after the walk's exit
+ * and after the surface lobes up to Cycles' light-path limits (dwvb_light_paths), with Russian
+ * roulette as Cycles, so that surfaces light each other (indirect light). */
 #ifndef DWV_BAKE_SHADE_H
 #define DWV_BAKE_SHADE_H
 
@@ -14,6 +15,19 @@
 #include "geom/embree.h"
 #include "light/direct.h"
 #include "walk/walk.h"
+
+/* Cycles' light-path limits (scene.cycles: Max Bounces Total, Diffuse, Glossy, Transmission,
+ * Min Light Bounces), counted as Cycles' path_state_next counts them: a reflection off a diffuse
+ * lobe (Lambertian, Principled diffuse, retro-reflection, a walk's exit) is one diffuse and one
+ * total bounce, off the specular layer one glossy and one total bounce; a walk itself is none
+ * (subsurface_bounce does not call path_state_next). A path whose next bounce would exceed a limit
+ * ends there (Cycles then only looks for emission, which no dwivedi surface has). All zero: the
+ * one-bounce image. `after_diffuse`: DWV_SUBSURFACE_AFTER_DIFFUSE_*, what a subsurface surface met
+ * after a diffuse bounce does. */
+typedef struct dwvb_light_paths {
+    uint32_t max_bounces, diffuse, glossy, transmission, min_bounces;
+    int after_diffuse;
+} dwvb_light_paths;
 
 typedef struct dwvb_shader {
     const dwvb_scene *scene;
@@ -30,6 +44,7 @@ typedef struct dwvb_shader {
      * where a channel's variance is worth more walks than its cost (pilot.c). */
     const uint8_t *channel_counts;
     uint32_t max_events;
+    dwvb_light_paths paths;
     /* Camera bakes: the camera ray's footprint at a hit (Cycles' sd->dP, for
      * dwvb_material.min_footprint): 1 perspective (eye, forward, and right / up one pixel apart on
      * the plane at unit distance), 2 orthographic (pixel: a pixel's width); 0 none (UV bakes). */
@@ -98,12 +113,27 @@ typedef struct dwvb_tally {
  * pairs DWVW_PAIRS_PER_EVENT x DWVB_STRATIFIED_EVENTS x j after the first's. */
 #define DWVB_MAX_CHANNEL_WALKS 3u
 
+/* The mixture a surface point's path rays are drawn from (Cycles picks a closure by its sample
+ * weight and weighs the direction by MIS over all closures): the specular layer's GGX visible
+ * normals reflected (Heitz 2018), pdf D_wi(h) / (4 wi.h) (Eq. 2 there and the reflection's
+ * Jacobian), with probability p_s; the cosine about n, pdf cos / pi, with 1 - p_s. p_s is the
+ * layer's albedo toward the viewer (4.x+: 1 - dwvb_specular_layer_weight; 3.x: Schlick's Fresnel
+ * of the mean F0) against the diffuse lobes' mean weight `diffuse` (+ the retro-reflection's);
+ * 0 where the layer is absent or a mirror (alpha^2 <= DWVB_GGX_MIN_ALPHA2); -1 where nothing
+ * scatters. dwvb_surface_sample draws a direction (uniforms u0, u1 and `choice`) and its lobe
+ * (DWVB_LOBE_*), 0 where none is drawn; dwvb_surface_pdf is the mixture's pdf of any direction. */
+double dwvb_surface_specular_probability(const dwvb_material *m, const double diffuse[3], double cos_view);
+int dwvb_surface_sample(const dwvb_material *m, double p_specular, dwvu_vec3 n, dwvu_vec3 to_view, double u0, double u1,
+                        double choice, dwvu_vec3 *w, int *lobe);
+double dwvb_surface_pdf(const dwvb_material *m, double p_specular, dwvu_vec3 n, dwvu_vec3 to_view, dwvu_vec3 w);
+
 /* The radiance leaving hit point `hit` along -view (view: unit direction of the ray that found
  * it, from the viewer), split into `parts` (zeroed first): the specular layer's direct light is
  * GLOSSY's; the Lambertian, Principled diffuse, retro-reflection and the walks' exits are
  * DIFFUSE's; each lobe's colour is its closures' weight (3.x) or albedo (4.x+) as Cycles' colour
  * passes. `sampler` drives entry and light sampling from pair `pair` on, then the walk's first
- * DWVB_STRATIFIED_EVENTS events; key_walk drives the rest of the walk. */
+ * DWVB_STRATIFIED_EVENTS events; key_walk drives the rest of the walk, and (mixed) the paths that
+ * go on from there (counter-based numbers). */
 void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, const dwvk_sampler *sampler,
                 uint32_t pair, uint64_t key_walk, dwvb_shade_parts *parts, dwvb_tally *tally);
 

@@ -12,6 +12,7 @@
 #define MAX_PIXELS (1u << 26)
 #define MAX_SAMPLES (1u << 24)
 #define MAX_THREADS 1024u
+#define MAX_BOUNCES 1024u
 #define MAX_MARGIN 64u
 
 static dwv_result_t read_seed(const cJSON *item, uint64_t *seed)
@@ -43,7 +44,10 @@ dwv_result_t dwvs_read_bake(dwvs_parser *ps, const cJSON *item)
     static const char *const keys[] = {"target",  "width",       "height",  "samples",   "technique",
                                        "channel_walks", "time_limit", "target_error", "seed", "threads",
                                        "max_events", "tile_size", "uv_mesh",     "uv_margin",
-                                       "transparent_background", "passes"};
+                                       "transparent_background", "passes", "max_bounces", "diffuse_bounces",
+                                       "glossy_bounces", "transmission_bounces", "min_light_bounces",
+                                       "subsurface_after_diffuse"};
+    static const char *const after_diffuse[] = {"by_model", "lambert", "walk"};
     static const char *const targets[] = {"camera", "uv"};
     DWV_TRY(dwvs_check_keys(item, "bake", keys, sizeof keys / sizeof keys[0]));
     dwv_bake_options_t *o = &ps->options;
@@ -112,6 +116,19 @@ dwv_result_t dwvs_read_bake(dwvs_parser *ps, const cJSON *item)
             mask |= DWV_PASS_BIT(pass);
         }
         o->passes = mask;
+    }
+
+    /* Cycles' Light Paths (capi's dwv_bake_options_t: 0 to 1024 each). */
+    DWV_TRY(dwvs_opt_u32(item, "bake", "max_bounces", 0u, MAX_BOUNCES, &o->max_bounces));
+    DWV_TRY(dwvs_opt_u32(item, "bake", "diffuse_bounces", 0u, MAX_BOUNCES, &o->diffuse_bounces));
+    DWV_TRY(dwvs_opt_u32(item, "bake", "glossy_bounces", 0u, MAX_BOUNCES, &o->glossy_bounces));
+    DWV_TRY(dwvs_opt_u32(item, "bake", "transmission_bounces", 0u, MAX_BOUNCES, &o->transmission_bounces));
+    DWV_TRY(dwvs_opt_u32(item, "bake", "min_light_bounces", 0u, MAX_BOUNCES, &o->min_light_bounces));
+    const cJSON *after = dwvs_member(item, "subsurface_after_diffuse");
+    if (after) {
+        size_t a = 0;
+        DWV_TRY(dwvs_read_choice(after, "bake.subsurface_after_diffuse", after_diffuse, 3, &a));
+        o->subsurface_after_diffuse = (dwv_subsurface_after_diffuse_t)a;
     }
 
     const cJSON *uv_mesh = dwvs_member(item, "uv_mesh"), *uv_margin = dwvs_member(item, "uv_margin");

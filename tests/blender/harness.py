@@ -163,6 +163,18 @@ def dwivedi_bake(scene, seed, samples, output_dir, event_cap=None):
     return pixels, seconds
 
 
+def render_and_bake(name, scene, cycles_samples, dwivedi_samples, work, event_cap=256):
+    """Cycles' renders and the add-on's bakes of `scene` with seeds 1 and 2 (files `name`_* in
+    `work`), compared (compare_two_seeds) with their times and samples. The event cap defaults to
+    Cycles' own 256 events per walk (BSSRDF_MAX_BOUNCES), as test_fidelity.py."""
+    c1, tc1 = cycles_render(scene, 1, cycles_samples, work / f"{name}_cycles_1.exr")
+    c2, tc2 = cycles_render(scene, 2, cycles_samples, work / f"{name}_cycles_2.exr")
+    o1, to1 = dwivedi_bake(scene, 1, dwivedi_samples, work / f"{name}_dwivedi_1", event_cap)
+    o2, to2 = dwivedi_bake(scene, 2, dwivedi_samples, work / f"{name}_dwivedi_2", event_cap)
+    return {**compare_two_seeds((c1, c2), (o1, o2)), "cycles_seconds": tc1 + tc2, "cycles_samples": 2 * cycles_samples,
+            "dwivedi_seconds": to1 + to2, "dwivedi_samples": 2 * dwivedi_samples}
+
+
 def compare_two_seeds(cycles_pair, ours_pair):
     """Cycles' and dwivedi's two-seed images of one scene (RGBA lists) compared: means per
     channel of the two-seed means, their relative difference, and per channel the noise ratio

@@ -166,15 +166,10 @@ def procedural_scene(resolution, samples):
 
 def compare(name, build):
     scene = build(RESOLUTION, CYCLES_SAMPLES)
-    c1, tc1 = harness.cycles_render(scene, 1, CYCLES_SAMPLES, WORK / f"{name}_cycles_1.exr")
-    c2, tc2 = harness.cycles_render(scene, 2, CYCLES_SAMPLES, WORK / f"{name}_cycles_2.exr")
-    # Cycles' own cap of 256 events per walk (BSSRDF_MAX_BOUNCES), as test_fidelity.py: without it
+    # Cycles' own cap of 256 events per walk (harness.render_and_bake's default): without it
     # dwivedi keeps the light Cycles loses on the sphere's long red walks (about +1.3%).
-    o1, to1 = harness.dwivedi_bake(scene, 1, DWIVEDI_SAMPLES, WORK / f"{name}_dwivedi_1", 256)
-    o2, to2 = harness.dwivedi_bake(scene, 2, DWIVEDI_SAMPLES, WORK / f"{name}_dwivedi_2", 256)
-    figures = {**harness.compare_two_seeds((c1, c2), (o1, o2)), "cycles_seconds": tc1 + tc2, "cycles_samples": 2 * CYCLES_SAMPLES,
-               "dwivedi_seconds": to1 + to2, "dwivedi_samples": 2 * DWIVEDI_SAMPLES, "resolution": RESOLUTION,
-               "warnings": last_warnings()}
+    figures = {**harness.render_and_bake(name, scene, CYCLES_SAMPLES, DWIVEDI_SAMPLES, WORK),
+               "resolution": RESOLUTION, "warnings": last_warnings()}
     FIGURES[name] = figures
     print(f"\n{name}: " + json.dumps(figures, indent=1), flush=True)
     (harness.HOME / "world_spot_figures.json").write_text(json.dumps(FIGURES, indent=2))

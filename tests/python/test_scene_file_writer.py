@@ -11,7 +11,7 @@ import unittest
 
 import dwivedi
 from dwivedi import scene_file
-from dwivedi.scene_file import SceneFileWriter, degrees_for
+from dwivedi.scene_file import LIGHT_PATH_KEYS, SceneFileWriter, degrees_for, light_path_keys
 
 CUBE = [-1, -1, -1, 1, -1, -1, 1, 1, -1, -1, 1, -1, -1, -1, 1, 1, -1, 1, 1, 1, 1, -1, 1, 1]
 CUBE_TRIANGLES = [0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4, 1, 2, 6, 1, 6, 5, 2, 3, 7, 2, 7, 6,
@@ -66,6 +66,25 @@ class SceneFileWriterTest(unittest.TestCase):
                 json.dump(document, f)
             planted = dwivedi.Scene.load(path).bake(options)
             self.assertNotEqual(bytes(planted.rgba), bytes(a.rgba))
+
+    def test_light_paths_written_and_read_back(self) -> None:
+        writer = SceneFileWriter()
+        build(writer)
+        paths = dwivedi.BakeSettings(max_bounces=7, diffuse_bounces=3, glossy_bounces=2, transmission_bounces=1,
+                                     min_light_bounces=4, subsurface_after_diffuse="walk")
+        with tempfile.TemporaryDirectory() as folder:
+            path = os.path.join(folder, "scene.json")
+            writer.write(path, bake=dict(width=8, height=8, samples=2, **light_path_keys(paths)))
+            loaded = dwivedi.Scene.load(path).settings
+            for key in LIGHT_PATH_KEYS:
+                self.assertEqual(getattr(loaded, key), getattr(paths, key), key)
+            absent = os.path.join(folder, "absent.json")
+            writer.write(absent, bake=dict(width=8, height=8, samples=2))
+            defaults = dwivedi.Scene.load(absent).settings  # Blender's Light Paths
+            self.assertEqual((defaults.max_bounces, defaults.diffuse_bounces, defaults.glossy_bounces,
+                              defaults.transmission_bounces, defaults.subsurface_after_diffuse), (12, 4, 4, 12, "by_model"))
+        with self.assertRaises(dwivedi.Error):
+            light_path_keys(dwivedi.BakeSettings(subsurface_after_diffuse="sometimes"))
 
     def test_sun_angle_degrees_map_back_exactly(self) -> None:
         per_degree = 3.14159265358979323846 / 180.0

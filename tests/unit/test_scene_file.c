@@ -55,8 +55,10 @@ static int same_options(const dwv_bake_options_t *a, const dwv_bake_options_t *b
            a->technique == b->technique && a->samples == b->samples && a->time_limit == b->time_limit &&
            a->target_error == b->target_error && a->threads == b->threads && a->max_events == b->max_events &&
            a->seed == b->seed && a->tile_size == b->tile_size && a->channel_walks == b->channel_walks &&
-           a->progress == b->progress &&
-           a->progress_user == b->progress_user;
+           a->progress == b->progress && a->max_bounces == b->max_bounces &&
+           a->diffuse_bounces == b->diffuse_bounces && a->glossy_bounces == b->glossy_bounces &&
+           a->transmission_bounces == b->transmission_bounces && a->min_light_bounces == b->min_light_bounces &&
+           a->subsurface_after_diffuse == b->subsurface_after_diffuse && a->progress_user == b->progress_user;
 }
 
 /* Loads JSON text (with meshes relative to the temp folder) and expects failure with `code`, a
@@ -513,6 +515,25 @@ static void test_schema(void)
         CHECK(walk_options.channel_walks == walks[i].caller, "channel_walks %u not kept when absent: %u",
               walks[i].caller, walk_options.channel_walks);
     }
+    /* Light paths (issue 18): read, kept when absent, ranges and names checked. */
+    dwv_bake_options_t paths = DWV_BAKE_OPTIONS_INIT;
+    CHECK(load_text("{\"version\": 1, \"meshes\": [], " CAMERA ", \"bake\": {\"max_bounces\": 3, \"diffuse_bounces\": 2, "
+                    "\"glossy_bounces\": 1, \"transmission_bounces\": 0, \"min_light_bounces\": 5, "
+                    "\"subsurface_after_diffuse\": \"walk\"}}",
+                    &paths) == DWV_SUCCESS,
+          "light paths: %s", dwv_last_error_message());
+    CHECK(paths.max_bounces == 3u && paths.diffuse_bounces == 2u && paths.glossy_bounces == 1u &&
+              paths.transmission_bounces == 0u && paths.min_light_bounces == 5u &&
+              paths.subsurface_after_diffuse == DWV_SUBSURFACE_AFTER_DIFFUSE_WALK,
+          "light paths read as %u %u %u %u %u %d", paths.max_bounces, paths.diffuse_bounces, paths.glossy_bounces,
+          paths.transmission_bounces, paths.min_light_bounces, (int)paths.subsurface_after_diffuse);
+    CHECK(load_text("{\"version\": 1, \"meshes\": [], " CAMERA ", \"bake\": {\"samples\": 4}}", &paths) == DWV_SUCCESS &&
+              paths.max_bounces == 3u && paths.subsurface_after_diffuse == DWV_SUBSURFACE_AFTER_DIFFUSE_WALK,
+          "light paths not kept when absent");
+    expect_failure("1025 bounces", "{\"version\": 1, \"meshes\": [], " CAMERA ", \"bake\": {\"glossy_bounces\": 1025}}",
+                   DWV_ERROR_OUT_OF_RANGE, "bake.glossy_bounces", NULL);
+    expect_failure("after diffuse", "{\"version\": 1, \"meshes\": [], " CAMERA ", \"bake\": {\"subsurface_after_diffuse\": \"x\"}}",
+                   DWV_ERROR_UNKNOWN_NAME, "subsurface_after_diffuse", NULL);
 }
 
 static void test_numbers_and_strings(void)

@@ -164,9 +164,16 @@ int main(void)
     old.sample_first = 99; /* beyond its struct_size: never read */
     old.sample_count = 99;
     dwv_image_t *old_image = NULL;
-    CHECK(dwv_bake(scene, &old, &old_image) == DWV_SUCCESS && same_image(old_image, whole),
+    /* (its struct also ends before the light paths: the one-bounce image) */
+    dwv_bake_options_t one_bounce = base;
+    one_bounce.max_bounces = one_bounce.diffuse_bounces = one_bounce.glossy_bounces = 0u;
+    one_bounce.transmission_bounces = 0u;
+    dwv_image_t *one_bounce_image = NULL;
+    CHECK(dwv_bake(scene, &one_bounce, &one_bounce_image) == DWV_SUCCESS, "one bounce: %s", dwv_last_error_message());
+    CHECK(dwv_bake(scene, &old, &old_image) == DWV_SUCCESS && same_image(old_image, one_bounce_image),
           "older struct_size: the whole bake (%s)", dwv_last_error_message());
     dwv_image_release(old_image);
+    dwv_image_release(one_bounce_image);
     dwv_image_release(whole);
     dwv_scene_release(scene);
     char command[400];
