@@ -672,6 +672,9 @@ dwv_result_t dwv_scene_add_texture_file(dwv_scene_t *scene, const char *path, co
     DWV_TRY(dwv_check_pointer(fn, "path", path));
     DWV_TRY(dwv_check_struct(fn, "settings", settings, (uint32_t)sizeof(dwv_texture_desc_t)));
     DWV_TRY(dwv_check_pointer(fn, "texture_id", texture_id));
+    FILE *probe = fopen(path, "rb");
+    if (!probe) return dwv_fail(DWV_ERROR_IO, "%s: cannot read '%s': %s", fn, path, strerror(errno));
+    fclose(probe);
     int exr = dwvo_file_is_exr(path);
     if (exr && settings->format != DWV_TEXEL_FLOAT32)
         return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,

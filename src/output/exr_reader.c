@@ -48,36 +48,46 @@ static int slot_of(const channel_plan *plan, const char *name)
     return strcmp(name, "Y") == 0 ? 0 : -1;
 }
 
-/* Decodes one chunk into the top-down interleaved buffer `out` of `width` texels a row. */
+/* Decodes one chunk into the top-down interleaved buffer `out` of `width` texels a row, its first
+ * texel at column x0, row y0 of the data window (OpenEXR 3.1 gives a tile's start_x / start_y as
+ * tile numbers, not pixels: the caller says where it goes), through
+ * `scratch` (one plane per channel slot, *scratch_size bytes, grown as needed). Each channel is
+ * decoded into its own plane and interleaved here: OpenEXR 3.1's fast paths for interleaved
+ * half channels write them in the file's (sorted) order whatever the pointers say. */
 static exr_result_t decode_chunk(exr_context_t ctxt, const exr_chunk_info_t *chunk, exr_decode_pipeline_t *decoder,
-                                 int *ready, const channel_plan *plan, const exr_attr_box2i_t *window, float *out,
-                                 uint32_t width)
+                                 int *ready, const channel_plan *plan, size_t x0, size_t y0, float *out,
+                                 uint32_t width, float **scratch, size_t *scratch_size)
 {
     exr_result_t rv = *ready ? exr_decoding_update(ctxt, 0, chunk, decoder)
                              : exr_decoding_initialize(ctxt, 0, chunk, decoder);
     if (rv != EXR_ERR_SUCCESS) return rv;
-    int first = !*ready;
     *ready = 1;
-    size_t pixel = (size_t)plan->count * sizeof(float);
+    size_t cw = (size_t)chunk->width, ch = (size_t)chunk->height, plane = cw * ch;
+    size_t need = plane * plan->count * sizeof(float);
+    if (need > *scratch_size) {
+        float *grown = realloc(*scratch, need);
+        if (!grown) return EXR_ERR_OUT_OF_MEMORY;
+        *scratch = grown;
+        *scratch_size = need;
+    }
     for (int16_t c = 0; c < decoder->channel_count; ++c) {
         exr_coding_channel_info_t *channel = &decoder->channels[c];
         int slot = slot_of(plan, channel->channel_name);
         channel->user_bytes_per_element = 4;
         channel->user_data_type = EXR_PIXEL_FLOAT;
-        channel->user_pixel_stride = (int32_t)pixel;
-        channel->user_line_stride = (int32_t)(pixel * width);
-        channel->decode_to_ptr =
-            slot < 0 ? NULL
-                     : (uint8_t *)out +
-                           ((size_t)(chunk->start_y - window->min.y) * width + (size_t)(chunk->start_x - window->min.x)) *
-                               pixel +
-                           (size_t)slot * sizeof(float);
+        channel->user_pixel_stride = (int32_t)sizeof(float);
+        channel->user_line_stride = (int32_t)(cw * sizeof(float));
+        channel->decode_to_ptr = slot < 0 ? NULL : (uint8_t *)(*scratch + (size_t)slot * plane);
     }
-    if (first) {
-        rv = exr_decoding_choose_default_routines(ctxt, 0, decoder);
-        if (rv != EXR_ERR_SUCCESS) return rv;
-    }
-    return exr_decoding_run(ctxt, 0, decoder);
+    /* The routines depend on the pointers' layout: chosen again for every chunk (cheap). */
+    rv = exr_decoding_choose_default_routines(ctxt, 0, decoder);
+    if (rv == EXR_ERR_SUCCESS) rv = exr_decoding_run(ctxt, 0, decoder);
+    if (rv != EXR_ERR_SUCCESS) return rv;
+    for (size_t y = 0; y < ch; ++y)
+        for (size_t x = 0; x < cw; ++x)
+            for (uint32_t k = 0; k < plan->count; ++k)
+                out[((y0 + y) * width + x0 + x) * plan->count + k] = (*scratch)[k * plane + y * cw + x];
+    return EXR_ERR_SUCCESS;
 }
 
 dwv_result_t dwvo_read_exr_float(const char *path, uint32_t max_side, uint64_t max_texels, uint32_t *width,
@@ -95,7 +105,8 @@ dwv_result_t dwvo_read_exr_float(const char *path, uint32_t max_side, uint64_t m
     init.error_handler_fn = on_exr_error;
     exr_context_t ctxt = NULL;
     dwv_result_t result = DWV_SUCCESS;
-    float *data = NULL;
+    float *data = NULL, *scratch = NULL;
+    size_t scratch_size = 0;
     exr_decode_pipeline_t decoder;
     memset(&decoder, 0, sizeof decoder);
     int ready = 0;
@@ -163,8 +174,8 @@ dwv_result_t dwvo_read_exr_float(const char *path, uint32_t max_side, uint64_t m
         for (int64_t y = window.min.y; y <= window.max.y; y += lines) {
             exr_chunk_info_t chunk;
             if ((rv = exr_read_scanline_chunk_info(ctxt, 0, (int)y, &chunk)) != EXR_ERR_SUCCESS) EXR_FAIL("scanlines");
-            if ((rv = decode_chunk(ctxt, &chunk, &decoder, &ready, &plan, &window, data, (uint32_t)w)) !=
-                EXR_ERR_SUCCESS)
+            if ((rv = decode_chunk(ctxt, &chunk, &decoder, &ready, &plan, 0u, (size_t)(y - window.min.y), data,
+                                   (uint32_t)w, &scratch, &scratch_size)) != EXR_ERR_SUCCESS)
                 EXR_FAIL("decoding scanlines");
         }
     } else {
@@ -177,7 +188,8 @@ dwv_result_t dwvo_read_exr_float(const char *path, uint32_t max_side, uint64_t m
                 exr_chunk_info_t chunk;
                 if ((rv = exr_read_tile_chunk_info(ctxt, 0, (int)tx, (int)ty, 0, 0, &chunk)) != EXR_ERR_SUCCESS)
                     EXR_FAIL("tiles");
-                if ((rv = decode_chunk(ctxt, &chunk, &decoder, &ready, &plan, &window, data, (uint32_t)w)) !=
+                if ((rv = decode_chunk(ctxt, &chunk, &decoder, &ready, &plan, (size_t)(tx * tile_w),
+                                       (size_t)(ty * tile_h), data, (uint32_t)w, &scratch, &scratch_size)) !=
                     EXR_ERR_SUCCESS)
                     EXR_FAIL("decoding tiles");
             }
@@ -202,5 +214,6 @@ done:
     if (ready) exr_decoding_destroy(ctxt, &decoder);
     if (ctxt) exr_finish(&ctxt);
     free(data);
+    free(scratch);
     return result;
 }
