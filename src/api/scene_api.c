@@ -746,12 +746,6 @@ dwv_result_t dwv_scene_bind_texture(dwv_scene_t *scene, uint32_t material_id, co
     if (binding->reserved != 0u) return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: reserved must be 0", fn);
     if (binding->uv_layer && strlen(binding->uv_layer) > MAX_LAYER_NAME)
         return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: uv_layer is longer than %u bytes", fn, MAX_LAYER_NAME);
-    const dwv_material_t *material = &s->materials[material_id];
-    if (material->specular_model == DWV_SPECULAR_PRINCIPLED_V2 && (input == DWV_INPUT_ROUGHNESS || input == DWV_INPUT_SPECULAR))
-        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
-                        "%s: a textured %s under the 4.x+ Principled v2 specular layer is not supported (its albedo "
-                        "tables are made per material); give the input a constant", fn,
-                        input == DWV_INPUT_ROUGHNESS ? "Roughness" : "Specular IOR Level");
     for (uint32_t b = 0; b < s->binding_count; ++b)
         if (s->bindings[b].material_id == material_id && s->bindings[b].input == input &&
             (input == DWV_INPUT_NORMAL_MAP || input == DWV_INPUT_BUMP))
