@@ -130,6 +130,37 @@ class SceneFileImages(unittest.TestCase):
         self.assert_refused(self.scene(world={"environment": {"file": "sky.exr", "rotation": [1, 0, 0, 0, 1, 0, 0, 0, -1]}}),
                             "world.environment.file", "mirrors")
 
+    def test_shim_file_calls(self):
+        """Scene.add_texture_file and set_world_environment_file: the same bits as in memory."""
+        texels = [((k * 5) % 9) / 8.0 for k in range(3 * 5 * 4)]
+        sky = [0.2 + ((k * 7) % 11) / 10.0 for k in range(3 * 8 * 4)]
+        tex = self.write("tex.exr", image_files.exr_bytes(texels, 5, 4, 3, half=True))
+        env = self.write("env.exr", image_files.exr_bytes(sky, 8, 4, 3))
+        rotation = [0, -1, 0, 1, 0, 0, 0, 0, 1]
+
+        def build(from_files):
+            scene = dwivedi.Scene()
+            material = scene.add_material(dwivedi.Material.diffuse((0.5, 0.5, 0.5)))
+            if from_files:
+                texture = scene.add_texture_file(os.path.join(self.folder, tex), interpolation="closest")
+                scene.set_world_environment_file(os.path.join(self.folder, env), strength=0.7, rotation=rotation)
+            else:
+                texture = scene.add_texture(texels, 5, 4, 3, interpolation="closest")
+                scene.set_world_environment(sky, 8, 4, strength=0.7, rotation=rotation)
+            scene.bind_texture(material, "base_color", texture)
+            scene.add_mesh([-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0], [0, 1, 2, 0, 2, 3], material,
+                           uvs=[0, 0, 1, 0, 1, 1, 0, 0, 1, 1, 0, 1])
+            scene.add_light(dwivedi.SunLight(strength=2.0))
+            scene.set_camera(dwivedi.Camera.look_at((0.3, -2.0, 1.5), (0, 0, 0)))
+            return scene.commit()
+
+        settings = dict(width=12, height=8, samples=2, threads=2)
+        a, b = build(True).bake(**settings), build(False).bake(**settings)
+        self.assertEqual(bytes(a.rgba), bytes(b.rgba))
+        with self.assertRaises(dwivedi.Error) as caught:
+            dwivedi.Scene().add_texture_file(os.path.join(self.folder, tex), format="srgb8")
+        self.assertIn("scene-linear floats", str(caught.exception))
+
 
 if __name__ == "__main__":
     unittest.main()
