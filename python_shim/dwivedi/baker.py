@@ -64,6 +64,17 @@ def _call(name: str, *args: Any) -> None:
     _library.check(result)
 
 
+def _environment_settings(c: Any, strength: float, rotation: Any, interpolation: str) -> None:
+    """An EnvironmentDesc's strength, interpolation and rotation (3 x 3 nested or 9 numbers, None:
+    none) from set_world_environment's arguments."""
+    c.strength = _real("strength", strength)
+    c.interpolation = _name_code("interpolation", interpolation, {"linear": 0, "closest": 1, "cubic": 2})
+    values = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0] if rotation is None else list(rotation)
+    if len(values) == 3:  # rows
+        values = [x for row in values for x in row]
+    c.rotation[:] = real_tuple(values, "rotation", 9)
+
+
 def _real(name: str, value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise TypeError(f"{name} must be a real number, not {type(value).__name__}")
@@ -782,12 +793,7 @@ class Scene:
             raise Error(f"texels hold {t.count} numbers: a {c.width} x {c.height} image needs {3 * c.width * c.height}",
                         _library.DWV_ERROR_INVALID_ARGUMENT)
         c.texels = t.address or None
-        c.strength = _real("strength", strength)
-        c.interpolation = _name_code("interpolation", interpolation, {"linear": 0, "closest": 1, "cubic": 2})
-        values = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0] if rotation is None else list(rotation)
-        if len(values) == 3:  # rows
-            values = [x for row in values for x in row]
-        c.rotation[:] = real_tuple(values, "rotation", 9)
+        _environment_settings(c, strength, rotation, interpolation)
         _call("dwv_scene_set_world_environment", self.handle, ctypes.byref(c))
 
     def set_world_environment_file(self, path: str, *, strength: float = 1.0, rotation: Any = None,
@@ -795,12 +801,7 @@ class Scene:
         """The equirectangular world from an OpenEXR or Radiance (.hdr) file
         (dwv_scene_set_world_environment_file); the other arguments as set_world_environment's."""
         c = _library.EnvironmentDesc()
-        c.strength = _real("strength", strength)
-        c.interpolation = _name_code("interpolation", interpolation, {"linear": 0, "closest": 1, "cubic": 2})
-        values = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0] if rotation is None else list(rotation)
-        if len(values) == 3:  # rows
-            values = [x for row in values for x in row]
-        c.rotation[:] = real_tuple(values, "rotation", 9)
+        _environment_settings(c, strength, rotation, interpolation)
         _call("dwv_scene_set_world_environment_file", self.handle, os.fsencode(path), ctypes.byref(c))
 
     def set_camera(self, camera: Camera) -> None:

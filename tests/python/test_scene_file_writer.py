@@ -85,23 +85,32 @@ def build_textured(scene) -> None:
     scene.set_camera(dwivedi.Camera.look_at((0.05, -0.3, 0.12), (0, 0, 0.03), focal_length=40.0))
 
 
+def bake_memory_and_file(test, builder, folder, name, settings):
+    """The scene `builder` makes, baked in memory and from the file SceneFileWriter writes of the
+    same calls: the two bakes must be the same bits. Returns (the in-memory image, the loaded
+    scene, the bake options, the file's path)."""
+    memory = dwivedi.Scene()
+    builder(memory)
+    memory.commit()
+    writer = SceneFileWriter()
+    builder(writer)
+    path = os.path.join(folder, name)
+    writer.write(path, bake=settings)
+    loaded = dwivedi.Scene.load(path)
+    options = dataclasses.replace(loaded.settings, threads=2)
+    a, b = memory.bake(options), loaded.bake(options)
+    test.assertEqual(bytes(a.rgba), bytes(b.rgba))
+    test.assertEqual(bytes(a.variance), bytes(b.variance))
+    test.assertEqual(memory.texture_memory(), loaded.texture_memory())
+    return a, loaded, options, path
+
+
 class SceneFileWriterTest(unittest.TestCase):
     def test_written_scene_bakes_the_same_bits(self) -> None:
-        memory = dwivedi.Scene()
-        build(memory)
-        memory.commit()
-        writer = SceneFileWriter()
-        build(writer)
         settings = dict(width=24, height=16, samples=8, technique="auto", seed=5)
         with tempfile.TemporaryDirectory() as folder:
-            path = os.path.join(folder, "scene.json")
-            writer.write(path, bake=settings)
-            loaded = dwivedi.Scene.load(path)
+            a, loaded, options, path = bake_memory_and_file(self, build, folder, "scene.json", settings)
             self.assertEqual((loaded.settings.width, loaded.settings.samples, loaded.settings.seed), (24, 8, 5))
-            options = dataclasses.replace(loaded.settings, threads=2)
-            a, b = memory.bake(options), loaded.bake(options)
-            self.assertEqual(bytes(a.rgba), bytes(b.rgba))
-            self.assertEqual(bytes(a.variance), bytes(b.variance))
             self.assertGreater(a.stats.mean_rgb[0], 0.0)
 
             with open(path, encoding="utf-8") as f:
@@ -118,23 +127,11 @@ class SceneFileWriterTest(unittest.TestCase):
             self.assertEqual(degrees_for(radians) * per_degree, radians, radians)
 
     def test_textured_scene_with_an_environment_bakes_the_same_bits(self) -> None:
-        memory = dwivedi.Scene()
-        build_textured(memory)
-        memory.commit()
-        writer = SceneFileWriter()
-        build_textured(writer)
         settings = dict(width=20, height=14, samples=6, technique="auto", seed=3)
         with tempfile.TemporaryDirectory() as folder:
-            path = os.path.join(folder, "shot.json")
-            writer.write(path, bake=settings)
+            a, loaded, options, path = bake_memory_and_file(self, build_textured, folder, "shot.json", settings)
             self.assertEqual(sorted(os.listdir(os.path.join(folder, "shot_files"))),
                              ["environment.exr", "texture0.exr", "texture1.png", "texture2.exr", "texture3.png"])
-            loaded = dwivedi.Scene.load(path)
-            options = dataclasses.replace(loaded.settings, threads=2)
-            a, b = memory.bake(options), loaded.bake(options)
-            self.assertEqual(bytes(a.rgba), bytes(b.rgba))
-            self.assertEqual(bytes(a.variance), bytes(b.variance))
-            self.assertEqual(memory.texture_memory(), loaded.texture_memory())
             with open(path, encoding="utf-8") as f:
                 document = json.load(f)
             self.assertEqual(len(document["world"]["environment"]["rotation"]), 9)
