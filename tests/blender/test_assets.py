@@ -8,6 +8,8 @@
   Texture): baked by Blender as a tangent-space normal map (256 x 256) and bound as one; against
   Cycles, means within 2% (measured 0.3%; figures printed), and the bump moves Cycles' own mean
   by 11%, more than the tolerance (the test can fail). At Distance 0.3 the gap grows to 3.7%;
+- the farm export's scene file of a scene with evaluated and image textures and an HDRI world
+  bakes the same bits as the add-on's scene in memory;
 - bad input: an image whose file is not an image (0 x 0 pixels) cancels the bake with a message
   naming it, nothing written; an HDRI of 1 x 1 bakes as the constant world of its colour (to 1e-5
   per pixel) and one of 100000 x 1 bakes.
@@ -149,6 +151,39 @@ class AssetsTest(harness.unittest.TestCase):
         self.assertLess(worst, 1e-5, "a 1 x 1 HDRI is the constant world of its colour")
         wide, _ = harness.dwivedi_bake(self.hdri(100000, 1, (0.3, 0.3, 0.3)), 4, 2, WORK / "hdri_wide")
         self.assertGreater(max(wide), 0.0)
+
+    def test_farm_scene_file_of_a_textured_scene(self):
+        """The farm export's scene file (SceneFileWriter) of a scene with evaluated textures, an
+        image texture and an HDRI world bakes the same bits as the add-on's scene in memory."""
+        scene = two_material_sphere(True)
+        grid = bpy.data.images.new("Grid", 16, 16, alpha=False)
+        grid.generated_type = 'COLOR_GRID'
+        tree = bpy.data.objects["Sphere"].data.materials[0].node_tree
+        node = tree.nodes.new("ShaderNodeTexImage")
+        node.image = grid
+        tree.links.new(node.outputs["Color"], tree.nodes["Principled BSDF"].inputs["Roughness"])
+        sky = bpy.data.images.new("sky", 8, 4, float_buffer=True)
+        sky.pixels.foreach_set([0.1 + 0.05 * (k % 7) for k in range(4 * 8 * 4)])
+        world = scene.world.node_tree
+        texture = world.nodes.new("ShaderNodeTexEnvironment")
+        texture.image = sky
+        world.links.new(texture.outputs["Color"], world.nodes["Background"].inputs["Color"])
+        addon = harness.addon_module()
+        dwivedi = addon.shim()
+        memory = addon.export.export_scene(bpy.context, scene.dwivedi_bake, dwivedi)
+        written = addon.export.export_scene(bpy.context, scene.dwivedi_bake, addon.farm._writer_module(dwivedi))
+        path = WORK / "farm" / "dwivedi_scene.json"
+        path.parent.mkdir(parents=True, exist_ok=True)
+        written.scene.write(str(path))
+        self.assertTrue((WORK / "farm" / "dwivedi_scene_files").is_dir())
+        loaded = dwivedi.Scene.load(str(path))
+        import dataclasses
+        options = dataclasses.replace(loaded.settings, width=12, height=12, samples=4, threads=2, seed=9)
+        a, b = memory.scene.bake(options), loaded.bake(options)
+        self.assertEqual(bytes(a.rgba), bytes(b.rgba))
+        self.assertGreater(a.stats.mean_rgb[0], 0.0)
+        memory.scene.close()
+        loaded.close()
 
 
 harness.run(AssetsTest)
