@@ -233,12 +233,13 @@ static dwv_result_t read_mesh(dwvs_parser *ps, const cJSON *item, const char *pa
         mesh.uvs = data.uvs;
         r = read_mesh_layers(item, path, mesh.triangle_count, data.uvs != NULL, &layers);
         attach_layers(&mesh, &layers, uv_name);
-        if (r == DWV_SUCCESS) r = dwv_scene_add_mesh(ps->scene, &mesh, &mesh_id);
-        else file_name = NULL;
-        if (r != DWV_SUCCESS && file_name) {
-            char where[PATH_SIZE + MAX_FILE_PATH / 16];
-            snprintf(where, sizeof where, "%s ('%s')", path, dwvs_shown(file_name, name));
-            r = dwvs_prefix_capi(r, where);
+        if (r == DWV_SUCCESS) {
+            r = dwv_scene_add_mesh(ps->scene, &mesh, &mesh_id);
+            if (r != DWV_SUCCESS) {
+                char where[PATH_SIZE + MAX_FILE_PATH / 16];
+                snprintf(where, sizeof where, "%s ('%s')", path, dwvs_shown(file_name, name));
+                r = dwvs_prefix_capi(r, where);
+            }
         }
         record->has_uvs = data.uvs != NULL;
         dwvs_mesh_data_free(&data);

@@ -344,7 +344,7 @@ static double largest_relative_difference(const test_result *a, const test_resul
 }
 
 /* v2's albedo tables over textured Roughness / Specular IOR Level (a grid, material.h): a
- * texture of a grid node's roughness (0.5 = node 16 of 33) bakes bit for bit as the constant;
+ * texture of a grid node's roughness (0.5 = node 8 of 17) bakes bit for bit as the constant;
  * between nodes (0.37) and for the level (whose nodes are in sqrt(f0)) within 0.2% of the
  * constant (the interpolation's error; the bakes are paired: same seed, same walks), while a
  * constant 0.1 away is far outside that (the comparison can fail). */
