@@ -11,8 +11,8 @@
 - the farm export's scene file of a scene with evaluated and image textures and an HDRI world
   bakes the same bits as the add-on's scene in memory;
 - bad input: an image whose file is not an image (0 x 0 pixels) cancels the bake with a message
-  naming it, nothing written; an HDRI of 1 x 1 bakes as the constant world of its colour (to 1e-5
-  per pixel) and one of 100000 x 1 bakes.
+  naming it, nothing written; an HDRI of 1 x 1 bakes as the constant world of its colour (to 1e-6
+  of each pixel: the operator's bakes vary in the last bits run to run) and one of 100000 x 1 bakes.
 """
 import math
 import sys
@@ -144,11 +144,13 @@ class AssetsTest(harness.unittest.TestCase):
         scene = scenes.sphere_scene(8, 4, shader='DIFFUSE')
         scenes.set_world(scene, (0.25, 0.5, 0.75), 0.5)
         constant, _ = harness.dwivedi_bake(scene, 4, 4, WORK / "hdri_constant")
-        # The library stores a 1 x 1 map as the constant world (bit for bit in unit.test_image_files);
-        # through the add-on the two bakes differ in the last bits of some pixels (not found why).
+        # The library stores a 1 x 1 map as exactly the constant world (bit for bit in
+        # unit.test_image_files); the add-on's operator bakes of one scene differ in the last bits
+        # of a few pixels from run to run (seen: the same constant-world scene baked twice in one
+        # session), so the bound here is 1e-6 of each pixel.
         worst = max(abs(a - b) / max(abs(b), 1e-6) for a, b in zip(one, constant))
         print(f"1 x 1 HDRI vs constant world: largest relative pixel difference {worst:.2g}", flush=True)
-        self.assertLess(worst, 1e-5, "a 1 x 1 HDRI is the constant world of its colour")
+        self.assertLess(worst, 1e-6, "a 1 x 1 HDRI is the constant world of its colour")
         wide, _ = harness.dwivedi_bake(self.hdri(100000, 1, (0.3, 0.3, 0.3)), 4, 2, WORK / "hdri_wide")
         self.assertGreater(max(wide), 0.0)
 
@@ -178,7 +180,10 @@ class AssetsTest(harness.unittest.TestCase):
         self.assertTrue((WORK / "farm" / "dwivedi_scene_files").is_dir())
         loaded = dwivedi.Scene.load(str(path))
         import dataclasses
-        options = dataclasses.replace(loaded.settings, width=12, height=12, samples=4, threads=2, seed=9)
+        # Technique Auto's trial picks walk engines by timing (which round differently in the last
+        # bits): a named technique and channel walks make the comparison exact.
+        options = dataclasses.replace(loaded.settings, width=12, height=12, samples=4, threads=2, seed=9,
+                                      technique="classical", channel_walks="shared")
         a, b = memory.scene.bake(options), loaded.bake(options)
         self.assertEqual(bytes(a.rgba), bytes(b.rgba))
         self.assertGreater(a.stats.mean_rgb[0], 0.0)
