@@ -683,6 +683,17 @@ typedef struct dwv_environment_t {
  * strength). Any other size within the limits is accepted too (a 100000 x 1 image is a world that
  * varies with longitude only); an all-black image or strength 0 is a black world. */
 DWV_API dwv_result_t dwv_scene_set_world_environment(dwv_scene_t *scene, const dwv_environment_t *environment);
+/* The environment from an image file: OpenEXR (half or float; R, G, B with or without A, whose
+ * alpha is dropped, or Y, taken as grey; the first part, scanline or tiled; values as stored,
+ * scene-linear as Blender takes EXRs) or a Radiance picture (.hdr, RGBE; Radiance's decoding
+ * (m + 0.5) 2^(e - 136), as Blender's loader). The file's size and texels replace `settings`'
+ * width, height and texels (ignored); interpolation, strength and rotation come from it, checked
+ * as dwv_scene_set_world_environment checks them, and so are the texels (the message names the
+ * file and the texel). A missing file: DWV_ERROR_IO; another kind of file, a damaged or truncated
+ * one, a side beyond DWV_ENVIRONMENT_MAX_SIDE or more than DWV_ENVIRONMENT_MAX_TEXELS texels
+ * (refused before its texels are read): DWV_ERROR_FORMAT. The scene is unchanged on failure. */
+DWV_API dwv_result_t dwv_scene_set_world_environment_file(dwv_scene_t *scene, const char *path,
+                                                          const dwv_environment_t *settings);
 /* ---- end of the world environment ---------------------------------------------------------- */
 
 typedef int32_t dwv_camera_kind_t;
@@ -780,7 +791,14 @@ DWV_API dwv_result_t dwv_scene_add_texture(dwv_scene_t *scene, const dwv_texture
 /* A texture from a PNG file (8 bits per channel; 16-bit files are reduced to 8): its size and
  * channels (1 grey, 3 colour, 4 with alpha) come from the file, extension and interpolation from
  * `settings`, whose format says what the bytes are (DWV_TEXEL_SRGB8 or DWV_TEXEL_LINEAR8; other
- * fields ignored). A missing file: DWV_ERROR_IO; not a PNG: DWV_ERROR_FORMAT; the message names it. */
+ * fields ignored). A missing file: DWV_ERROR_IO; not a PNG: DWV_ERROR_FORMAT; the message names it.
+ * Or from an OpenEXR file (told by its magic number; added after 0.2): float texels as stored
+ * (half converted; scene-linear, as Blender takes EXRs), channels R G B A -> 4, R G B -> 3, Y -> 1
+ * (an alpha beside Y is dropped), the first part (scanline, or a tiled one's full resolution);
+ * settings->format must then be DWV_TEXEL_FLOAT32. A multi-layer or deep file, sub-sampled
+ * channels, an empty data window, sizes beyond the limits (refused before the texels are read),
+ * a damaged or truncated file: DWV_ERROR_FORMAT; NaN or infinite texels are refused as
+ * dwv_scene_add_texture refuses them, the file named. The scene is unchanged on failure. */
 DWV_API dwv_result_t dwv_scene_add_texture_file(dwv_scene_t *scene, const char *path,
                                                 const dwv_texture_desc_t *settings, uint32_t *texture_id);
 

@@ -1,10 +1,18 @@
 """Material inputs driven by node trees other than an Image Texture (a procedural texture, a
 Mapping node, a Mix...), evaluated by Blender itself: Cycles bakes the input's value as emission
 into a float image on the object's active UV map (Object.bake, type EMIT, 1 sample), which the
-add-on then passes as an image texture (textures.py). The material is changed only for the bake
-and restored (its links, nodes, the scene's render settings, the selection), and the image is
-removed once its pixels are read. The resolution is the user's (scene.dwivedi_bake.texture_bake_size)
-and the warning states it; texture detail finer than it is lost.
+add-on then passes as an image texture (textures.py). A Normal input fed by anything but an
+Image Texture through a Normal Map or Bump node is baked as Blender's normal bake does (type
+NORMAL, tangent space of the active UV map: the shading normal as 0.5 + 0.5 (x, y, z) in its
+MikkTSpace frame) and bound as a tangent-space normal map of that UV map, which maps it back.
+
+An object with several materials is baked per material: the material being evaluated gets the
+target image, every other material of the object a throwaway image for its own faces (Cycles
+writes each face into its own material's active image), so each material's image holds its
+faces only. The materials are changed only for the bake and restored (their links, nodes, the
+scene's render settings, the selection), and the images are removed once their pixels are read.
+The resolution is the user's (scene.dwivedi_bake.texture_bake_size) and the warning states it;
+texture detail finer than it is lost.
 """
 from __future__ import annotations
 
@@ -23,51 +31,75 @@ def _active_output(tree: Any) -> Any:
 
 
 def _bake_socket(obj: Any, material: Any, socket: Any, size: int) -> Any:
-    """A float image of `socket`'s value over the object's active UV map."""
+    """A float image of `socket`'s value (the Normal input: the tangent-space normal map of the
+    shading normal) over the object's active UV map, on the faces of `material`."""
+    normal = socket.name == "Normal"
     tree = material.node_tree
     output = _active_output(tree)
     image = bpy.data.images.new(f"dwivedi {material.name} {socket.name}", size, size, alpha=False, float_buffer=True)
     image.colorspace_settings.name = 'Non-Color'
-    emission = tree.nodes.new("ShaderNodeEmission")
+    emission = None if normal else tree.nodes.new("ShaderNodeEmission")
     target = tree.nodes.new("ShaderNodeTexImage")
     target.image = image
     surface = output.inputs["Surface"]
     previous = [link.from_socket for link in surface.links]
     active = tree.nodes.active
+    # The object's other materials write their faces into a throwaway image.
+    others = []
+    spare = None
+    for slot in obj.material_slots:
+        other = slot.material
+        if other is None or other == material or other.node_tree is None or any(o[0] == other for o in others):
+            continue
+        if spare is None:
+            spare = bpy.data.images.new("dwivedi spare", 8, 8, alpha=False, float_buffer=True)
+        node = other.node_tree.nodes.new("ShaderNodeTexImage")
+        node.image = spare
+        others.append((other, node, other.node_tree.nodes.active))
+        other.node_tree.nodes.active = node
     scene = bpy.context.scene
-    saved = (scene.render.engine, scene.cycles.samples, scene.render.bake.margin, scene.render.bake.use_clear,
-             scene.render.bake.target)
+    bake = scene.render.bake
+    saved = (scene.render.engine, scene.cycles.samples, bake.margin, bake.use_clear, bake.target, bake.normal_space,
+             bake.normal_r, bake.normal_g, bake.normal_b)
     view_layer = bpy.context.view_layer
     selected = [o for o in view_layer.objects if o.select_get()]
     was_active = view_layer.objects.active
     try:
-        tree.links.new(socket.links[0].from_socket, emission.inputs["Color"])
-        emission.inputs["Strength"].default_value = 1.0
-        tree.links.new(emission.outputs["Emission"], surface)
+        if not normal:
+            tree.links.new(socket.links[0].from_socket, emission.inputs["Color"])
+            emission.inputs["Strength"].default_value = 1.0
+            tree.links.new(emission.outputs["Emission"], surface)
         tree.nodes.active = target
         scene.render.engine = 'CYCLES'
         scene.cycles.samples = 1
-        scene.render.bake.margin = 4
-        scene.render.bake.use_clear = True
-        scene.render.bake.target = 'IMAGE_TEXTURES'
+        bake.margin = 4
+        bake.use_clear = True
+        bake.target = 'IMAGE_TEXTURES'
+        bake.normal_space, bake.normal_r, bake.normal_g, bake.normal_b = 'TANGENT', 'POS_X', 'POS_Y', 'POS_Z'
         for o in selected:
             o.select_set(False)
         obj.select_set(True)
         view_layer.objects.active = obj
-        bpy.ops.object.bake(type='EMIT')
+        bpy.ops.object.bake(type='NORMAL' if normal else 'EMIT')
     except BaseException:
         bpy.data.images.remove(image)
         raise
     finally:
-        for link in list(surface.links):
-            tree.links.remove(link)
-        for source in previous:
-            tree.links.new(source, surface)
-        tree.nodes.remove(emission)
+        if not normal:
+            for link in list(surface.links):
+                tree.links.remove(link)
+            for source in previous:
+                tree.links.new(source, surface)
+            tree.nodes.remove(emission)
         tree.nodes.remove(target)
         tree.nodes.active = active
-        (scene.render.engine, scene.cycles.samples, scene.render.bake.margin, scene.render.bake.use_clear,
-         scene.render.bake.target) = saved
+        for other, node, other_active in others:
+            other.node_tree.nodes.remove(node)
+            other.node_tree.nodes.active = other_active
+        if spare is not None:
+            bpy.data.images.remove(spare)
+        (scene.render.engine, scene.cycles.samples, bake.margin, bake.use_clear, bake.target, bake.normal_space,
+         bake.normal_r, bake.normal_g, bake.normal_b) = saved
         obj.select_set(False)
         for o in selected:
             o.select_set(True)
@@ -92,10 +124,10 @@ def evaluate_object(obj: Any, materials: List[Any], shader_of: Any, blender4: bo
             continue
         done.add(material.name_full)
         mesh = original.data
-        if len(original.material_slots) != 1 or getattr(mesh, "uv_layers", None) is None or len(mesh.uv_layers) == 0:
+        if getattr(mesh, "uv_layers", None) is None or len(mesh.uv_layers) == 0:
             warnings.append(f"material '{material.name}': {', '.join(repr(s.name) for s in sockets)} driven by node "
-                            f"trees could not be evaluated by Blender (object '{original.name}' needs one material "
-                            "and a UV map): their own values are used")
+                            f"trees could not be evaluated by Blender (object '{original.name}' has no UV map): "
+                            "their own values are used")
             continue
         users = [o for o in bpy.data.objects if any(slot.material == material for slot in o.material_slots)]
         if len(users) > 1:
@@ -108,5 +140,7 @@ def evaluate_object(obj: Any, materials: List[Any], shader_of: Any, blender4: bo
             textures.EVALUATED[textures.evaluated_key(material.name_full, socket)] = (textures.EvaluatedImage(image), uv_map)
         warnings.append(f"material '{material.name}': {', '.join(repr(s.name) for s in sockets)} driven by node "
                         f"trees, evaluated by Blender into {size} x {size} images on UV map '{uv_map}' (detail "
-                        "finer than that is lost; set Texture Bake Size)")
+                        "finer than that is lost; set Texture Bake Size)"
+                        + ("; the Normal as a tangent-space normal map" if any(s.name == "Normal" for s in sockets)
+                           else ""))
     return images

@@ -5,8 +5,10 @@ pixels (Image.pixels), its colour space (image.colorspace_settings: sRGB bytes s
 Non-Color and linear bytes 8-bit data, float images scene-linear float), its extension and
 interpolation, and the UV map it reads (the UV Map node's, else the mesh's active render UV map).
 
-Anything else linked to an input (a Mapping node, a procedural texture, a Mix node...) is not
-evaluated: the input's own value is used, with a warning that says so.
+Anything else linked to an input (a Mapping node, a procedural texture, a Mix node..., and a
+Normal input fed by anything but those nodes) is evaluated by Blender into an image first
+(evaluate.py: an emission bake, or for the Normal a tangent-space normal bake bound as a normal
+map), per material of each object.
 """
 from __future__ import annotations
 
@@ -94,17 +96,21 @@ def _image_source(socket: Any, material_name: str = "") -> Optional[Tuple[Any, s
 
 def passes(socket: Any, material_name: str = "") -> bool:
     """Whether a linked input is one this module passes on (no warning about it)."""
-    return _image_source(socket, material_name) is not None or _normal_uses(socket) is not None
+    return _image_source(socket, material_name) is not None or _normal_uses(socket, material_name) is not None
 
 
 def _plain(socket: Any, default: float) -> float:
     return float(socket.default_value) if socket is not None and not socket.is_linked else default
 
 
-def _normal_uses(socket: Any) -> Optional[List[Use]]:
-    """The normal map and bump feeding a Normal input, or None if it is fed otherwise."""
+def _normal_uses(socket: Any, material_name: str = "") -> Optional[List[Use]]:
+    """The normal map and bump feeding a Normal input (or the tangent-space normal map Blender
+    baked of it, EVALUATED), or None if it is fed otherwise."""
     if socket is None or not socket.is_linked:
         return None
+    evaluated = EVALUATED.get(evaluated_key(material_name, socket)) if material_name else None
+    if evaluated is not None:
+        return [Use("normal_map", evaluated[0], "Color", evaluated[1])]
     node = socket.links[0].from_node
     uses: List[Use] = []
     if node.type == 'BUMP':
@@ -167,6 +173,7 @@ def material_uses(node: Any, blender4: bool, material: Any, material_name: str =
         add("subsurface_scale", ("Subsurface Scale",))
         add("subsurface_anisotropy", ("Subsurface Anisotropy",))
         add("specular_tint", ("Specular Tint",))
+        add("specular", ("Specular IOR Level",))
     else:
         # 3.x: the walk's colour is mix(Base Color, Subsurface Color, Subsurface); the bindings
         # rebuild the mix from the constant they start with (dwv_texture_binding_t.blend).
@@ -185,9 +192,9 @@ def material_uses(node: Any, blender4: bool, material: Any, material_name: str =
                 uses.append(Use("subsurface_color", colour[0], colour[1], colour[2], blend=min(factor, 1.0)))
         add("subsurface_radius", ("Subsurface Radius",))
         add("specular", ("Specular",))
-    if node.type != 'SUBSURFACE_SCATTERING' and not (blender4 and material.specular_model == "principled_v2"):
+    if node.type != 'SUBSURFACE_SCATTERING':
         add("roughness", ("Roughness",))
-    normal = _normal_uses(node.inputs.get("Normal"))
+    normal = _normal_uses(node.inputs.get("Normal"), material_name)
     if normal:
         uses.extend(normal)
     return uses
@@ -200,7 +207,7 @@ def evaluable_inputs(node: Any, blender4: bool) -> List[Any]:
         names = ("Color", "Radius", "Scale", "Anisotropy")
     elif blender4:
         names = ("Base Color", "Subsurface Weight", "Subsurface Radius", "Subsurface Scale", "Subsurface Anisotropy",
-                 "Specular Tint")
+                 "Specular Tint", "Specular IOR Level", "Roughness")
     else:
         names = ("Base Color", "Subsurface Color", "Subsurface Radius", "Specular", "Roughness")
     out = []
@@ -208,6 +215,9 @@ def evaluable_inputs(node: Any, blender4: bool) -> List[Any]:
         socket = node.inputs.get(name)
         if socket is not None and socket.is_linked and _image_source(socket) is None:
             out.append(socket)
+    normal = node.inputs.get("Normal")
+    if normal is not None and normal.is_linked and _normal_uses(normal) is None:
+        out.append(normal)  # baked as a tangent-space normal map (evaluate.py)
     return out
 
 
@@ -216,8 +226,8 @@ def linked_unpassed(node: Any, blender4: bool, material_name: str = "") -> List[
     used): for the warning."""
     covered = {"Base Color", "Color", "Radius", "Scale", "Anisotropy", "Subsurface Radius", "Normal", "Roughness"}
     if blender4:
-        covered |= {"Subsurface Weight", "Subsurface Scale", "Subsurface Anisotropy", "Specular Tint"}
-        covered.discard("Roughness")
+        covered |= {"Subsurface Weight", "Subsurface Scale", "Subsurface Anisotropy", "Specular Tint",
+                    "Specular IOR Level"}
     else:
         covered |= {"Subsurface Color", "Specular"}
     names = []
@@ -225,7 +235,7 @@ def linked_unpassed(node: Any, blender4: bool, material_name: str = "") -> List[
         if not socket.is_linked:
             continue
         if socket.name in covered and (passes(socket, material_name) if socket.name != "Normal"
-                                       else _normal_uses(socket) is not None):
+                                       else _normal_uses(socket, material_name) is not None):
             continue
         names.append(socket.name)
     return names

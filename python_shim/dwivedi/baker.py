@@ -64,6 +64,17 @@ def _call(name: str, *args: Any) -> None:
     _library.check(result)
 
 
+def _environment_settings(c: Any, strength: float, rotation: Any, interpolation: str) -> None:
+    """An EnvironmentDesc's strength, interpolation and rotation (3 x 3 nested or 9 numbers, None:
+    none) from set_world_environment's arguments."""
+    c.strength = _real("strength", strength)
+    c.interpolation = _name_code("interpolation", interpolation, {"linear": 0, "closest": 1, "cubic": 2})
+    values = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0] if rotation is None else list(rotation)
+    if len(values) == 3:  # rows
+        values = [x for row in values for x in row]
+    c.rotation[:] = real_tuple(values, "rotation", 9)
+
+
 def _real(name: str, value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise TypeError(f"{name} must be a real number, not {type(value).__name__}")
@@ -783,6 +794,22 @@ class Scene:
         del owner
         return out.value
 
+    def add_texture_file(self, path: str, *, format: Optional[str] = None, extension: str = "repeat",
+                         interpolation: str = "linear") -> int:
+        """Adds a texture from a PNG or OpenEXR file (dwv_scene_add_texture_file); returns its id.
+        format: "srgb8" or "linear8" for a PNG (default "srgb8"); an EXR's texels are "float32"
+        (its default)."""
+        desc = _library.TextureDesc()
+        if format is None:
+            with open(path, "rb") as f:
+                format = "float32" if f.read(4) == b"\x76\x2f\x31\x01" else "srgb8"
+        desc.format = _choice("format", format, TEXEL_FORMATS)
+        desc.extension = _choice("extension", extension, TEXTURE_EXTENSIONS)
+        desc.interpolation = _choice("interpolation", interpolation, TEXTURE_INTERPOLATIONS)
+        out = ctypes.c_uint32()
+        _call("dwv_scene_add_texture_file", self.handle, os.fsencode(path), ctypes.byref(desc), ctypes.byref(out))
+        return out.value
+
     def bind_texture(self, material: int, input: str, texture: int, *, uv_layer: Optional[str] = None,
                      blend: float = 1.0, strength: float = 1.0, distance: float = 1.0, invert: bool = False,
                      bump_shadowing: str = "chiang2019") -> None:
@@ -838,13 +865,16 @@ class Scene:
             raise Error(f"texels hold {t.count} numbers: a {c.width} x {c.height} image needs {3 * c.width * c.height}",
                         _library.DWV_ERROR_INVALID_ARGUMENT)
         c.texels = t.address or None
-        c.strength = _real("strength", strength)
-        c.interpolation = _name_code("interpolation", interpolation, {"linear": 0, "closest": 1, "cubic": 2})
-        values = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0] if rotation is None else list(rotation)
-        if len(values) == 3:  # rows
-            values = [x for row in values for x in row]
-        c.rotation[:] = real_tuple(values, "rotation", 9)
+        _environment_settings(c, strength, rotation, interpolation)
         _call("dwv_scene_set_world_environment", self.handle, ctypes.byref(c))
+
+    def set_world_environment_file(self, path: str, *, strength: float = 1.0, rotation: Any = None,
+                                   interpolation: str = "linear") -> None:
+        """The equirectangular world from an OpenEXR or Radiance (.hdr) file
+        (dwv_scene_set_world_environment_file); the other arguments as set_world_environment's."""
+        c = _library.EnvironmentDesc()
+        _environment_settings(c, strength, rotation, interpolation)
+        _call("dwv_scene_set_world_environment_file", self.handle, os.fsencode(path), ctypes.byref(c))
 
     def set_camera(self, camera: Camera) -> None:
         if not isinstance(camera, Camera):

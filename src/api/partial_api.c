@@ -109,7 +109,8 @@ static void add_textures(fnv *f, const dwvb_scene *s)
         }
     }
 }
-_Static_assert(sizeof(dwvb_scene) == 488, "a new dwvb_scene field: hash it in dwv_scene_hash if it changes images");
+/* 496: spec_grids (assets18) is made at commit from the materials and bindings hashed above. */
+_Static_assert(sizeof(dwvb_scene) == 496, "a new dwvb_scene field: hash it in dwv_scene_hash if it changes images");
 
 uint64_t dwv_scene_hash(const dwvb_scene *s)
 {

@@ -1,5 +1,6 @@
 /* capi entry points that build a scene: every argument checked and copied, nothing kept from the
  * caller, nothing changed once the scene is committed. */
+#include <errno.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -10,7 +11,9 @@
 #include <dwivedi.h>
 #include "util/error.h"
 #include "geom/mesh.h"
+#include "output/exr_reader.h"
 #include "output/png_reader.h"
+#include "output/radiance_reader.h"
 #include "scene_handle.h"
 
 dwv_result_t dwv_scene_create(dwv_scene_t **scene)
@@ -555,6 +558,59 @@ const char *dwv_feature_name(uint32_t feature)
     }
 }
 
+dwv_result_t dwv_scene_set_world_environment_file(dwv_scene_t *scene, const char *path,
+                                                  const dwv_environment_t *settings)
+{
+    static const char fn[] = "dwv_scene_set_world_environment_file";
+    dwvb_scene *s;
+    DWV_TRY(open_scene(fn, scene, &s));
+    DWV_TRY(dwv_check_pointer(fn, "path", path));
+    DWV_TRY(dwv_check_struct(fn, "settings", settings, (uint32_t)sizeof(dwv_environment_t)));
+    dwv_environment_t e = *settings;
+    float *texels = NULL;
+    uint32_t channels = 3u;
+    char message[512];
+    dwv_result_t r;
+    if (dwvo_file_is_exr(path))
+        r = dwvo_read_exr_float(path, DWV_ENVIRONMENT_MAX_SIDE, DWV_ENVIRONMENT_MAX_TEXELS, &e.width, &e.height,
+                                &channels, &texels, message, sizeof message);
+    else if (dwvo_file_is_radiance(path))
+        r = dwvo_read_radiance(path, DWV_ENVIRONMENT_MAX_SIDE, DWV_ENVIRONMENT_MAX_TEXELS, &e.width, &e.height,
+                               &texels, message, sizeof message);
+    else {
+        FILE *f = fopen(path, "rb");
+        if (!f) return dwv_fail(DWV_ERROR_IO, "%s: cannot read '%s': %s", fn, path, strerror(errno));
+        fclose(f);
+        return dwv_fail(DWV_ERROR_FORMAT, "%s: '%s' is neither an OpenEXR file nor a Radiance picture (.hdr)", fn,
+                        path);
+    }
+    if (r != DWV_SUCCESS) return dwv_fail(r, "%s: %s", fn, message);
+    /* To RGB in place: an alpha channel is dropped (a world has none), Y is grey. */
+    size_t n = (size_t)e.width * e.height;
+    if (channels == 4u)
+        for (size_t i = 0; i < n; ++i)
+            for (int c = 0; c < 3; ++c) texels[3u * i + (size_t)c] = texels[4u * i + (size_t)c];
+    if (channels == 1u) {
+        float *rgb = realloc(texels, 3u * n * sizeof *rgb);
+        if (!rgb) {
+            free(texels);
+            return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "%s: no memory for '%s' (%u x %u)", fn, path, e.width, e.height);
+        }
+        texels = rgb;
+        for (size_t i = n; i-- > 0;) texels[3u * i] = texels[3u * i + 1u] = texels[3u * i + 2u] = texels[i];
+    }
+    e.struct_size = (uint32_t)sizeof e;
+    e.texels = texels;
+    r = dwv_scene_set_world_environment(scene, &e);
+    free(texels);
+    if (r != DWV_SUCCESS) {
+        char reason[768];
+        snprintf(reason, sizeof reason, "%s", dwv_last_error_message());
+        return dwv_fail(r, "%s: '%s': %s", fn, path, reason);
+    }
+    return DWV_SUCCESS;
+}
+
 dwv_result_t dwv_scene_add_texture(dwv_scene_t *scene, const dwv_texture_desc_t *texture, uint32_t *texture_id)
 {
     static const char fn[] = "dwv_scene_add_texture";
@@ -616,20 +672,44 @@ dwv_result_t dwv_scene_add_texture_file(dwv_scene_t *scene, const char *path, co
     DWV_TRY(dwv_check_pointer(fn, "path", path));
     DWV_TRY(dwv_check_struct(fn, "settings", settings, (uint32_t)sizeof(dwv_texture_desc_t)));
     DWV_TRY(dwv_check_pointer(fn, "texture_id", texture_id));
-    if (settings->format != DWV_TEXEL_SRGB8 && settings->format != DWV_TEXEL_LINEAR8)
+    FILE *probe = fopen(path, "rb");
+    if (!probe) return dwv_fail(DWV_ERROR_IO, "%s: cannot read '%s': %s", fn, path, strerror(errno));
+    fclose(probe);
+    int exr = dwvo_file_is_exr(path);
+    if (exr && settings->format != DWV_TEXEL_FLOAT32)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
+                        "%s: '%s' is an OpenEXR file, which holds scene-linear floats: format must be float32 (0), "
+                        "not %d", fn, path, (int)settings->format);
+    if (!exr && settings->format != DWV_TEXEL_SRGB8 && settings->format != DWV_TEXEL_LINEAR8)
         return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
                         "%s: a PNG holds 8-bit values: format must be sRGB 8-bit (1) or linear 8-bit (2), not %d", fn,
                         (int)settings->format);
     dwv_texture_desc_t desc = *settings;
-    uint8_t *pixels = NULL;
+    void *pixels = NULL;
     char message[512];
-    dwv_result_t r = dwvo_read_png8(path, &desc.width, &desc.height, &desc.channels, &pixels, message, sizeof message);
+    dwv_result_t r;
+    if (exr) {
+        float *values = NULL;
+        r = dwvo_read_exr_float(path, DWVB_MAX_TEXTURE_SIDE, DWVB_MAX_TEXTURE_TEXELS, &desc.width, &desc.height,
+                                &desc.channels, &values, message, sizeof message);
+        pixels = values;
+    } else {
+        uint8_t *bytes = NULL;
+        r = dwvo_read_png8(path, &desc.width, &desc.height, &desc.channels, &bytes, message, sizeof message);
+        pixels = bytes;
+    }
     if (r != DWV_SUCCESS) return dwv_fail(r, "%s: %s", fn, message);
     desc.struct_size = (uint32_t)sizeof desc;
     desc.texels = pixels;
     r = dwv_scene_add_texture(scene, &desc, texture_id);
     free(pixels);
-    return r;
+    if (r != DWV_SUCCESS) {
+        /* Name the file in front of dwv_scene_add_texture's reason (a NaN texel, say). */
+        char reason[768];
+        snprintf(reason, sizeof reason, "%s", dwv_last_error_message());
+        return dwv_fail(r, "%s: '%s': %s", fn, path, reason);
+    }
+    return DWV_SUCCESS;
 }
 
 dwv_result_t dwv_scene_bind_texture(dwv_scene_t *scene, uint32_t material_id, const dwv_texture_binding_t *binding)
@@ -666,12 +746,6 @@ dwv_result_t dwv_scene_bind_texture(dwv_scene_t *scene, uint32_t material_id, co
     if (binding->reserved != 0u) return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: reserved must be 0", fn);
     if (binding->uv_layer && strlen(binding->uv_layer) > MAX_LAYER_NAME)
         return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: uv_layer is longer than %u bytes", fn, MAX_LAYER_NAME);
-    const dwv_material_t *material = &s->materials[material_id];
-    if (material->specular_model == DWV_SPECULAR_PRINCIPLED_V2 && (input == DWV_INPUT_ROUGHNESS || input == DWV_INPUT_SPECULAR))
-        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
-                        "%s: a textured %s under the 4.x+ Principled v2 specular layer is not supported (its albedo "
-                        "tables are made per material); give the input a constant", fn,
-                        input == DWV_INPUT_ROUGHNESS ? "Roughness" : "Specular IOR Level");
     for (uint32_t b = 0; b < s->binding_count; ++b)
         if (s->bindings[b].material_id == material_id && s->bindings[b].input == input &&
             (input == DWV_INPUT_NORMAL_MAP || input == DWV_INPUT_BUMP))

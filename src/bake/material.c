@@ -1,6 +1,7 @@
 #include "material.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #define FOUR_PI 12.566370614359172954
@@ -224,14 +225,15 @@ static double v2_share(double cos_hi, double eta, double F0)
     return fmin(fmax(s, 0.0), 1.0);
 }
 
-void dwvb_ggx_albedo(double alpha, double eta, double mu, int n, double *E, double *s)
+void dwvb_ggx_albedo_etas(double alpha, const double *etas, int count, double mu, int n, double *E, double *s)
 {
     double a2 = alpha * alpha;
     mu = fmin(fmax(mu, 1e-4), 1.0);
     dwvu_vec3 wi = dwvu_v(sqrt(fmax(0.0, 1.0 - mu * mu)), 0.0, mu);
-    double F0 = dwvb_fresnel_dielectric(1.0, eta);
+    double F0[DWVB_SPEC_GRID];
+    for (int k = 0; k < count; ++k) F0[k] = dwvb_fresnel_dielectric(1.0, etas[k]), s[k] = 0.0;
     double lambda_i = dwvb_ggx_lambda(a2, mu);
-    double sum_e = 0.0, sum_s = 0.0;
+    double sum_e = 0.0;
     for (int i = 0; i < n; ++i)
         for (int j = 0; j < n; ++j) {
             dwvu_vec3 h = dwvb_ggx_sample_vndf(wi, alpha, (i + 0.5) / n, (j + 0.5) / n);
@@ -240,10 +242,15 @@ void dwvb_ggx_albedo(double alpha, double eta, double mu, int n, double *E, doub
             if (!(wo.z > 0.0)) continue;
             /* eval / pdf of VNDF sampling: G2 / G1(wi) = (1 + Lambda_i) / (1 + Lambda_i + Lambda_o). */
             sum_e += (1.0 + lambda_i) / (1.0 + lambda_i + dwvb_ggx_lambda(a2, wo.z));
-            sum_s += v2_share(c, eta, F0);
+            for (int k = 0; k < count; ++k) s[k] += v2_share(c, etas[k], F0[k]);
         }
     *E = sum_e / ((double)n * n);
-    *s = sum_s / ((double)n * n);
+    for (int k = 0; k < count; ++k) s[k] /= (double)n * n;
+}
+
+void dwvb_ggx_albedo(double alpha, double eta, double mu, int n, double *E, double *s)
+{
+    dwvb_ggx_albedo_etas(alpha, &eta, 1, mu, n, E, s);
 }
 
 void dwvb_specular_factor(const dwvb_material *m, dwvu_vec3 n, dwvu_vec3 L, dwvu_vec3 V, double f[3])
@@ -303,10 +310,104 @@ double dwvb_specular_layer_weight(const dwvb_material *m, double mu)
 }
 
 /* The specular layer's constants (svm_closure.h of each release, capi's DWV_SPECULAR_*). */
+/* The v2 eta of Specular IOR Level `level` over IOR `ior` (specular_init's rule). */
+static double v2_eta(double ior, double level)
+{
+    double r = (ior - 1.0) / (ior + 1.0), f0 = r * r, eta = ior;
+    if (level != 0.5) {
+        f0 *= 2.0 * level;
+        double root = sqrt(fmin(fmax(f0, 0.0), 0.99));
+        eta = (1.0 + root) / (1.0 - root);
+    }
+    return eta;
+}
+
+/* Node k of n over [0, hi] and the linear weights of x between nodes k and k + 1 (exactly 0 or 1
+ * at a node). */
+static uint32_t grid_cell(double x, double hi, uint32_t n, double *t)
+{
+    if (n < 2u) {
+        *t = 0.0;
+        return 0u;
+    }
+    double position = fmin(fmax(x / hi, 0.0), 1.0) * (double)(n - 1u);
+    uint32_t k = (uint32_t)position;
+    if (k > n - 2u) k = n - 2u;
+    *t = position - (double)k;
+    return k;
+}
+
+#define SPEC_Q_MAX 0.99498743710661995 /* sqrt(0.99) */
+
+static void spec_grid_lookup(const dwvb_spec_grid *g, double roughness, double q, double *E, double *s)
+{
+    double tr = 0.0, tq = 0.0;
+    uint32_t kr = grid_cell(roughness, 1.0, g->roughness_nodes, &tr);
+    uint32_t kq = grid_cell(q, SPEC_Q_MAX, g->q_nodes, &tq);
+    uint32_t r1 = g->roughness_nodes > 1u ? kr + 1u : kr, q1 = g->q_nodes > 1u ? kq + 1u : kq;
+    for (int i = 0; i < DWVB_SPEC_MU; ++i) {
+        E[i] = (1.0 - tr) * g->E[kr * DWVB_SPEC_MU + (uint32_t)i] + tr * g->E[r1 * DWVB_SPEC_MU + (uint32_t)i];
+#define S_AT(a, b) g->s[((a) * g->q_nodes + (b)) * DWVB_SPEC_MU + (uint32_t)i]
+        s[i] = (1.0 - tr) * ((1.0 - tq) * S_AT(kr, kq) + tq * S_AT(kr, q1)) +
+               tr * ((1.0 - tq) * S_AT(r1, kq) + tq * S_AT(r1, q1));
+#undef S_AT
+    }
+}
+
+dwvb_spec_grid *dwvb_spec_grid_make(const dwv_material_t *in, int textured_roughness, int textured_level)
+{
+    dwvb_spec_grid *g = calloc(1, sizeof *g);
+    if (!g) return NULL;
+    g->roughness_nodes = textured_roughness ? DWVB_SPEC_GRID : 1u;
+    g->q_nodes = textured_level ? DWVB_SPEC_GRID : 1u;
+    g->E = malloc((size_t)g->roughness_nodes * DWVB_SPEC_MU * sizeof *g->E);
+    g->s = malloc((size_t)g->roughness_nodes * g->q_nodes * DWVB_SPEC_MU * sizeof *g->s);
+    if (!g->E || !g->s) {
+        dwvb_spec_grid_free(g);
+        return NULL;
+    }
+    double material_eta = v2_eta(in->ior, in->specular);
+    for (uint32_t k = 0; k < g->roughness_nodes; ++k) {
+        /* The node's alpha as specular_init makes it from a roughness of that value. */
+        double roughness = textured_roughness ? (double)k / (DWVB_SPEC_GRID - 1) : in->roughness;
+        double alpha = roughness * roughness;
+        /* One quadrature per (roughness, mu) for E and every eta's s (the same samples, summed
+         * in the same order as dwvb_ggx_albedo: a node gives the constant material's bits). The
+         * textured level's q = 0 node (eta 1: no layer) takes the next node's s (f0 below 0.1%
+         * there); without a textured level an eta of 1 is never read. */
+        double etas[DWVB_SPEC_GRID], shares[DWVB_SPEC_GRID];
+        int first = 0, count = 0;
+        for (uint32_t j = 0; j < g->q_nodes; ++j) {
+            double q = (double)j / (DWVB_SPEC_GRID - 1) * SPEC_Q_MAX;
+            etas[j] = textured_level ? (1.0 + q) / (1.0 - q) : material_eta;
+        }
+        first = textured_level ? 1 : 0;
+        count = (int)g->q_nodes - first;
+        for (int i = 0; i < DWVB_SPEC_MU; ++i) {
+            double mu = (double)i / (DWVB_SPEC_MU - 1);
+            dwvb_ggx_albedo_etas(alpha, etas + first, count, mu, 48, &g->E[k * DWVB_SPEC_MU + (uint32_t)i], shares);
+            for (uint32_t j = 0; j < g->q_nodes; ++j) {
+                int from = (int)j - first < 0 ? 0 : (int)j - first;
+                g->s[(k * g->q_nodes + j) * DWVB_SPEC_MU + (uint32_t)i] = etas[j] > 1.0 || textured_level ? shares[from] : 0.0;
+            }
+        }
+    }
+    return g;
+}
+
+void dwvb_spec_grid_free(dwvb_spec_grid *grid)
+{
+    if (!grid) return;
+    free(grid->E);
+    free(grid->s);
+    free(grid);
+}
+
 static void specular_init(dwvb_material *out, const dwv_material_t *in, const dwvb_material *tables)
 {
     out->specular = 0;
     out->spec_multiscatter = 0;
+    out->spec_grid = NULL;
     out->spec_alpha = in->roughness * in->roughness;
     for (int c = 0; c < 3; ++c) out->spec_f0[c] = out->spec_Fms[c] = 0.0;
     for (int i = 0; i < DWVB_SPEC_MU; ++i) out->spec_E[i] = 1.0, out->spec_s[i] = 0.0;
@@ -340,9 +441,11 @@ static void specular_init(dwvb_material *out, const dwv_material_t *in, const dw
     double rr = (eta - 1.0) / (eta + 1.0);
     out->spec_F0 = rr * rr;
     for (int c = 0; c < 3; ++c) out->spec_f0[c] = fmin(fmax(f0 * in->specular_tint[c], 0.0), 1.0);
-    /* The tables depend on roughness and eta only, which a texture never changes under v2
-     * (dwv_scene_bind_texture refuses it): a textured point copies its material's. */
-    if (tables && tables->specular == DWV_SPECULAR_PRINCIPLED_V2) {
+    /* The tables depend on roughness and eta only: a textured point copies its material's, or
+     * interpolates them in its grid where a texture drives either. */
+    if (tables && tables->spec_grid) {
+        spec_grid_lookup(tables->spec_grid, in->roughness, sqrt(fmin(fmax(f0, 0.0), 0.99)), out->spec_E, out->spec_s);
+    } else if (tables && tables->specular == DWV_SPECULAR_PRINCIPLED_V2) {
         memcpy(out->spec_E, tables->spec_E, sizeof out->spec_E);
         memcpy(out->spec_s, tables->spec_s, sizeof out->spec_s);
     } else {

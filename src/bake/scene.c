@@ -308,6 +308,10 @@ static dwv_result_t commit_bindings(dwvb_scene *scene, char *message, size_t siz
 static dwv_result_t uncommit(dwvb_scene *scene, dwv_result_t result)
 {
     if (scene->geometry.device) dwvg_world_free(&scene->geometry);
+    if (scene->spec_grids)
+        for (uint32_t m = 0; m < scene->material_count; ++m) dwvb_spec_grid_free(scene->spec_grids[m]);
+    free(scene->spec_grids);
+    scene->spec_grids = NULL;
     free(scene->shading);
     free(scene->emitters);
     free(scene->patches);
@@ -331,10 +335,11 @@ dwv_result_t dwvb_scene_commit(dwvb_scene *scene, char *message, size_t size)
 {
     uint32_t nm = scene->material_count, nl = scene->light_count, nmesh = scene->mesh_count;
     scene->shading = calloc(nm ? nm : 1u, sizeof *scene->shading);
+    scene->spec_grids = calloc(nm ? nm : 1u, sizeof *scene->spec_grids);
     scene->emitters = calloc(nl ? nl : 1u, sizeof *scene->emitters);
     scene->patches = calloc(nmesh ? nmesh : 1u, sizeof *scene->patches);
     scene->patch_count = calloc(nmesh ? nmesh : 1u, sizeof *scene->patch_count);
-    if (!scene->shading || !scene->emitters || !scene->patches || !scene->patch_count) {
+    if (!scene->shading || !scene->spec_grids || !scene->emitters || !scene->patches || !scene->patch_count) {
         snprintf(message, size, "out of memory");
         return uncommit(scene, DWV_ERROR_OUT_OF_MEMORY);
     }
@@ -345,6 +350,22 @@ dwv_result_t dwvb_scene_commit(dwvb_scene *scene, char *message, size_t size)
         dwv_material_t planned = scene->materials[i];
         if (scene->material_textures[i].count) dwvb_textured_representative(scene, i, &planned);
         dwvb_material_init(&scene->shading[i], &planned);
+        /* v2's albedo tables depend on Roughness and Specular IOR Level: over a texture's values
+         * they come from a grid (material.h). */
+        int rough = 0, level = 0;
+        for (uint32_t k = 0; k < scene->material_textures[i].count; ++k) {
+            dwv_material_input_t input = scene->bindings[scene->binding_order[scene->material_textures[i].first + k]].input;
+            rough |= input == DWV_INPUT_ROUGHNESS;
+            level |= input == DWV_INPUT_SPECULAR;
+        }
+        if (scene->materials[i].specular_model == DWV_SPECULAR_PRINCIPLED_V2 && (rough || level)) {
+            scene->spec_grids[i] = dwvb_spec_grid_make(&scene->materials[i], rough, level);
+            if (!scene->spec_grids[i]) {
+                snprintf(message, size, "out of memory for material %u's specular tables", i);
+                return uncommit(scene, DWV_ERROR_OUT_OF_MEMORY);
+            }
+            scene->shading[i].spec_grid = scene->spec_grids[i];
+        }
     }
     for (uint32_t i = 0; i < nl; ++i) dwvl_light_init(&scene->emitters[i], &scene->lights[i]);
     uint32_t features = 0;

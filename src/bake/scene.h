@@ -80,6 +80,8 @@ typedef struct dwvb_scene {
     /* Made by dwvb_scene_commit, read-only afterwards (bakes share them across threads). */
     dwvg_world geometry;       /* built when there is a mesh */
     dwvb_material *shading;    /* per material */
+    dwvb_spec_grid **spec_grids; /* per material: v2 specular tables over textured Roughness /
+                                  Specular IOR Level values (shading[i].spec_grid), else NULL */
     dwvl_light *emitters;      /* per light */
     dwvw_light_patch (*patches)[DWVW_MAX_PATCHES]; /* per mesh: lit patches of subsurface meshes */
     int *patch_count;          /* per mesh */

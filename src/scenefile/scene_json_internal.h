@@ -96,6 +96,16 @@ dwv_result_t dwvs_resolve_path(const char *base_dir, const char *file, const cha
 
 /* ---- the sections of a scene file, in the order read_scene reads them ---- */
 
+/* A texture or environment file that a scene file names ("file" at `path` in the JSON, resolved to
+ * `resolved`): reads it whole; with `sha256` (the "sha256" key's 64 hexadecimal digits, or
+ * NULL) refuses it unless its bytes hash to that (DWV_ERROR_FORMAT: a different file than the one
+ * the scene was written with); *is_exr says whether it starts with OpenEXR's magic number. A
+ * missing file: DWV_ERROR_IO. */
+dwv_result_t dwvs_check_image_file(const char *path, const char *resolved, const char *sha256, int *is_exr);
+/* "file" (+ "sha256") of `item` at `path`: resolved, checked as above. */
+dwv_result_t dwvs_read_image_file(dwvs_parser *ps, const cJSON *item, const char *path, char resolved[MAX_FILE_PATH],
+                                  int *is_exr);
+
 dwv_result_t dwvs_read_textures(dwvs_parser *ps, const cJSON *item);
 /* A material's "textures" array: its bindings (after dwvs_read_textures). */
 dwv_result_t dwvs_read_material_textures(dwvs_parser *ps, const cJSON *item, const char *path, uint32_t material_id);

@@ -84,31 +84,53 @@ dwv_result_t dwvs_read_lights(dwvs_parser *ps, const cJSON *item)
     return DWV_SUCCESS;
 }
 
-/* "world": {"environment": {...}}: an equirectangular map with its texels inline. */
+/* "world": {"environment": {...}}: an equirectangular map, its texels inline or from a file. */
 static dwv_result_t read_environment(dwvs_parser *ps, const cJSON *item)
 {
     static const char path[] = "world.environment";
-    static const char *const keys[] = {"width", "height", "texels", "interpolation", "strength", "rotate"};
+    static const char *const keys[] = {"width", "height", "texels", "file", "sha256", "interpolation", "strength",
+                                       "rotate", "rotation"};
     static const char *const interpolations[] = {"linear", "closest", "cubic"};
     if (!cJSON_IsObject(item))
         return dwvs_fail_at(DWV_ERROR_FORMAT, path, "expected an object, found %s", dwvs_type_name(item));
     DWV_TRY(dwvs_check_keys(item, path, keys, sizeof keys / sizeof keys[0]));
-    if (!dwvs_member(item, "width") || !dwvs_member(item, "height") || !dwvs_member(item, "texels"))
-        return dwvs_fail_at(DWV_ERROR_FORMAT, path, "needs 'width', 'height' and 'texels'");
+    int from_file = dwvs_member(item, "file") != NULL;
+    int inline_texels = dwvs_member(item, "width") || dwvs_member(item, "height") || dwvs_member(item, "texels");
+    if (from_file == inline_texels || (!from_file && !(dwvs_member(item, "width") && dwvs_member(item, "height") &&
+                                                       dwvs_member(item, "texels"))))
+        return dwvs_fail_at(DWV_ERROR_FORMAT, path, "needs either 'file' or 'width', 'height' and 'texels'");
+    if (!from_file && dwvs_member(item, "sha256"))
+        return dwvs_fail_at(DWV_ERROR_FORMAT, path, "'sha256' applies to a 'file'");
     dwv_environment_t e = DWV_ENVIRONMENT_INIT;
-    DWV_TRY(dwvs_opt_u32(item, path, "width", 1u, DWV_ENVIRONMENT_MAX_SIDE, &e.width));
-    DWV_TRY(dwvs_opt_u32(item, path, "height", 1u, DWV_ENVIRONMENT_MAX_SIDE, &e.height));
     size_t interpolation = 0;
     DWV_TRY(dwvs_opt_choice(item, path, "interpolation", interpolations, 3, &interpolation));
     e.interpolation = (dwv_environment_interpolation_t)interpolation;
     DWV_TRY(dwvs_opt_number(item, path, "strength", &e.strength));
-    /* The Mapping node's rotation (degrees, Euler XYZ): the rotation part of a T R S transform. */
-    double rotate[3] = {0.0, 0.0, 0.0}, zero[3] = {0.0, 0.0, 0.0}, one[3] = {1.0, 1.0, 1.0}, m[12];
-    DWV_TRY(dwvs_opt_vector(item, path, "rotate", 3, rotate));
-    dwvs_transform_trs(zero, rotate, one, m);
-    for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) e.rotation[3 * r + c] = m[4 * r + c];
+    if (dwvs_member(item, "rotate") && dwvs_member(item, "rotation"))
+        return dwvs_fail_at(DWV_ERROR_FORMAT, path, "give either 'rotate' (Euler degrees) or 'rotation' (a matrix)");
+    if (dwvs_member(item, "rotation")) {
+        /* The exact row-major 3 x 3 matrix (what the C API takes), so that a written scene gives
+         * back the same doubles. */
+        DWV_TRY(dwvs_opt_vector(item, path, "rotation", 9, e.rotation));
+    } else {
+        /* The Mapping node's rotation (degrees, Euler XYZ): the rotation part of a T R S transform. */
+        double rotate[3] = {0.0, 0.0, 0.0}, zero[3] = {0.0, 0.0, 0.0}, one[3] = {1.0, 1.0, 1.0}, m[12];
+        DWV_TRY(dwvs_opt_vector(item, path, "rotate", 3, rotate));
+        dwvs_transform_trs(zero, rotate, one, m);
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c) e.rotation[3 * r + c] = m[4 * r + c];
+    }
     char p[PATH_SIZE];
+    if (from_file) {
+        char resolved[MAX_FILE_PATH];
+        int exr = 0;
+        DWV_TRY(dwvs_read_image_file(ps, item, path, resolved, &exr));
+        dwv_result_t r = dwv_scene_set_world_environment_file(ps->scene, resolved, &e);
+        dwvs_path_key(p, path, "file");
+        return r == DWV_SUCCESS ? r : dwvs_prefix_capi(r, p);
+    }
+    DWV_TRY(dwvs_opt_u32(item, path, "width", 1u, DWV_ENVIRONMENT_MAX_SIDE, &e.width));
+    DWV_TRY(dwvs_opt_u32(item, path, "height", 1u, DWV_ENVIRONMENT_MAX_SIDE, &e.height));
     dwvs_path_key(p, path, "texels");
     size_t count = 0;
     float *texels = NULL;

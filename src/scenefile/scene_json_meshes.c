@@ -79,11 +79,99 @@ dwv_result_t dwvs_resolve_path(const char *base_dir, const char *file, const cha
     return DWV_SUCCESS;
 }
 
+/* A mesh's UV layers beyond its first ("uv_layers": [{"name", "uvs", "tangents"}]) and the
+ * tangents of each ("tangents" beside "uvs" for the first), read once the triangle count is
+ * known: 6 numbers a triangle for UVs, 12 for tangents (xyz and the bitangent's sign per corner). */
+#define MAX_EXTRA_LAYERS 64u
+typedef struct mesh_layers {
+    uint32_t count;
+    float *uvs[MAX_EXTRA_LAYERS];
+    float *tangents[MAX_EXTRA_LAYERS + 1u];
+    const char *names[MAX_EXTRA_LAYERS + 1u];
+} mesh_layers;
+
+static void mesh_layers_free(mesh_layers *l)
+{
+    for (uint32_t i = 0; i < MAX_EXTRA_LAYERS; ++i) free(l->uvs[i]);
+    for (uint32_t i = 0; i <= MAX_EXTRA_LAYERS; ++i) free(l->tangents[i]);
+}
+
+static dwv_result_t read_per_corner(const cJSON *item, const char *path, size_t per_triangle, uint32_t triangles,
+                                    const char *what, float **out)
+{
+    size_t n = 0;
+    DWV_TRY(dwvs_read_floats(item, path, per_triangle, &n, out));
+    if (n != per_triangle * triangles) {
+        free(*out);
+        *out = NULL;
+        return dwvs_fail_at(DWV_ERROR_FORMAT, path, "%zu numbers for %u triangles: %s per triangle corner", n,
+                            triangles, what);
+    }
+    return DWV_SUCCESS;
+}
+
+static dwv_result_t read_mesh_layers(const cJSON *item, const char *path, uint32_t triangles, int has_uvs,
+                                     mesh_layers *l)
+{
+    char p[PATH_SIZE];
+    const cJSON *tangents = dwvs_member(item, "tangents");
+    if (tangents) {
+        dwvs_path_key(p, path, "tangents");
+        if (!has_uvs) return dwvs_fail_at(DWV_ERROR_FORMAT, p, "tangents need the mesh's UVs");
+        DWV_TRY(read_per_corner(tangents, p, 12u, triangles, "4 (x, y, z, sign)", &l->tangents[0]));
+    }
+    const cJSON *layers = dwvs_member(item, "uv_layers");
+    if (!layers) return DWV_SUCCESS;
+    char q[PATH_SIZE];
+    dwvs_path_key(q, path, "uv_layers");
+    if (!cJSON_IsArray(layers))
+        return dwvs_fail_at(DWV_ERROR_FORMAT, q, "expected an array of UV layers, found %s", dwvs_type_name(layers));
+    if (!has_uvs) return dwvs_fail_at(DWV_ERROR_FORMAT, q, "extra UV layers need the mesh's first ('uvs')");
+    static const char *const keys[] = {"name", "uvs", "tangents"};
+    size_t index = 0;
+    for (const cJSON *e = layers->child; e; e = e->next, ++index) {
+        dwvs_path_index(p, q, index);
+        if (index >= MAX_EXTRA_LAYERS)
+            return dwvs_fail_at(DWV_ERROR_OUT_OF_RANGE, p, "a mesh has at most %u extra UV layers", MAX_EXTRA_LAYERS);
+        if (!cJSON_IsObject(e)) return dwvs_fail_at(DWV_ERROR_FORMAT, p, "expected an object, found %s", dwvs_type_name(e));
+        DWV_TRY(dwvs_check_keys(e, p, keys, 3));
+        char r[PATH_SIZE];
+        if (!dwvs_member(e, "name") || !dwvs_member(e, "uvs"))
+            return dwvs_fail_at(DWV_ERROR_FORMAT, p, "a UV layer needs 'name' and 'uvs'");
+        dwvs_path_key(r, p, "name");
+        DWV_TRY(dwvs_read_string(dwvs_member(e, "name"), r, &l->names[index + 1u]));
+        dwvs_path_key(r, p, "uvs");
+        DWV_TRY(read_per_corner(dwvs_member(e, "uvs"), r, 6u, triangles, "one (u, v)", &l->uvs[index]));
+        l->count = (uint32_t)index + 1u;
+        if (dwvs_member(e, "tangents")) {
+            dwvs_path_key(r, p, "tangents");
+            DWV_TRY(read_per_corner(dwvs_member(e, "tangents"), r, 12u, triangles, "4 (x, y, z, sign)",
+                                    &l->tangents[index + 1u]));
+        }
+    }
+    return DWV_SUCCESS;
+}
+
+/* Points `mesh` at the layers (names default to the numbers the C API gives when none is named). */
+static void attach_layers(dwv_mesh_t *mesh, mesh_layers *l, const char *first_name)
+{
+    mesh->uv_layer_count = l->count;
+    mesh->uv_layers = l->count ? (const float *const *)l->uvs : NULL;
+    if (l->count || first_name) {
+        static const char *const numbers[] = {"0"};
+        l->names[0] = first_name ? first_name : numbers[0];
+        mesh->uv_layer_names = l->names;
+    }
+    int any_tangents = 0;
+    for (uint32_t i = 0; i <= l->count; ++i) any_tangents |= l->tangents[i] != NULL;
+    mesh->tangents = any_tangents ? (const float *const *)l->tangents : NULL;
+}
+
 static dwv_result_t read_mesh(dwvs_parser *ps, const cJSON *item, const char *path, dwvs_named *record)
 {
     static const char *const keys[] = {"name",    "material", "transform", "file", "positions",
                                        "indices", "normals",  "uvs",       "shadow_terminator_geometry_offset",
-                                       "uv_name"};
+                                       "uv_name", "uv_layers", "tangents"};
     DWV_TRY(dwvs_check_keys(item, path, keys, sizeof keys / sizeof keys[0]));
     char p[PATH_SIZE], name[SHOWN_SIZE];
     const cJSON *name_item = dwvs_member(item, "name");
@@ -110,12 +198,13 @@ static dwv_result_t read_mesh(dwvs_parser *ps, const cJSON *item, const char *pa
     DWV_TRY(dwvs_opt_transform(item, path, mesh.transform));
     DWV_TRY(dwvs_opt_number(item, path, "shadow_terminator_geometry_offset", &mesh.shadow_terminator_geometry_offset));
     /* The name of the mesh's UV layer, which texture bindings name ("Textures"). */
-    const char *uv_names[1] = {NULL};
+    const char *uv_name = NULL;
     if (dwvs_member(item, "uv_name")) {
         dwvs_path_key(p, path, "uv_name");
-        DWV_TRY(dwvs_read_string(dwvs_member(item, "uv_name"), p, &uv_names[0]));
-        mesh.uv_layer_names = uv_names;
+        DWV_TRY(dwvs_read_string(dwvs_member(item, "uv_name"), p, &uv_name));
     }
+    mesh_layers layers;
+    memset(&layers, 0, sizeof layers);
 
     const cJSON *file = dwvs_member(item, "file");
     int inline_data = dwvs_member(item, "positions") || dwvs_member(item, "indices") || dwvs_member(item, "normals") ||
@@ -142,11 +231,15 @@ static dwv_result_t read_mesh(dwvs_parser *ps, const cJSON *item, const char *pa
         mesh.indices = data.indices;
         mesh.normals = data.normals;
         mesh.uvs = data.uvs;
-        r = dwv_scene_add_mesh(ps->scene, &mesh, &mesh_id);
-        if (r != DWV_SUCCESS) {
-            char where[PATH_SIZE + MAX_FILE_PATH / 16];
-            snprintf(where, sizeof where, "%s ('%s')", path, dwvs_shown(file_name, name));
-            r = dwvs_prefix_capi(r, where);
+        r = read_mesh_layers(item, path, mesh.triangle_count, data.uvs != NULL, &layers);
+        attach_layers(&mesh, &layers, uv_name);
+        if (r == DWV_SUCCESS) {
+            r = dwv_scene_add_mesh(ps->scene, &mesh, &mesh_id);
+            if (r != DWV_SUCCESS) {
+                char where[PATH_SIZE + MAX_FILE_PATH / 16];
+                snprintf(where, sizeof where, "%s ('%s')", path, dwvs_shown(file_name, name));
+                r = dwvs_prefix_capi(r, where);
+            }
         }
         record->has_uvs = data.uvs != NULL;
         dwvs_mesh_data_free(&data);
@@ -181,8 +274,12 @@ static dwv_result_t read_mesh(dwvs_parser *ps, const cJSON *item, const char *pa
             mesh.indices = indices;
             mesh.normals = normals;
             mesh.uvs = uvs;
-            r = dwv_scene_add_mesh(ps->scene, &mesh, &mesh_id);
-            if (r != DWV_SUCCESS) r = dwvs_prefix_capi(r, path);
+            r = read_mesh_layers(item, path, mesh.triangle_count, uvs != NULL, &layers);
+            attach_layers(&mesh, &layers, uv_name);
+            if (r == DWV_SUCCESS) {
+                r = dwv_scene_add_mesh(ps->scene, &mesh, &mesh_id);
+                if (r != DWV_SUCCESS) r = dwvs_prefix_capi(r, path);
+            }
         }
         record->has_uvs = uvs != NULL;
         free(positions);
@@ -190,6 +287,7 @@ static dwv_result_t read_mesh(dwvs_parser *ps, const cJSON *item, const char *pa
         free(normals);
         free(uvs);
     }
+    mesh_layers_free(&layers);
     record->id = mesh_id;
     return r;
 }

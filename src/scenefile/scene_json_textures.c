@@ -4,7 +4,62 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <errno.h>
+#include <stdio.h>
+
 #include "util/error.h"
+#include "util/sha256.h"
+
+dwv_result_t dwvs_check_image_file(const char *path, const char *resolved, const char *sha256, int *is_exr)
+{
+    static const unsigned char exr_magic[4] = {0x76, 0x2f, 0x31, 0x01};
+    char name[SHOWN_SIZE];
+    FILE *f = fopen(resolved, "rb");
+    if (!f)
+        return dwvs_fail_at(DWV_ERROR_IO, path, "image file '%s': %s", dwvs_shown(resolved, name), strerror(errno));
+    unsigned char chunk[65536], head[4] = {0, 0, 0, 0};
+    size_t got, total = 0;
+    dwvu_sha256 hash;
+    dwvu_sha256_init(&hash);
+    while ((got = fread(chunk, 1, sizeof chunk, f)) > 0) {
+        if (total < 4u) memcpy(head + total, chunk, got < 4u - total ? got : 4u - total);
+        total += got;
+        if (!sha256) break;
+        dwvu_sha256_add(&hash, chunk, got);
+    }
+    int failed = ferror(f);
+    fclose(f);
+    if (failed) return dwvs_fail_at(DWV_ERROR_IO, path, "image file '%s': read error", dwvs_shown(resolved, name));
+    *is_exr = total >= 4u && memcmp(head, exr_magic, 4) == 0;
+    if (sha256) {
+        char digest[65];
+        dwvu_sha256_hex(&hash, digest);
+        if (strcmp(digest, sha256) != 0)
+            return dwvs_fail_at(DWV_ERROR_FORMAT, path,
+                                "image file '%s' has SHA-256 %.12s..., the scene file says %.12s...: it is not the "
+                                "file the scene was written with", dwvs_shown(resolved, name), digest, sha256);
+    }
+    return DWV_SUCCESS;
+}
+
+dwv_result_t dwvs_read_image_file(dwvs_parser *ps, const cJSON *item, const char *path, char resolved[MAX_FILE_PATH],
+                                  int *is_exr)
+{
+    char p[PATH_SIZE], q[PATH_SIZE];
+    const char *file_name = NULL, *sha256 = NULL;
+    dwvs_path_key(p, path, "file");
+    DWV_TRY(dwvs_read_string(dwvs_member(item, "file"), p, &file_name));
+    DWV_TRY(dwvs_resolve_path(ps->base_dir, file_name, p, resolved));
+    if (dwvs_member(item, "sha256")) {
+        dwvs_path_key(q, path, "sha256");
+        DWV_TRY(dwvs_read_string(dwvs_member(item, "sha256"), q, &sha256));
+        size_t n = strlen(sha256);
+        int hex = n == 64u;
+        for (size_t i = 0; hex && i < n; ++i) hex = (sha256[i] >= '0' && sha256[i] <= '9') || (sha256[i] >= 'a' && sha256[i] <= 'f');
+        if (!hex) return dwvs_fail_at(DWV_ERROR_FORMAT, q, "expected 64 lower-case hexadecimal digits (SHA-256)");
+    }
+    return dwvs_check_image_file(p, resolved, sha256, is_exr);
+}
 
 static const char *const extensions[] = {"repeat", "extend", "clip", "mirror"};
 static const char *const interpolations[] = {"linear", "closest", "cubic"};
@@ -13,7 +68,7 @@ static const char *const interpolations[] = {"linear", "closest", "cubic"};
  * "texels": scene-linear floats). */
 static dwv_result_t read_texture(dwvs_parser *ps, const cJSON *item, const char *path, uint32_t *id)
 {
-    static const char *const keys[] = {"file", "colorspace", "width", "height", "channels", "texels",
+    static const char *const keys[] = {"file", "sha256", "colorspace", "width", "height", "channels", "texels",
                                        "extension", "interpolation"};
     static const char *const spaces[] = {"srgb", "non_color", "linear"};
     if (!cJSON_IsObject(item))
@@ -31,17 +86,23 @@ static dwv_result_t read_texture(dwvs_parser *ps, const cJSON *item, const char 
         if (dwvs_member(item, "width") || dwvs_member(item, "height") || dwvs_member(item, "channels") ||
             dwvs_member(item, "texels"))
             return dwvs_fail_at(DWV_ERROR_FORMAT, path, "give either 'file' or 'width'/'height'/'channels'/'texels'");
-        const char *file_name = NULL;
         char resolved[MAX_FILE_PATH];
+        int exr = 0;
+        DWV_TRY(dwvs_read_image_file(ps, item, path, resolved, &exr));
         dwvs_path_key(p, path, "file");
-        DWV_TRY(dwvs_read_string(file, p, &file_name));
-        DWV_TRY(dwvs_resolve_path(ps->base_dir, file_name, p, resolved));
-        size_t space = 0;
+        /* An EXR holds scene-linear floats ("linear" or "non_color": data as stored, the default);
+         * a PNG 8-bit values, sRGB unless said. */
+        size_t space = exr ? 2 : 0;
         DWV_TRY(dwvs_opt_choice(item, path, "colorspace", spaces, 3, &space));
-        desc.format = space == 0 ? DWV_TEXEL_SRGB8 : DWV_TEXEL_LINEAR8;
+        if (exr && space == 0)
+            return dwvs_fail_at(DWV_ERROR_FORMAT, path, "an OpenEXR file holds scene-linear floats: its 'colorspace' "
+                                "is 'linear' or 'non_color', not 'srgb'");
+        desc.format = exr ? DWV_TEXEL_FLOAT32 : space == 0 ? DWV_TEXEL_SRGB8 : DWV_TEXEL_LINEAR8;
         dwv_result_t r = dwv_scene_add_texture_file(ps->scene, resolved, &desc, id);
         return r == DWV_SUCCESS ? r : dwvs_prefix_capi(r, p);
     }
+    if (dwvs_member(item, "sha256"))
+        return dwvs_fail_at(DWV_ERROR_FORMAT, path, "'sha256' applies to a 'file'");
     if (dwvs_member(item, "colorspace"))
         return dwvs_fail_at(DWV_ERROR_FORMAT, path, "'colorspace' applies to a 'file' (inline texels are scene-linear)");
     const char *need[] = {"width", "height", "channels", "texels"};
@@ -113,7 +174,9 @@ dwv_result_t dwvs_read_textures(dwvs_parser *ps, const cJSON *item)
 
 dwv_result_t dwvs_read_material_textures(dwvs_parser *ps, const cJSON *item, const char *path, uint32_t material_id)
 {
-    static const char *const keys[] = {"input", "texture", "uv_layer", "blend", "strength", "distance", "invert"};
+    static const char *const keys[] = {"input", "texture", "uv_layer", "blend", "strength", "distance", "invert",
+                                       "bump_shadowing"};
+    static const char *const shadowings[] = {"none", "chiang2019", "chiang2019_mapped", "conty2019"};
     static const char *const inputs[] = {"base_color", "subsurface_color", "subsurface_weight", "subsurface_radius",
                                          "subsurface_scale", "subsurface_anisotropy", "roughness", "specular",
                                          "specular_tint", "normal_map", "bump"};
@@ -157,6 +220,9 @@ dwv_result_t dwvs_read_material_textures(dwvs_parser *ps, const cJSON *item, con
                 return dwvs_fail_at(DWV_ERROR_FORMAT, r_path, "expected true or false, found %s", dwvs_type_name(invert));
             binding.invert = cJSON_IsTrue(invert) ? 1 : 0;
         }
+        size_t shadowing = (size_t)binding.bump_shadowing;
+        DWV_TRY(dwvs_opt_choice(b, q, "bump_shadowing", shadowings, 4, &shadowing));
+        binding.bump_shadowing = (dwv_bump_shadowing_t)shadowing;
         dwv_result_t r = dwv_scene_bind_texture(ps->scene, material_id, &binding);
         if (r != DWV_SUCCESS) return dwvs_prefix_capi(r, q);
     }

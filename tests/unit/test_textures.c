@@ -154,7 +154,8 @@ static void refusals(void)
           "absent layer: %s", dwv_last_error_message());
     dwv_scene_release(scene);
 
-    /* v2 specular: textured roughness refused; a mesh without UVs for a textured material. */
+    /* v2 specular: textured roughness accepted (v2_specular_textures bakes it); a mesh without
+     * UVs for a textured material. */
     scene = new_scene();
     dwv_material_t m = DWV_MATERIAL_INIT;
     m.specular_model = DWV_SPECULAR_PRINCIPLED_V2;
@@ -162,7 +163,7 @@ static void refusals(void)
     grey = add_texture(scene, 2, 2, 1, DWV_INTERPOLATION_LINEAR, DWV_EXTENSION_REPEAT, texels);
     b = (dwv_texture_binding_t)DWV_TEXTURE_BINDING_INIT;
     b.input = DWV_INPUT_ROUGHNESS, b.texture_id = grey;
-    CHECK(dwv_scene_bind_texture(scene, material, &b) == DWV_ERROR_INVALID_ARGUMENT, "v2 roughness");
+    CHECK(dwv_scene_bind_texture(scene, material, &b) == DWV_SUCCESS, "v2 roughness: %s", dwv_last_error_message());
     b.input = DWV_INPUT_SUBSURFACE_SCALE;
     CHECK(dwv_scene_bind_texture(scene, material, &b) == DWV_SUCCESS, "scale: %s", dwv_last_error_message());
     test_mesh box = test_box(-1, -1, -1, 1, 1, 1);
@@ -308,9 +309,72 @@ static void subsurface_halves(void)
     free(rt.rgba);
 }
 
+/* A diffuse quad under the 4.x+ (v2) specular layer, its Roughness and / or Specular IOR Level
+ * constant or from a 1 x 1 texture of value `rough` / `level` (negative: constant). */
+static test_result v2_quad(double rough, double level, int textured_rough, int textured_level)
+{
+    dwv_scene_t *scene = new_scene();
+    dwv_material_t m = DWV_MATERIAL_INIT;
+    m.kind = DWV_MATERIAL_DIFFUSE;
+    m.specular_model = DWV_SPECULAR_PRINCIPLED_V2;
+    m.specular_multiscatter = 1;
+    m.base_color[0] = 0.9, m.base_color[1] = 0.5, m.base_color[2] = 0.2;
+    m.roughness = textured_rough ? 0.9 : rough; /* a texture's value replaces it */
+    m.specular = textured_level ? 0.1 : level;
+    uint32_t material = 0;
+    dwv_scene_add_material(scene, &m, &material);
+    float r = (float)rough, l = (float)level;
+    if (textured_rough)
+        bind(scene, material, DWV_INPUT_ROUGHNESS,
+             add_texture(scene, 1, 1, 1, DWV_INTERPOLATION_CLOSEST, DWV_EXTENSION_REPEAT, &r), 1.0);
+    if (textured_level)
+        bind(scene, material, DWV_INPUT_SPECULAR,
+             add_texture(scene, 1, 1, 1, DWV_INTERPOLATION_CLOSEST, DWV_EXTENSION_REPEAT, &l), 1.0);
+    quad_scene(scene, material, NULL, 0, NULL);
+    test_result out = bake(scene, 8, 4);
+    dwv_scene_release(scene);
+    return out;
+}
+
+static double largest_relative_difference(const test_result *a, const test_result *b)
+{
+    double worst = 0.0;
+    for (int c = 0; c < 3; ++c) worst = fmax(worst, fabs(a->mean[c] - b->mean[c]) / b->mean[c]);
+    return worst;
+}
+
+/* v2's albedo tables over textured Roughness / Specular IOR Level (a grid, material.h): a
+ * texture of a grid node's roughness (0.5 = node 8 of 17) bakes bit for bit as the constant;
+ * between nodes (0.37) and for the level (whose nodes are in sqrt(f0)) within 0.2% of the
+ * constant (the interpolation's error; the bakes are paired: same seed, same walks), while a
+ * constant 0.1 away is far outside that (the comparison can fail). */
+static void v2_specular_textures(void)
+{
+    test_result constant = v2_quad(0.5, 0.5, 0, 0), textured = v2_quad(0.5, 0.5, 1, 0);
+    CHECK(constant.rgba && textured.rgba && memcmp(constant.rgba, textured.rgba, 4u * 64u * sizeof(float)) == 0,
+          "roughness 0.5 from a texture differs from the constant");
+    free(constant.rgba), free(textured.rgba);
+    static const struct { double rough, level; int tr, tl; } cases[] = {
+        {0.37, 0.5, 1, 0}, {0.37, 0.23, 0, 1}, {0.61, 0.8, 1, 1}, {0.05, 0.5, 1, 0}};
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+        test_result c = v2_quad(cases[i].rough, cases[i].level, 0, 0);
+        test_result t = v2_quad(cases[i].rough, cases[i].level, cases[i].tr, cases[i].tl);
+        test_result off = v2_quad(cases[i].rough + (cases[i].tr ? 0.1 : 0.0), cases[i].level + (cases[i].tl ? 0.1 : 0.0),
+                                  0, 0);
+        double d = largest_relative_difference(&t, &c), planted = largest_relative_difference(&off, &c);
+        CHECK(d < 2e-3, "v2 case %zu: textured vs constant %.3g%%", i, 100.0 * d);
+        CHECK(planted > 4e-3, "v2 case %zu: a value 0.1 off changes the mean by only %.3g%%", i, 100.0 * planted);
+        printf("v2 case %zu (roughness %.2f%s, level %.2f%s): textured vs constant %.4f%%, 0.1 off %.3f%%\n", i,
+               cases[i].rough, cases[i].tr ? " textured" : "", cases[i].level, cases[i].tl ? " textured" : "", 100.0 * d,
+               100.0 * planted);
+        free(c.rgba), free(t.rgba), free(off.rgba);
+    }
+}
+
 int main(void)
 {
     refusals();
+    v2_specular_textures();
     diffuse_bakes();
     subsurface_halves();
     return check_report("test_textures");

@@ -412,7 +412,7 @@ static void test_scene_file(void)
         {"{\"version\": 1, \"meshes\": [], \"world\": {\"environment\": {\"width\": 2, \"height\": 1, \"texels\": [1,1,1]}}}",
          "world.environment.texels: 3 numbers: a 2 x 1 image needs 6"},
         {"{\"version\": 1, \"meshes\": [], \"world\": {\"color\": [1,1,1], \"environment\": {}}}", "either 'environment'"},
-        {"{\"version\": 1, \"meshes\": [], \"world\": {\"environment\": {\"width\": 2, \"height\": 1}}}", "needs 'width'"},
+        {"{\"version\": 1, \"meshes\": [], \"world\": {\"environment\": {\"width\": 2, \"height\": 1}}}", "needs either 'file' or 'width', 'height' and 'texels'"},
         {"{\"version\": 1, \"meshes\": [], \"world\": {\"environment\": {\"width\": 2, \"height\": 1, \"texels\": [1,1,1, 1,-1,1]}}}",
          "world.environment: dwv_scene_set_world_environment: texel (1, 0)"},
         {"{\"version\": 1, \"meshes\": [], \"world\": {\"environment\": {\"width\": 1, \"height\": 1, \"texels\": [1,1,1], \"interpolation\": \"smart\"}}}",
