@@ -12,7 +12,7 @@
  *        flight pdf exp(-tau) max(a + mu tau, f) / N(a, mu) (f = FLOOR, a quarter of z_e) and its
  *        tail written out here in closed form, piece by piece,
  *      dir_pdf = (1 + s mu) / (2 pi Z), s = up for mu >= 0, down below, Z = 2 + (up - down) / 2,
- *        the chords of N(a_guide, mu) either side of 0: up = N(a, 1) / N(a, 0) - 1,
+ *        the chords of N(a_guide, mu) either side of 0: up = min(N(a, 1) / N(a, 0) - 1, 1 / z_e),
  *        down = 1 - N(a, -1) / N(a, 0),
  *      a_c = sigma_c h + z_e, h the height above the entry point along the lit normal (of either
  *        sign),
@@ -143,7 +143,8 @@ static long double ref_hg(long double g, long double mu)
 static long double ref_cosine_pdf(long double a, long double mu, long double plant)
 {
     long double n0 = ref_norm(a, 0.0L);
-    long double up = plant * (ref_norm(a, 1.0L) / n0 - 1.0L), down = plant * (1.0L - ref_norm(a, -1.0L) / n0);
+    long double up = plant * fminl(ref_norm(a, 1.0L) / n0 - 1.0L, 1.0L / 0.7104L);
+    long double down = plant * (1.0L - ref_norm(a, -1.0L) / n0);
     return (1.0L + (mu >= 0.0L ? up : down) * mu) / (2.0L + 0.5L * (up - down));
 }
 
