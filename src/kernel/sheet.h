@@ -14,21 +14,29 @@
  *   psi(z) ~ z + z_e,  z_e = 0.7104 (the Milne extrapolation length of an index-matched boundary,
  *   in mean free paths; Case and Zweifel 1967).
  *
- * A step from a point at importance a = z + z_e (>= z_e: the walk holds a there) then draws
- *   the cosine mu to the lit face's outward normal:   p(mu) = (1 + beta mu) / 2 on [-1, 1],
- *       beta = min(DWVK_SHEET_BETA_MAX, 1 / a): the first-order term of the exact marginal a + mu
- *       of the kernel x psi; held at 0.75 so that p stays >= 1/8 at mu = -1 (at beta = 1 the
- *       weight 1/p would have an infinite second moment there);
- *   the optical flight tau given mu:                  p(tau) = exp(-tau) (a + mu tau)_+ / N(a, mu),
- *       N = a + mu for mu >= 0, N = a + mu + |mu| exp(-a / |mu|) for mu < 0 (the flight stops
- *       where psi reaches 0, tau_max = a / |mu|: the classical share covers longer flights);
- *   and leaves through a surface at tau with the tail P(T > tau). Held at 0 there, psi sends few
- *   walks out by the far face, where they would score nothing (its exits' importance is 0 in the
- *   zero-variance walk); an importance held at z_e instead (an exponential flight past the entry's
- *   height) doubled the variance on the leaf, and did not rescue front-lit thick media.
- * Measured in a one-dimensional model of the report's leaf (2.5 mean free paths, walks entering
- * the far face): variance x events per walk 7x below classical sampling's at albedo 0.9995,
- * 7x at 0.951 and 4.7x at 0.851. */
+ * A step from a point of linear importance a = z + z_e (z the optical height above the entry
+ * point, of either sign: a curved sheet's walk goes below its entry's height inside the medium)
+ * and importance psi = max(a, f), f = DWVK_SHEET_FLOOR = z_e / 4, then draws
+ *   the cosine mu to the lit face's outward normal:   p(mu) = (1 + s mu) / Z, linear either side
+ *       of 0 (s = up or down, Z = 2 + (up - down) / 2) through the chords of the exact marginal
+ *       N(a, mu) of the kernel x psi (dwvk_sheet_slopes: up = 1 / a above the floor, held at
+ *       1 / z_e);
+ *   the optical flight tau given mu:                  p(tau) = exp(-tau) max(a + mu tau, f) / N(a, mu),
+ *       N the integral of the same (dwvk_sheet_tail_integral at 0);
+ *   and leaves through a surface at tau with the tail P(T > tau). The floor keeps the flight's pdf
+ *   at least f / N times the exponential's wherever the walk can land, so that the weight x
+ *   importance a walk keeps changes by a bounded factor per step. Before it (psi = (a + mu tau)_+,
+ *   the walk's a held at z_e below the entry's height, one slope min(1 / a, 0.75)) a flat sheet's
+ *   walks never met psi = 0 inside the medium (the far face is at z = 0), but a bent sheet's did:
+ *   flights past a / |mu| were the classical share's alone, a weight factor of 1 / q_classical =
+ *   100 at such a step, and a bake with one sample of weight ~5,800 (docs/speed.md, the bent
+ *   sheet). The floor costs the flat sheet a little: its far face's exits (importance 0 in the
+ *   zero-variance walk) get the floor's share, variance per walk +13% on the 2.5-mfp slab at albedo
+ *   0.9995 (a floor of z_e / 2: +34%, z_e: +100%; z_e / 10: +5% but 1.2x the bent sheet's noise).
+ *   The first version's measurements, one-dimensional model of the report's leaf (2.5 mean free
+ *   paths, walks entering the far face), held for the linear part:
+ * variance x events per walk 7x below classical sampling's at albedo 0.9995, 7x at 0.951 and 4.7x
+ * at 0.851. */
 #ifndef DWV_KERNEL_SHEET_H
 #define DWV_KERNEL_SHEET_H
 
