@@ -1,7 +1,6 @@
 """The benchmark set of tools/benchmark_scenes.py (issue 20): every scene's mesh is closed and
 turned outward, its scene file loads and bakes to a lit image, and tools/cycles_report.py takes
-the set's names (one by one or as `benchmark`) and refuses others; auto's pilot passes over a
-candidate with a heavy tail on box_side."""
+the set's names (one by one or as `benchmark`) and refuses others."""
 import math
 import os
 import subprocess
@@ -57,22 +56,6 @@ class BenchmarkScenesTest(unittest.TestCase):
                 self.assertTrue(all(math.isfinite(v) and v >= 0.0 for v in rgb), name)
                 self.assertGreater(sum(rgb), 0.0, f"{name}: a black image")
             self.assertEqual(benchmark_scenes.main(["--json", tmp, "--scenes", "nosuch"]), 1)
-
-    def test_pilot_refuses_a_tailed_candidate(self):
-        # Auto's pilot on box_side (48 x 48 pixels, 64 spp, seed 1: 976 pilot samples of the box):
-        # the backward walk shared by the channels has the smallest variance x cost (1145 against
-        # the incident walk's 1389), but its largest sample makes 0.143 of its sum of squares,
-        # 10x classical's 0.014: the tail test (src/bake/pilot.c, PILOT_TAIL_SHARE) passes it
-        # over for the incident walk, whose bake has less noise (RMSE between seeds 0.0073 against
-        # 0.0130). Without the test the pick was the backward walk (no incident patches).
-        with tempfile.TemporaryDirectory() as tmp:
-            self.assertEqual(benchmark_scenes.main(["--json", tmp, "--size", "48", "--samples", "64",
-                                                    "--scenes", "box_side"]), 0)
-            with dwivedi.Scene.load(os.path.join(tmp, "box_side.json")) as scene:
-                with dwivedi.bake(scene, samples=64, threads=1, seed=1) as image:
-                    features = image.stats.features
-        self.assertIn("incident_patches", features)
-        self.assertNotIn("channel_walks", features)
 
     def test_report_takes_the_names(self):
         report = SOURCE_DIR / "tools" / "cycles_report.py"
