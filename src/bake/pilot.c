@@ -92,6 +92,22 @@ enum { PILOT_CLASSICAL = 0, PILOT_ENTRY = 1, PILOT_GUIDED = 2, PILOT_SHEET = 3 }
  * against classical's 0.23, so the pilot's estimate would pick it by chance. */
 #define PILOT_ISOTROPIC_SHARE 0.01
 
+/* The pilot's variance is a sample variance, and a heavy tail (rare samples of huge weight, where
+ * the variance may be infinite) hides from it until its rare sample comes, which then makes most
+ * of the sum of squares: the bent sheet's sheet walks before their fix had RMSE 0.38 against
+ * classical's 0.008 in the bake, from one sample of weight 5,800, and won the pilot (docs/speed.md).
+ * A candidate whose largest sample makes more than PILOT_TAIL_SHARE of its sum of squares (in any
+ * channel), and more than PILOT_TAIL_RATIO times the share of classical's largest (classical
+ * walks' weights are at most 1: a share that large in classical is the scene's, a bright pixel,
+ * not the technique's), is not chosen. Only extreme tails: at 5% and 4x the test refused box_side's
+ * backward walk (share 0.14 against classical's 0.014; the incident walk it took had 1.35x less
+ * variance per sample) but at 48 px also the cylinder's pick, whose replacement had 5x more
+ * (docs/speed.md); at 25% and 10x it changed no pick of the benchmark's sheet, box_side, bowl and
+ * cylinder_front at 48 px, and refuses the sheet walk on the marble (shares 0.996 shared, 0.64
+ * with channel walks, against classical's 0.001), where the variance estimate is one sample's. */
+#define PILOT_TAIL_SHARE 0.25
+#define PILOT_TAIL_RATIO 10.0
+
 /* Technique `technique` (PILOT_*) of the pilot for a mesh of `medium` whose guide auto made
  * (`mixture`: auto's mixture, or classical where the albedo is too low to guide). */
 static void pilot_guide(const dwvb_bake *bake, uint32_t m, int technique, const dwvw_medium *medium,
@@ -135,7 +151,7 @@ static void pilot_candidate(const dwvb_bake *bake, uint32_t m, int candidate, dw
 }
 
 typedef struct pilot_sums {
-    double count, sum[3], sum_squares[3], cost;
+    double count, sum[3], sum_squares[3], largest[3], cost;
     double channel_cost[3]; /* of the cost, the channel walks' own, by channel */
 } pilot_sums;
 
@@ -195,6 +211,7 @@ static void *pilot_worker(void *arg)
                 for (int c = 0; c < 3; ++c) {
                     p->sum[c] += rgb[c];
                     p->sum_squares[c] += rgb[c] * rgb[c];
+                    p->largest[c] = fmax(p->largest[c], fabs(rgb[c]));
                 }
                 double event_cost = PILOT_COST_EVENT + (candidate % PILOT_TECHNIQUES == PILOT_CLASSICAL ? 0.0 : PILOT_COST_GUIDED_EVENT);
                 p->cost += PILOT_COST_SAMPLE + PILOT_COST_WALK * (double)tally.walks + event_cost * (double)tally.events +
@@ -230,6 +247,7 @@ static int run_pilot(dwvb_bake *bake, const dwvb_shader *shaders, const int *can
             for (int c = 0; c < 3; ++c) {
                 sums[k].sum[c] += b->sum[c];
                 sums[k].sum_squares[c] += b->sum_squares[c];
+                sums[k].largest[c] = fmax(sums[k].largest[c], b->largest[c]); /* in any order */
             }
             sums[k].cost += b->cost;
             for (int c = 0; c < 3; ++c) sums[k].channel_cost[c] += b->channel_cost[c];
@@ -284,6 +302,16 @@ static double candidate_work(const pilot_sums *p, const dwvb_material *material,
                 for (int c = 0; c < 3; ++c) counts[c] = (uint8_t)n[c];
             }
     return best;
+}
+
+/* The largest share one sample makes of a candidate's sum of squares, over the channels: near 1 /
+ * count where every sample weighs alike, near 1 where one sample makes the variance estimate. */
+static double tail_share(const pilot_sums *p)
+{
+    double share = 0.0;
+    for (int c = 0; c < 3; ++c)
+        if (p->sum_squares[c] > 0.0) share = fmax(share, p->largest[c] * p->largest[c] / p->sum_squares[c]);
+    return share;
 }
 
 int dwvb_pilot_choose(dwvb_bake *bake)
@@ -353,11 +381,19 @@ int dwvb_pilot_choose(dwvb_bake *bake)
             int best = candidates[0];
             double best_work = INFINITY;
             uint8_t best_counts[3] = {1u, 1u, 1u};
+            /* The tail test (PILOT_TAIL_SHARE): classical's share, the smallest of its forms run */
+            double classical_share = INFINITY;
+            for (int k = 0; k < candidate_count; ++k)
+                if (candidates[k] % PILOT_TECHNIQUES == PILOT_CLASSICAL)
+                    classical_share = fmin(classical_share, tail_share(&sums[(size_t)candidates[k] * meshes + m]));
             for (int k = 0; k < candidate_count; ++k) {
                 const pilot_sums *p = &sums[(size_t)candidates[k] * meshes + m];
                 uint8_t counts[3];
                 double work = candidate_work(p, material, trial_walks[(size_t)candidates[k] * meshes + m], counts);
-                if (work < best_work) {
+                double share = tail_share(p);
+                int tailed = candidates[k] % PILOT_TECHNIQUES != PILOT_CLASSICAL && share > PILOT_TAIL_SHARE &&
+                             share > PILOT_TAIL_RATIO * classical_share;
+                if (!tailed && work < best_work) {
                     best_work = work;
                     best = candidates[k];
                     for (int c = 0; c < 3; ++c) best_counts[c] = counts[c];

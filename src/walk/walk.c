@@ -291,14 +291,16 @@ static inline int walk_pair_bits(const dwvw_walk *walk, uint32_t pair, uint64_t 
     return (cache->stratified & bit) != 0u;
 }
 
-/* The sheet technique's importance a = sigma_t h + z_e per channel at the walk's position, h its
- * height above the entry point toward the lit side, held at h >= 0 (src/kernel/sheet.h: a sheet's
- * far face is where its walks come in). */
+/* The sheet technique's linear importance a = sigma_t h + z_e per channel at the walk's position,
+ * h its height above the entry point toward the lit side, of either sign; the importance is
+ * max(a, DWVK_SHEET_FLOOR) (src/kernel/sheet.h). Not held at h >= 0: a curved sheet's walk goes
+ * below its entry's height inside the medium, and an importance held there would not be the one
+ * its flight followed (the weight x importance a walk keeps then jumped by z_e / (a + mu tau),
+ * up to 1 / q_classical, at every such step: docs/speed.md, the bent sheet). */
 static void sheet_importance(const dwvw_walk *walk, double a[DWVW_MAX_CHANNELS])
 {
     const dwvw_medium *m = walk->medium;
     double h = dwvu_dot(dwvu_sub(walk->position, walk->entry_point), walk->guide->sheet_normal);
-    h = h > 0.0 ? h : 0.0;
     for (int c = 0; c < m->channels; ++c) a[c] = m->sigma_t[c] * h + DWVK_SHEET_EXTRAPOLATION;
 }
 
@@ -320,7 +322,8 @@ static double sheet_sample(dwvw_walk *walk, int channel, const double *choice, f
     sheet_importance(walk, walk->sheet_a);
     double u_component = choice != NULL ? *choice : dwvk_rng_uniform_d(walk->key, dim + DWVW_DIM_COMPONENT);
     int classical = u_component < guide->q_classical;
-    double beta = dwvk_sheet_beta(walk->sheet_a[m->guide_channel]);
+    double up, down;
+    dwvk_sheet_slopes(walk->sheet_a[m->guide_channel], &up, &down);
     dwvu_vec3 previous = walk->direction;
     float g = (float)m->g;
     if (walk->events > 0) {
@@ -335,7 +338,7 @@ static double sheet_sample(dwvw_walk *walk, int channel, const double *choice, f
         if (classical) {
             walk->direction = dwvw_classical_direction(previous, g, u);
         } else {
-            double mu = dwvk_sheet_cosine_sample(beta, (double)u.a);
+            double mu = dwvk_sheet_cosine_sample(up, down, (double)u.a);
             double sin2 = (1.0 - mu) * (1.0 + mu);
             walk->direction = dwvk_frame_direction(frame_about_axis(walk, normal), mu, sqrt(sin2 > 0.0 ? sin2 : 0.0),
                                                    dwvk_azimuth_f(u.b));
@@ -346,7 +349,7 @@ static double sheet_sample(dwvw_walk *walk, int channel, const double *choice, f
     }
     /* the cosine of the direction as it is, for the flight and both pdfs alike */
     walk->sheet_mu = dwvw_cosine(walk->direction, normal);
-    walk->sheet_direction_pdf = walk->events > 0 ? dwvk_sheet_cosine_pdf(beta, walk->sheet_mu) * DWVK_SHEET_INV_TWO_PI : 1.0;
+    walk->sheet_direction_pdf = walk->events > 0 ? dwvk_sheet_cosine_pdf(up, down, walk->sheet_mu) * DWVK_SHEET_INV_TWO_PI : 1.0;
     for (int c = 0; c < m->channels; ++c) /* channels of equal extinction have equal importance */
         walk->sheet_norm[c] = c > 0 && m->sigma_t[c] == m->sigma_t[c - 1]
                                   ? walk->sheet_norm[c - 1]
@@ -560,8 +563,7 @@ static void sheet_weight_update(dwvw_walk *walk, double t, int exited)
         /* the sheet's pdf depends on the extinction alone: channels of equal extinction share it */
         if (c == 0 || sigma != m->sigma_t[c - 1] || !(walk->channel_p[c - 1] > 0.0)) {
             double a = walk->sheet_a[c], mu = walk->sheet_mu, tau = sigma * t;
-            double psi = a + mu * tau;
-            double scaled = exited ? dwvk_sheet_tail_integral(a, mu, tau) : psi > 0.0 ? sigma * psi : 0.0;
+            double scaled = exited ? dwvk_sheet_tail_integral(a, mu, tau) : sigma * dwvk_sheet_importance(a + mu * tau);
             sheet = guide->q_sheet * walk->sheet_direction_pdf * scaled / walk->sheet_norm[c];
         }
         double classical = guide->q_classical * walk->phase * (exited ? 1.0 : sigma);
@@ -649,7 +651,7 @@ dwvw_status dwvw_walk_complete(dwvw_walk *walk, double hit_distance, dwvu_vec3 h
          * that walks nearing the lit side are not ended for their small weights. */
         double a[DWVW_MAX_CHANNELS];
         sheet_importance(walk, a);
-        largest *= a[m->guide_channel] / DWVK_SHEET_EXTRAPOLATION;
+        largest *= dwvk_sheet_importance(a[m->guide_channel]) / DWVK_SHEET_EXTRAPOLATION;
     }
     if (largest < DWVW_ROULETTE_THRESHOLD) { /* Russian roulette (step.h) */
         double survive;

@@ -173,7 +173,8 @@ typedef struct dwvw_walk {
     double component_stretch[DWVW_MAX_COMPONENTS];
     double channel_p[DWVW_MAX_CHANNELS];
     double phase;                                   /* phase function value of the step */
-    /* the sheet technique's step: importance a per channel at its start, its cosine to the lit
+    /* the sheet technique's step: linear importance a per channel at its start (the importance is
+     * max(a, DWVK_SHEET_FLOOR), src/kernel/sheet.h), its cosine to the lit
      * normal, the flight's normalisation N per channel, and its direction pdf per steradian (1 on
      * the first step) */
     double sheet_a[DWVW_MAX_CHANNELS], sheet_norm[DWVW_MAX_CHANNELS], sheet_mu, sheet_direction_pdf;

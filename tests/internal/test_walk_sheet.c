@@ -9,28 +9,32 @@
  *      D = sum_c P_c [ q_cl phase pdist_cl,c(t) + q_sheet dir_pdf pdist_sheet,c(t) ],
  *      pdist_cl = sigma_c exp(-sigma_c t) (a scattering event at t) or exp(-sigma_c t) (leaving at t),
  *      pdist_sheet = sigma_c p(a_c, mu, sigma_c t) (event) or P(T > sigma_c t) (leaving), with the
- *        flight pdf exp(-tau) (a + mu tau)_+ / N(a, mu) and its tail written out here in closed form,
- *      dir_pdf = (1 + beta mu) / (4 pi), beta = min(0.75, 1 / a_guide),
- *      a_c = sigma_c max(h, 0) + z_e, h the height above the entry point along the lit normal,
+ *        flight pdf exp(-tau) max(a + mu tau, f) / N(a, mu) (f = FLOOR, a quarter of z_e) and its
+ *        tail written out here in closed form, piece by piece,
+ *      dir_pdf = (1 + s mu) / (2 pi Z), s = up for mu >= 0, down below, Z = 2 + (up - down) / 2,
+ *        the chords of N(a_guide, mu) either side of 0: up = min(N(a, 1) / N(a, 0) - 1, 1 / z_e),
+ *        down = 1 - N(a, -1) / N(a, 0),
+ *      a_c = sigma_c h + z_e, h the height above the entry point along the lit normal (of either
+ *        sign),
  *      f_c' = phase sigma_c' alpha_c' exp(-sigma_c' t) (event) or phase exp(-sigma_c' t) (leaving),
  *      phase = dir_pdf = 1 on the first step; q_cl = max(0.01, |g|), q_sheet = 1 - q_cl,
  *    for random states (grey and RGB media, equal and unequal extinctions, channels of P = 0, first
  *    and later steps, g = 0 and not, every cosine, heights above and below the entry, the sampled
- *    distance or another, up to and past the flight's end tau_max = a / |mu|), relative 1e-11. The
+ *    distance or another, up to and past where the flight meets the floor), relative 1e-11. The
  *    phase value the walk keeps (single precision) is checked against HG apart, to 1e-5; the channel
  *    probabilities against throughput x albedo. Planted: one extinction 1e-6 off in the direct form.
  * 1b. The Russian roulette after a scattering event, on the largest weight times
- *    a_guide(new position) / z_e below DWVW_ROULETTE_THRESHOLD: the fate (the walk's roulette
+ *    max(a_guide(new position), f) / z_e below DWVW_ROULETTE_THRESHOLD: the fate (the walk's roulette
  *    number against the survival probability) and the survivors' weights. Planted: no importance
  *    factor (the fates that would change are counted).
  * 2. What the walk samples against the pdf it divides by: from a fixed state (grey medium, lit
  *    normal (0, 0, 1), the walk at a chosen height after a first scattering event at a chosen
  *    distance), many steps, each a walk begun anew with its own key. Chi-square of the cosine to
- *    the lit normal against q_cl (phase marginal) + q_sheet (1 + beta mu) / 2, and of the joint
+ *    the lit normal against q_cl (phase marginal) + q_sheet (1 + s mu) / Z, and of the joint
  *    (cosine, optical flight) on a 16 x 16 grid against the cell integrals of
  *    q_cl p_cl(mu) exp(-tau) + q_sheet p_sheet(mu) p(a, mu, tau); the first step's flight along
  *    the entry direction. Isotropic (phase marginal 1/2) and g = 0.5 with the previous direction
- *    along the lit normal (then the classical cosine is HG's). Planted: beta 10% off, a 15% off.
+ *    along the lit normal (then the classical cosine is HG's). Planted: both slopes 10% off, a 15% off.
  * 3. The lit-side rule: a sheet walk whose entry normal faces the lit normal (dot > 0) is the
  *    classical walk of the same key, bit for bit (positions, directions, weights, events, status),
  *    step by step in a slab, grey and RGB, g = 0 and not; in the estimator (general path) its
@@ -89,29 +93,43 @@ static int long_double_has_range(void)
     return tiny * tiny != 0.0L;
 }
 
-static long double ref_norm(long double a, long double mu)
+#define FLOOR (0.25L * 0.7104L) /* the importance's floor, a quarter of z_e (src/kernel/sheet.h) */
+
+/* The integral of exp(-s) psi(s), psi = max(a + mu s, f), over [x, y] (y may be infinite) where
+ * psi has one form: exp(-x) (a + mu + mu x) - exp(-y) (a + mu + mu y) on a line, f (exp(-x) -
+ * exp(-y)) on the floor. */
+static long double ref_piece(long double a, long double mu, long double x, long double y)
 {
-    return mu >= 0.0L ? a + mu : a + mu - mu * expl(a / mu);
+    long double middle = isinf(y) ? x + 1.0L : 0.5L * (x + y);
+    if (a + mu * middle >= FLOOR)
+        return expl(-x) * (a + mu + mu * x) - (isinf(y) ? 0.0L : expl(-y) * (a + mu + mu * y));
+    return FLOOR * (expl(-x) - (isinf(y) ? 0.0L : expl(-y)));
 }
 
-/* exp(-tau) (a + mu tau)_+ / N */
-static long double ref_flight_pdf(long double a, long double mu, long double tau)
-{
-    long double psi = a + mu * tau;
-    return psi > 0.0L ? expl(-tau) * psi / ref_norm(a, mu) : 0.0L;
-}
-
-/* P(T > tau): [exp(-tau) (a + mu + mu tau) - (mu < 0 ? mu exp(-a / |mu|) : 0)] / N, 0 past tau_max. */
-static long double ref_flight_tail(long double a, long double mu, long double tau)
+/* The integral of exp(-s) psi(s) over s > tau, in the pieces either side of t0 = (f - a) / mu. */
+static long double ref_tail_integral(long double a, long double mu, long double tau)
 {
     if (isinf(tau)) return 0.0L;
-    long double rest = expl(-tau) * (a + mu + mu * tau);
-    if (mu < 0.0L) {
-        long double end = a / -mu;
-        if (tau >= end) return 0.0L;
-        rest -= mu * expl(-end);
-    }
-    return rest > 0.0L ? rest / ref_norm(a, mu) : 0.0L;
+    long double t0 = mu != 0.0L ? (FLOOR - a) / mu : -1.0L;
+    if (t0 > tau) return ref_piece(a, mu, tau, t0) + ref_piece(a, mu, t0, INFINITY);
+    return ref_piece(a, mu, tau, INFINITY);
+}
+
+static long double ref_norm(long double a, long double mu)
+{
+    return ref_tail_integral(a, mu, 0.0L);
+}
+
+/* exp(-tau) max(a + mu tau, f) / N */
+static long double ref_flight_pdf(long double a, long double mu, long double tau)
+{
+    return expl(-tau) * fmaxl(a + mu * tau, FLOOR) / ref_norm(a, mu);
+}
+
+/* P(T > tau) */
+static long double ref_flight_tail(long double a, long double mu, long double tau)
+{
+    return ref_tail_integral(a, mu, tau) / ref_norm(a, mu);
 }
 
 static long double ref_hg(long double g, long double mu)
@@ -120,9 +138,14 @@ static long double ref_hg(long double g, long double mu)
     return (1.0L - g * g) / (4.0L * PI_L * base * sqrtl(base));
 }
 
-static long double ref_beta(long double a)
+/* The sheet cosine's pdf per unit cosine at linear importance a: linear either side of 0 through
+ * the chords of N(a, mu), slopes times `plant`. */
+static long double ref_cosine_pdf(long double a, long double mu, long double plant)
 {
-    return fminl(0.75L, 1.0L / a);
+    long double n0 = ref_norm(a, 0.0L);
+    long double up = plant * fminl(ref_norm(a, 1.0L) / n0 - 1.0L, 1.0L / 0.7104L);
+    long double down = plant * (1.0L - ref_norm(a, -1.0L) / n0);
+    return (1.0L + (mu >= 0.0L ? up : down) * mu) / (2.0L + 0.5L * (up - down));
 }
 
 /* ---- small helpers -------------------------------------------------------------------------- */
@@ -254,8 +277,8 @@ static int make_case(uint64_t index, step_case *s)
         for (int c = 0; c < 3; ++c) w->channel_p[c] = c == off ? 0.0 : 0.05 + uniform(key, &dim);
     }
 
-    /* the distance: as sampled, or another (as test_walk_weight), or about the guide channel's
-     * tau_max where the direction points down */
+    /* the distance: as sampled, or another (as test_walk_weight), or about where a channel's
+     * flight meets the floor, where the direction points down */
     double t = sampled, choice = uniform(key, &dim);
     double mu = dwvw_cosine(w->direction, s->normal);
     if (choice < 0.3) {
@@ -265,9 +288,9 @@ static int make_case(uint64_t index, step_case *s)
     } else if (choice < 0.45 && mu < -1e-3) {
         s->overridden_t = 1;
         int c = (int)(channels * uniform(key, &dim)) % channels;
-        double h = fmax(0.0, dwvu_dot(dwvu_sub(w->position, w->entry_point), s->normal));
+        double h = dwvu_dot(dwvu_sub(w->position, w->entry_point), s->normal);
         double a = s->medium.sigma_t[c] * h + DWVK_SHEET_EXTRAPOLATION;
-        t = a / -mu / s->medium.sigma_t[c] * (1.0 + 1e-3 * (2.0 * uniform(key, &dim) - 1.0));
+        t = fabs(a - (double)FLOOR) / -mu / s->medium.sigma_t[c] * (1.0 + 1e-3 * (2.0 * uniform(key, &dim) - 1.0));
     }
     s->t = t;
     s->exited = uniform(key, &dim) < 0.35;
@@ -282,13 +305,12 @@ static long double direct_ratio(const step_case *s, int cw, int planted, long do
     const dwvw_medium *m = &s->medium;
     long double t = s->t;
     long double h = dot_l(dwvu_sub(w->position, w->entry_point), s->normal);
-    h = h > 0.0L ? h : 0.0L;
     long double mu = dot_l(w->direction, s->normal);
     mu = mu < -1.0L ? -1.0L : mu > 1.0L ? 1.0L : mu;
     long double a_guide = (long double)m->sigma_t[m->guide_channel] * h + DWVK_SHEET_EXTRAPOLATION;
     long double first = w->events == 0;
     long double phase = first ? 1.0L : (long double)w->phase;
-    long double dir_pdf = first ? 1.0L : (1.0L + ref_beta(a_guide) * mu) / (4.0L * PI_L);
+    long double dir_pdf = first ? 1.0L : ref_cosine_pdf(a_guide, mu, 1.0L) / (2.0L * PI_L);
     long double q_classical = fmaxl(0.01L, fabsl((long double)m->g)), q_sheet = 1.0L - q_classical;
     long double denominator = 0.0L;
     for (int c = 0; c < m->channels; ++c) {
@@ -353,8 +375,8 @@ static void test_weight_update(void)
                            s.medium.sigma_t[0] == s.medium.sigma_t[2];
         }
         for (int c = 0; c < channels; ++c) {
-            long double a = s.medium.sigma_t[c] * fmaxl(h, 0.0L) + DWVK_SHEET_EXTRAPOLATION;
-            if (mu < 0.0L && (long double)s.medium.sigma_t[c] * s.t > a / -mu) {
+            long double a = s.medium.sigma_t[c] * h + DWVK_SHEET_EXTRAPOLATION;
+            if (mu < 0.0L && a > FLOOR && (long double)s.medium.sigma_t[c] * s.t > (a - FLOOR) / -mu) {
                 ++past_end;
                 break;
             }
@@ -404,7 +426,7 @@ static void test_weight_update(void)
     }
     printf("1. weight update: %d ratios in %d states (%d grey; RGB: %d with a channel of P = 0, %d with equal "
            "extinctions; %d with g != 0; first step: %d scatter, %d exit; later: %d scatter, %d exit; %d below the "
-           "entry, %d cosines < 0, %d distances not the sampled one, %d past a channel's tau_max), worst relative "
+           "entry, %d cosines < 0, %d distances not the sampled one, %d past where a channel's flight meets the floor), worst relative "
            "difference %.2g from the direct form; %d exact zeros, %d far below double's range, %d states beyond it "
            "skipped; phase within %.2g of HG; a 1e-6 change of one extinction caught in %d of %d states\n",
            compared, CASES - skipped, grey, p_zero, equal_sigma, anisotropic, kinds[0][0], kinds[0][1], kinds[1][0],
@@ -415,7 +437,7 @@ static void test_weight_update(void)
           "too few states of some kind");
     CHECK(below > CASES / 50 && negative_mu > CASES / 10 && past_end > CASES / 50 && p_zero > CASES / 20 &&
               equal_sigma > CASES / 10 && anisotropic > CASES / 5,
-          "too few states of some kind: below the entry %d, going down %d, past tau_max %d, P = 0 %d, equal "
+          "too few states of some kind: below the entry %d, going down %d, onto the floor %d, P = 0 %d, equal "
           "extinctions %d, g != 0 %d", below, negative_mu, past_end, p_zero, equal_sigma, anisotropic);
     CHECK(planted_caught > planted_cases * 3 / 4, "a planted 1e-6 change caught in only %d of %d states", planted_caught,
           planted_cases);
@@ -442,8 +464,8 @@ static void test_roulette(void)
         if (!(largest > 1e-250L && largest < 1e250L)) continue;
         dwvu_vec3 moved = dwvu_madd(w->position, w->direction, s.t);
         long double h = dot_l(dwvu_sub(moved, w->entry_point), s.normal);
-        long double importance = ((long double)m->sigma_t[m->guide_channel] * fmaxl(h, 0.0L) + DWVK_SHEET_EXTRAPOLATION) /
-                                 DWVK_SHEET_EXTRAPOLATION;
+        long double importance =
+            fmaxl((long double)m->sigma_t[m->guide_channel] * h + DWVK_SHEET_EXTRAPOLATION, FLOOR) / DWVK_SHEET_EXTRAPOLATION;
         /* scale the weights so that L = largest x importance is uniform in (0, 0.7) */
         long double target = 0.7L * dwvk_rng_uniform_d(dwvk_rng_key(SEED, 5u, i), 0u) + 1e-6L;
         long double scale = target / (largest * importance);
@@ -508,7 +530,7 @@ typedef struct sample_state {
 #define SAMPLE_SIGMA 2.0
 
 typedef struct cosine_context {
-    double g, beta, plant;
+    double g, a, plant;
     int sheet; /* 1: the sheet's cosine pdf, 0: the classical one */
 } cosine_context;
 
@@ -522,11 +544,11 @@ static double classical_cosine_pdf(double g, double mu)
 static double cosine_integrand(double mu, void *context)
 {
     const cosine_context *k = context;
-    return k->sheet ? 0.5 * (1.0 + k->beta * k->plant * mu) : classical_cosine_pdf(k->g, mu);
+    return k->sheet ? (double)ref_cosine_pdf(k->a, mu, k->plant) : classical_cosine_pdf(k->g, mu);
 }
 
 typedef struct cell_context {
-    double a, beta, tau_lo, tau_hi;
+    double a, a_direction, tau_lo, tau_hi;
 } cell_context;
 
 /* The sheet's density in mu times its flight's probability in [tau_lo, tau_hi] given mu. */
@@ -534,17 +556,18 @@ static double cell_integrand(double mu, void *context)
 {
     const cell_context *k = context;
     long double in_bin = ref_flight_tail(k->a, mu, k->tau_lo) - ref_flight_tail(k->a, mu, k->tau_hi);
-    return 0.5 * (1.0 + k->beta * mu) * (double)in_bin;
+    return (double)(ref_cosine_pdf(k->a_direction, mu, 1.0L) * in_bin);
 }
 
-/* The integral over [m0, m1] with panels split where a flight's end a / |mu| meets tau_lo or tau_hi,
- * at mu = -a / tau (the tail has a kink in its second derivative there); tau_lo < tau_hi puts the
- * two cuts in order. */
+/* The integral over [m0, m1] with panels split where a flight meets the floor at tau_lo or tau_hi,
+ * at mu = (f - a) / tau (the tail has a kink in its second derivative there); tau_lo < tau_hi puts
+ * the two cuts in order. */
 static double cell_sheet(const cell_context *k, double m0, double m1)
 {
     double cut[4] = {m0, m1, m1, m1};
     int n = 1;
-    const double ends[2] = {-k->a / k->tau_lo, -k->a / k->tau_hi}; /* -inf at tau 0, -0 at tau inf */
+    const double floor_gap = (double)FLOOR - k->a; /* < 0: the states start above the floor */
+    const double ends[2] = {floor_gap / k->tau_lo, floor_gap / k->tau_hi}; /* -inf at tau 0, -0 at tau inf */
     for (int e = 0; e < 2; ++e)
         if (ends[e] > m0 && ends[e] < m1) cut[n++] = ends[e];
     cut[n] = m1;
@@ -594,7 +617,8 @@ static void test_sampling_state(const sample_state *st)
     dwvw_guide_init(&guide, DWVW_SHEET, &medium, &patch, 1);
     const double q_classical = fmax(0.01, fabs(st->g)), q_sheet = 1.0 - q_classical;
     const double a = st->first_step ? DWVK_SHEET_EXTRAPOLATION : st->optical_height + DWVK_SHEET_EXTRAPOLATION;
-    const double beta = dwvk_sheet_beta(a);
+    double up, down;
+    dwvk_sheet_slopes(a, &up, &down);
 
     /* the state reached as intended */
     {
@@ -664,7 +688,7 @@ static void test_sampling_state(const sample_state *st)
     }
     double total = 0.0;
     for (int k = 0; k < COSINE_BINS; ++k) {
-        cosine_context cl = {st->g, beta, 1.0, 0}, sh = {st->g, beta, 1.0, 1}, shp = {st->g, beta, 1.10, 1};
+        cosine_context cl = {st->g, a, 1.0, 0}, sh = {st->g, a, 1.0, 1}, shp = {st->g, a, 1.10, 1};
         double p_cl = bin_integral(cosine_integrand, &cl, edges[k], edges[k + 1]);
         double p_sh = stats_gl_panel(cosine_integrand, &sh, edges[k], edges[k + 1]);
         double p_shp = stats_gl_panel(cosine_integrand, &shp, edges[k], edges[k + 1]);
@@ -690,12 +714,12 @@ static void test_sampling_state(const sample_state *st)
     }
     double joint_total = 0.0;
     for (int km = 0; km < GRID; ++km) {
-        cosine_context cl = {st->g, beta, 1.0, 0};
+        cosine_context cl = {st->g, a, 1.0, 0};
         double p_cl = bin_integral(cosine_integrand, &cl, mu_edges[km], mu_edges[km + 1]);
         for (int kt = 0; kt < GRID; ++kt) {
             double lo = tau_edges[kt], hi = tau_edges[kt + 1];
             double cl_flight = exp(-lo) - (isinf(hi) ? 0.0 : exp(-hi));
-            cell_context honest = {a, beta, lo, hi}, wrong = {1.15 * a, beta, lo, hi};
+            cell_context honest = {a, a, lo, hi}, wrong = {1.15 * a, a, lo, hi};
             double sh = cell_sheet(&honest, mu_edges[km], mu_edges[km + 1]);
             double shp = cell_sheet(&wrong, mu_edges[km], mu_edges[km + 1]);
             joint_e[km * GRID + kt] = STEP_SAMPLES * (q_classical * p_cl * cl_flight + q_sheet * sh);
@@ -707,13 +731,13 @@ static void test_sampling_state(const sample_state *st)
           joint_total / STEP_SAMPLES);
     stats_chi_square_t j = stats_chi_square(joint_o, joint_e, GRID * GRID);
     stats_chi_square_t jp = stats_chi_square(joint_o, joint_p, GRID * GRID);
-    printf("2. %s (a %.4f, beta %.4f, q_cl %.2f): cosine chi2 %.1f dof %d p %.3g (planted beta +10%% p %.3g); "
+    printf("2. %s (a %.4f, slopes %.4f %.4f, q_cl %.2f): cosine chi2 %.1f dof %d p %.3g (planted slopes +10%% p %.3g); "
            "joint (cosine, flight) chi2 %.1f dof %d p %.3g (planted a +15%% p %.3g)\n",
-           st->name, a, beta, q_classical, r.x2, r.dof, r.p, rp.p, j.x2, j.dof, j.p, jp.p);
+           st->name, a, up, down, q_classical, r.x2, r.dof, r.p, rp.p, j.x2, j.dof, j.p, jp.p);
     CHECK(outside == 0 && joint_outside == 0, "%s: %d cosines, %d (cosine, flight) pairs outside their range", st->name,
           outside, joint_outside);
     CHECK(r.p > STATS_P_REJECT, "%s: the cosine does not follow its pdf (p %.3g)", st->name, r.p);
-    CHECK(rp.p < STATS_P_REJECT, "%s: a planted 10%% change of beta was not caught (p %.3g)", st->name, rp.p);
+    CHECK(rp.p < STATS_P_REJECT, "%s: a planted 10%% change of the slopes was not caught (p %.3g)", st->name, rp.p);
     CHECK(j.p > STATS_P_REJECT, "%s: the (cosine, flight) pairs do not follow their pdf (p %.3g)", st->name, j.p);
     CHECK(jp.p < STATS_P_REJECT, "%s: a planted 15%% change of a was not caught (p %.3g)", st->name, jp.p);
 }
