@@ -1,5 +1,5 @@
 /* The estimator's guided and mixture walkers in lock-step lanes: the walks of guided_walk_in and
- * mixture_walk_in (estimate_fast.c), eight at a time. Their step pieces are step.h's and
+ * mixture_walk_in (estimate_fast.c), DWVW_LANES (16) at a time. Their step pieces are step.h's and
  * estimate_walkers.h's, as there; what is written out here is the lanes' form of a step (a loop
  * over the lanes per stage, selects for branches). */
 #include <math.h>
@@ -36,6 +36,8 @@
 #else
 #define DWVW_LANE_CLONES
 #endif
+
+_Static_assert(DWVW_LANES <= 32, "the flagged lanes are a 32-bit mask (lanes_run_in)");
 
 /* The lanes' state. p: position; d: the direction of the step being taken (for a lane at
  * events = 0, its entry direction). log_constants and exponent as in guided_walk_in, weight as in
@@ -515,9 +517,13 @@ static inline void lanes_run_in(const dwvw_estimate_setup *setup, const dwvw_fas
     }
     while (live_count > 0) {
         if (!lanes_step(&L, setup, plan, kind)) continue;
+        /* The live flagged lanes as a bit mask, visited lowest first (the order of a scan over the
+         * lanes) without a branch per lane: about half the steps flag a lane, seldom the same one. */
+        uint32_t pending = 0;
+        for (int l = 0; l < DWVW_LANES; ++l) pending |= (uint32_t)(L.flagged[l] & live[l]) << l;
         int freed = 0;
-        for (int l = 0; l < DWVW_LANES; ++l) {
-            if (!L.flagged[l] || !live[l]) continue;
+        for (; pending; pending &= pending - 1u) {
+            int l = __builtin_ctz(pending);
             dwvw_walk_end end;
             int ended = plan->walker == DWVW_WALKER_MIXTURE ? mixture_lane_end(&L, l, setup, kind, &end)
                                                             : guided_lane_end(&L, l, setup, plan, kind, &end);
