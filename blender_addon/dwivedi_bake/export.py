@@ -16,7 +16,7 @@ from typing import Any, Dict, List, Optional, Tuple
 
 import bpy
 
-from . import evaluate, textures
+from . import evaluate, normals, textures
 
 
 class ExportError(Exception):
@@ -335,6 +335,10 @@ def _mesh_arrays(mesh: Any, want_uvs: bool, texture_maps: Optional[List[Optional
     tris.foreach_get("split_normals", corner_normals)
     corner_vertices = array.array("I", [0]) * (3 * t)
     tris.foreach_get("vertices", corner_vertices)
+    # Blender 3.x's vertex normals vary in their last bits from one evaluation to the next (threads
+    # add into them in any order): the same normals in a fixed order, so that a scene bakes the same
+    # bits every time (normals.py).
+    normals.settle_corner_normals(mesh, corner_vertices, corner_normals, smooth, bpy.app.version)
     positions = array.array("f", [0.0]) * (9 * t)
     for c, v in enumerate(corner_vertices):
         positions[3 * c:3 * c + 3] = vertex_co[3 * v:3 * v + 3]
