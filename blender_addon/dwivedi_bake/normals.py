@@ -15,7 +15,9 @@ precision, by Blender's definition: a face's normal by Newell's method (its vect
 normalised; +z where it vanishes), weighted at each corner by the corner's angle between its two
 edges (Thurmer and Wuthrich 1998, "Computing vertex normals from polygonal facets"), summed per
 vertex and normalised; a vertex whose sum vanishes takes its normalised position, as Blender's
-does. They agree with Blender's to float rounding (tests/python/test_normals.py).
+does. They agree with Blender's within 3e-6 on a 48 x 24 UV sphere (Blender sums in float, and
+its Newell sums lose that much on the poles' thin triangles; tests/blender/test_export_normals.py
+bounds it by 1e-5) and are the same bits every time (tests/python/test_normals.py).
 
 numpy where Blender has it (whole-array operations; np.add.at adds in index order), the standard
 library otherwise, with the same result up to rounding and each path deterministic.
