@@ -70,7 +70,8 @@
 #define PILOT_COST_RAY 0.0
 #define PILOT_COST_QUERY 6028.0
 #define PILOT_COST_TERM 25.22
-/* Pilot samples per candidate: a sixteenth of the bake's samples, at most PILOT_MAX; below
+/* Pilot samples per candidate: a sixteenth of the bake's samples, at most PILOT_MAX (the first
+ * quarter of them for every candidate, the rest for those not clearly worse: pilot_survivors); below
  * PILOT_MIN the estimate is too noisy to act on and auto keeps its mixture. A mesh needs
  * PILOT_MESH_MIN of them to be decided. */
 #define PILOT_MAX 4096u
@@ -107,6 +108,14 @@ enum { PILOT_CLASSICAL = 0, PILOT_ENTRY = 1, PILOT_GUIDED = 2, PILOT_SHEET = 3 }
  * with channel walks, against classical's 0.001), where the variance estimate is one sample's. */
 #define PILOT_TAIL_SHARE 0.25
 #define PILOT_TAIL_RATIO 10.0
+
+/* The standard errors of a variance estimate (block_spread) either side of it that bound it in
+ * pilot_survivors. The choice among the candidates left takes the estimate itself: taking its upper
+ * bound instead (2 standard errors) changed no pick on the benchmark's scenes at 48 x 48 pixels,
+ * 32 spp, seeds 1-4 (docs/speed.md). */
+#define PILOT_CONFIDENCE 2.0
+/* Of the PILOT_BLOCKS blocks, the first that every candidate runs (pilot_survivors). */
+#define PILOT_FIRST_BLOCKS 16u
 
 /* Technique `technique` (PILOT_*) of the pilot for a mesh of `medium` whose guide auto made
  * (`mixture`: auto's mixture, or classical where the albedo is too low to guide). */
@@ -153,6 +162,7 @@ static void pilot_candidate(const dwvb_bake *bake, uint32_t m, int candidate, dw
 typedef struct pilot_sums {
     double count, sum[3], sum_squares[3], largest[3], cost;
     double channel_cost[3]; /* of the cost, the channel walks' own, by channel */
+    double variance_error[3]; /* the standard error of the channel's variance estimate (block_spread) */
 } pilot_sums;
 
 static uint64_t active_pixels(const dwvb_bake *bake)
@@ -175,6 +185,7 @@ typedef struct pilot_run {
     int candidate_count;
     pilot_sums *block_sums;     /* [block][candidate][mesh] */
     uint32_t samples, meshes;
+    uint32_t end_block;         /* the blocks run: next_block's first value to end_block - 1 */
     atomic_uint next_block;
     atomic_int stopped;
 } pilot_run;
@@ -186,7 +197,7 @@ static void *pilot_worker(void *arg)
     uint64_t pixels = (uint64_t)bake->width * bake->height;
     for (;;) {
         uint32_t block = atomic_fetch_add(&run->next_block, 1u);
-        if (block >= PILOT_BLOCKS || atomic_load(&run->stopped)) break;
+        if (block >= run->end_block || atomic_load(&run->stopped)) break;
         uint32_t first = (uint32_t)((uint64_t)run->samples * block / PILOT_BLOCKS);
         uint32_t end = (uint32_t)((uint64_t)run->samples * (block + 1u) / PILOT_BLOCKS);
         pilot_sums *sums = &run->block_sums[(size_t)block * PILOT_CANDIDATES * run->meshes];
@@ -227,22 +238,57 @@ static void *pilot_worker(void *arg)
     return NULL;
 }
 
-/* Runs the pilot on the bake's threads; sums gets [candidate][mesh] totals. 0 done, 1 stopped
- * (cancel or time), -1 out of memory or no thread. */
-static int run_pilot(dwvb_bake *bake, const dwvb_shader *shaders, const int *candidates, int candidate_count,
-                     uint32_t samples, pilot_sums *sums)
+/* The standard error of a candidate's variance estimate per channel, from the spread of its
+ * PILOT_BLOCKS blocks (`blocks`, every `stride`-th pilot_sums), into total->variance_error. The
+ * blocks hold disjoint runs of independent pixel samples, so they are a cluster sample: with
+ * y_b the mean squared deviation from the overall mean in block b of n_b samples, the variance
+ * estimate is sum n_b y_b / N and its variance sum n_b^2 (y_b - v)^2 / N^2 (Cochran 1977,
+ * Sampling Techniques, ch. 9, the ratio estimate of a mean over clusters). A sample variance has
+ * an error of its own that grows with the distribution's fourth moment, (m4 - v^2) / N: one
+ * sample that makes a share s of the sum of squares gives an error near s v. In block order, so
+ * the same for any thread count. */
+static void block_spread(pilot_sums *total, const pilot_sums *blocks, size_t stride)
 {
-    uint32_t meshes = bake->scene->mesh_count;
-    size_t per_block = PILOT_CANDIDATES * (size_t)meshes;
-    pilot_run run = {bake, shaders, candidates, candidate_count, calloc(PILOT_BLOCKS * per_block, sizeof(pilot_sums)),
-                     samples, meshes, 0u, 0};
-    if (!run.block_sums) return -1;
-    atomic_init(&run.next_block, 0u);
-    atomic_init(&run.stopped, 0);
-    dwvu_parallel_run(bake->threads < 64u ? bake->threads : 64u, pilot_worker, &run);
+    for (int c = 0; c < 3; ++c) {
+        total->variance_error[c] = 0.0;
+        if (!(total->count > 1.0)) continue;
+        double mean = total->sum[c] / total->count, deviations = 0.0;
+        for (uint32_t b = 0; b < PILOT_BLOCKS; ++b) {
+            const pilot_sums *block = &blocks[b * stride];
+            deviations += block->sum_squares[c] - 2.0 * mean * block->sum[c] + mean * mean * block->count;
+        }
+        double variance = deviations / total->count, spread = 0.0;
+        for (uint32_t b = 0; b < PILOT_BLOCKS; ++b) {
+            const pilot_sums *block = &blocks[b * stride];
+            double own = block->sum_squares[c] - 2.0 * mean * block->sum[c] + mean * mean * block->count;
+            double off = own - variance * block->count; /* n_b (y_b - v) */
+            spread += off * off;
+        }
+        total->variance_error[c] = sqrt(spread) / total->count;
+    }
+}
+
+/* Runs blocks first_block to end_block - 1 of the pilot for `candidates` on the bake's threads,
+ * into run->block_sums. 0 done, 1 stopped (cancel or time). */
+static int run_blocks(pilot_run *run, const int *candidates, int candidate_count, uint32_t first_block,
+                      uint32_t end_block)
+{
+    run->candidates = candidates;
+    run->candidate_count = candidate_count;
+    run->end_block = end_block;
+    atomic_store(&run->next_block, first_block);
+    dwvu_parallel_run(run->bake->threads < 64u ? run->bake->threads : 64u, pilot_worker, run);
+    return atomic_load(&run->stopped) ? 1 : 0;
+}
+
+/* sums ([candidate][mesh]) = the totals of every block run so far, added in block order. */
+static void merge_blocks(const pilot_run *run, pilot_sums *sums)
+{
+    size_t per_block = PILOT_CANDIDATES * (size_t)run->meshes;
+    for (size_t k = 0; k < per_block; ++k) sums[k] = (pilot_sums){0};
     for (uint32_t block = 0; block < PILOT_BLOCKS; ++block)
         for (size_t k = 0; k < per_block; ++k) {
-            const pilot_sums *b = &run.block_sums[block * per_block + k];
+            const pilot_sums *b = &run->block_sums[block * per_block + k];
             sums[k].count += b->count;
             for (int c = 0; c < 3; ++c) {
                 sums[k].sum[c] += b->sum[c];
@@ -252,8 +298,7 @@ static int run_pilot(dwvb_bake *bake, const dwvb_shader *shaders, const int *can
             sums[k].cost += b->cost;
             for (int c = 0; c < 3; ++c) sums[k].channel_cost[c] += b->channel_cost[c];
         }
-    free(run.block_sums);
-    return atomic_load(&run.stopped) ? 1 : 0;
+    for (size_t k = 0; k < per_block; ++k) block_spread(&sums[k], run->block_sums + k, per_block);
 }
 
 /* A candidate's variance x cost per sample that saw the mesh; the variance is the three channels'
@@ -266,13 +311,16 @@ static int run_pilot(dwvb_bake *bake, const dwvb_shader *shaders, const int *can
  * its walks' cost t_c by n; the rest of a sample's cost is shared. A channel whose walks are cheap
  * and noisy gets more of them: the back-lit slab's red, 1.3 mean free paths thick, against its
  * blue, 5 (docs/speed.md). Fewer than one walk per sample would cost the channel's squared mean
- * on top of its variance, more than it saves. */
-static double candidate_work(const pilot_sums *p, const dwvb_material *material, int channel_walks, uint8_t counts[3])
+ * on top of its variance, more than it saves. Each channel's variance is taken `confidence`
+ * standard errors (variance_error) above its estimate (below, if negative; at least 0). */
+static double candidate_work(const pilot_sums *p, const dwvb_material *material, int channel_walks, double confidence,
+                             uint8_t counts[3])
 {
     double variance[3], walk_cost[3], shared_cost = p->cost / p->count;
     for (int c = 0; c < 3; ++c) {
         double mean = p->sum[c] / p->count;
-        variance[c] = fmax(p->sum_squares[c] / p->count - mean * mean, 0.0) * p->count / (p->count - 1.0);
+        variance[c] = fmax(fmax(p->sum_squares[c] / p->count - mean * mean, 0.0) * p->count / (p->count - 1.0) +
+                               confidence * p->variance_error[c], 0.0);
         walk_cost[c] = p->channel_cost[c] / p->count;
         shared_cost -= walk_cost[c];
         counts[c] = 1u;
@@ -314,6 +362,42 @@ static double tail_share(const pilot_sums *p)
     return share;
 }
 
+/* The candidates still in the running after the first PILOT_FIRST_BLOCKS blocks (`sums`), kept in
+ * their order in `candidates`; returns their count. A candidate drops out where, on every deciding
+ * mesh the first blocks saw often enough (their share of PILOT_MESH_MIN), its variance x cost with
+ * the variance PILOT_CONFIDENCE standard errors below its estimate is above the best candidate's
+ * with the variance as many above (a confidence bound on each side: successive elimination, Even-Dar,
+ * Mannor and Mansour 2006, "Action elimination and stopping conditions for the multi-armed bandit
+ * and reinforcement learning problems"). The rest of the pilot then runs only the candidates left:
+ * on the benchmark's scenes the pilot had run all eight on as many samples, up to half the bake's
+ * samples again at 32 spp (docs/speed.md). */
+static int pilot_survivors(const dwvb_bake *bake, const pilot_sums *sums, const int *trial_walks, int *candidates,
+                           int candidate_count)
+{
+    const dwvb_scene *scene = bake->scene;
+    uint32_t meshes = scene->mesh_count;
+    int keep[PILOT_CANDIDATES] = {0}, seen = 0;
+    for (uint32_t m = 0; m < meshes; ++m) {
+        double seen_enough = PILOT_MESH_MIN * PILOT_FIRST_BLOCKS / PILOT_BLOCKS;
+        if (!bake->auto_choice[m] || sums[(size_t)candidates[0] * meshes + m].count < seen_enough) continue;
+        const dwvb_material *material = &scene->shading[scene->meshes[m].material_id];
+        double low[PILOT_CANDIDATES], best_high = INFINITY;
+        for (int k = 0; k < candidate_count; ++k) {
+            size_t slot = (size_t)candidates[k] * meshes + m;
+            uint8_t counts[3];
+            low[k] = candidate_work(&sums[slot], material, trial_walks[slot], -PILOT_CONFIDENCE, counts);
+            best_high = fmin(best_high, candidate_work(&sums[slot], material, trial_walks[slot], PILOT_CONFIDENCE, counts));
+        }
+        for (int k = 0; k < candidate_count; ++k) keep[k] |= !(low[k] > best_high);
+        seen = 1;
+    }
+    if (!seen) return candidate_count; /* nothing to go by: all stay */
+    int left = 0;
+    for (int k = 0; k < candidate_count; ++k)
+        if (keep[k]) candidates[left++] = candidates[k];
+    return left;
+}
+
 int dwvb_pilot_choose(dwvb_bake *bake)
 {
     const dwvb_scene *scene = bake->scene;
@@ -329,7 +413,7 @@ int dwvb_pilot_choose(dwvb_bake *bake)
     if (budget < PILOT_MIN) return 0;
     uint32_t n = budget < PILOT_MAX ? (uint32_t)budget : PILOT_MAX;
     /* Which forms run: the option's, or both where some deciding mesh has channels that differ. */
-    int candidates[PILOT_CANDIDATES], candidate_count = 0;
+    int candidates[PILOT_CANDIDATES], candidate_count = 0, ran[PILOT_CANDIDATES], ran_count = 0;
     int shared = bake->options.channel_walks != DWV_CHANNEL_WALKS_SEPARATE || !separable;
     int separate = separable && bake->options.channel_walks != DWV_CHANNEL_WALKS_SHARED;
     /* The sheet walks only where some deciding mesh has a lit side to aim at (else they are
@@ -344,6 +428,7 @@ int dwvb_pilot_choose(dwvb_bake *bake)
     int *trial_walks = malloc(slots * sizeof *trial_walks);
     pilot_sums *sums = calloc(slots, sizeof *sums); /* [candidate][mesh] */
     int stopped = -1;
+    pilot_run run = {.bake = bake, .samples = n, .meshes = meshes, .block_sums = NULL};
     if (!trial || !trial_channels || !trial_closest || !trial_walks || !sums) goto done;
     dwvb_shader shaders[PILOT_CANDIDATES];
     for (int k = 0; k < candidate_count; ++k) {
@@ -369,8 +454,23 @@ int dwvb_pilot_choose(dwvb_bake *bake)
         shaders[candidate].channel_walks = &trial_walks[base];
         shaders[candidate].needs_closest = &trial_closest[base];
     }
-    stopped = run_pilot(bake, shaders, candidates, candidate_count, n, sums);
+    run.shaders = shaders;
+    run.block_sums = calloc(PILOT_BLOCKS * slots, sizeof(pilot_sums));
+    if (!run.block_sums) goto done;
+    atomic_init(&run.next_block, 0u);
+    atomic_init(&run.stopped, 0);
+    /* First every candidate on PILOT_FIRST_BLOCKS of the blocks, then the rest of the blocks for
+     * those still in the running (pilot_survivors). */
+    stopped = run_blocks(&run, candidates, candidate_count, 0u, PILOT_FIRST_BLOCKS);
     if (stopped == 0) {
+        merge_blocks(&run, sums);
+        for (int k = 0; k < candidate_count; ++k) ran[k] = candidates[k];
+        ran_count = candidate_count;
+        candidate_count = pilot_survivors(bake, sums, trial_walks, candidates, candidate_count);
+        stopped = run_blocks(&run, candidates, candidate_count, PILOT_FIRST_BLOCKS, PILOT_BLOCKS);
+    }
+    if (stopped == 0) {
+        merge_blocks(&run, sums);
         for (uint32_t m = 0; m < meshes; ++m) {
             /* Every candidate traced the same camera rays, so each saw the mesh equally often. */
             if (!bake->auto_choice[m] || sums[(size_t)candidates[0] * meshes + m].count < PILOT_MESH_MIN) continue;
@@ -381,15 +481,16 @@ int dwvb_pilot_choose(dwvb_bake *bake)
             int best = candidates[0];
             double best_work = INFINITY;
             uint8_t best_counts[3] = {1u, 1u, 1u};
-            /* The tail test (PILOT_TAIL_SHARE): classical's share, the smallest of its forms run */
+            /* The tail test (PILOT_TAIL_SHARE): classical's share, the smallest of its forms run
+             * (on the first blocks only where it dropped out) */
             double classical_share = INFINITY;
-            for (int k = 0; k < candidate_count; ++k)
-                if (candidates[k] % PILOT_TECHNIQUES == PILOT_CLASSICAL)
-                    classical_share = fmin(classical_share, tail_share(&sums[(size_t)candidates[k] * meshes + m]));
+            for (int k = 0; k < ran_count; ++k)
+                if (ran[k] % PILOT_TECHNIQUES == PILOT_CLASSICAL)
+                    classical_share = fmin(classical_share, tail_share(&sums[(size_t)ran[k] * meshes + m]));
             for (int k = 0; k < candidate_count; ++k) {
                 const pilot_sums *p = &sums[(size_t)candidates[k] * meshes + m];
                 uint8_t counts[3];
-                double work = candidate_work(p, material, trial_walks[(size_t)candidates[k] * meshes + m], counts);
+                double work = candidate_work(p, material, trial_walks[(size_t)candidates[k] * meshes + m], 0.0, counts);
                 double share = tail_share(p);
                 int tailed = candidates[k] % PILOT_TECHNIQUES != PILOT_CLASSICAL && share > PILOT_TAIL_SHARE &&
                              share > PILOT_TAIL_RATIO * classical_share;
@@ -409,6 +510,7 @@ int dwvb_pilot_choose(dwvb_bake *bake)
         dwvb_bake_update_features(bake);
     }
 done:
+    free(run.block_sums);
     free(trial);
     free(trial_channels);
     free(trial_closest);

@@ -1,0 +1,113 @@
+#!/usr/bin/env python3
+"""What technique auto picks on the benchmark scenes (tools/benchmark_scenes.py), and its
+efficiency against each fixed technique, without Blender:
+
+    PYTHONPATH=python_shim python3 tools/auto_pick_report.py --size 48 --spp 32 --seeds 4 [--scenes a,b]
+
+Every scene is baked (one thread, through the shim) with auto and with each fixed technique the
+pilot chooses among (classical, backward, incident, sheet; channel walks shared and separate), at
+seeds 1..N. The variance per sample is the mean over pixels and RGB of (a - b)^2 / 2 between the
+images of seeds 2k-1 and 2k (independent and unbiased, so that is twice the variance of one
+image's pixel), times the samples per pixel; the cost is the CPU time of the bake (the process's,
+around Scene.bake on one thread: the pilot and the passes, not the scene's load), averaged over
+the seeds, so efficiency = 1 / (variance per sample x seconds per sample). Printed: per scene the features of auto's bakes
+(which technique it walked with), each configuration's variance, seconds and efficiency relative
+to the best fixed configuration, as a Markdown table. CPU time moves less with the machine's load
+than wall time, but still some (caches and memory shared with other processes).
+"""
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+sys.path.insert(0, str(HERE.parent / "python_shim"))
+
+import benchmark_scenes  # noqa: E402
+import dwivedi  # noqa: E402
+
+FIXED = [(t, c) for c in ("shared", "separate") for t in ("classical", "backward", "incident", "sheet")]
+
+
+def walked(features):
+    """The technique a bake's features say it walked with (one subsurface mesh)."""
+    names = set(features)
+    kind = ("sheet" if "sheet" in names else "mixture" if {"incident_patches", "closest_point"} <= names
+            else "incident" if "incident_patches" in names
+            else "closest" if "closest_point" in names else "backward" if "guided" in names else "classical")
+    return kind + (" separate" if "channel_walks" in names else " shared")
+
+
+def measure(scene, base, technique, channel_walks, seeds):
+    images, seconds, features = [], 0.0, set()
+    for seed in range(1, seeds + 1):
+        settings = dataclasses.replace(base, technique=technique, channel_walks=channel_walks, seed=seed, threads=1,
+                                       time_limit=0.0, target_error=0.0)
+        start = time.process_time()
+        image = scene.bake(settings)
+        seconds += time.process_time() - start
+        try:
+            rgba = image.pixels()
+            images.append([v for i, v in enumerate(rgba) if i % 4 != 3])
+            features.add(walked(image.stats.features))
+        finally:
+            image.close()
+    pairs = [(images[k], images[k + 1]) for k in range(0, len(images) - 1, 2)]
+    variance = sum(sum((a - b) ** 2 for a, b in zip(x, y)) / (2.0 * len(x)) for x, y in pairs) / len(pairs)
+    return variance * base.samples, seconds / seeds / base.samples, sorted(features)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--size", type=int, default=48)
+    parser.add_argument("--spp", type=int, default=32)
+    parser.add_argument("--seeds", type=int, default=4, help="an even number: seed pairs (1, 2), (3, 4), ...")
+    parser.add_argument("--scenes", default=",".join(n for n in benchmark_scenes.NAMES if n != "marble"),
+                        help="comma-separated (default: the set but the marble, whose bakes take 20x the others')")
+    parser.add_argument("--json", type=Path, help="also write the figures here")
+    parser.add_argument("--fixed-from", type=Path, metavar="JSON",
+                        help="take the fixed techniques' figures from an earlier run's --json (bake auto only)")
+    args = parser.parse_args(argv)
+    if args.seeds < 2 or args.seeds % 2:
+        parser.error("--seeds must be even and at least 2")
+    rows, figures = [], {}
+    with tempfile.TemporaryDirectory() as folder:
+        for name in args.scenes.split(","):
+            path = Path(folder) / f"{name}.json"
+            path.write_text(json.dumps(benchmark_scenes.scene_json(name, args.size, args.spp)))
+            scene = dwivedi.Scene.load(str(path))
+            try:
+                base = dataclasses.replace(scene.settings, width=args.size, height=args.size, samples=args.spp)
+                if args.fixed_from:
+                    earlier = json.loads(args.fixed_from.read_text())[name]
+                    found = {key: (f["variance_per_sample"], f["seconds_per_sample"], f["walked"])
+                             for key, f in earlier.items() if key != "auto"}
+                else:
+                    found = {f"{t} {c}": measure(scene, base, t, c, args.seeds) for t, c in FIXED}
+                found["auto"] = measure(scene, base, "auto", "auto", args.seeds)
+            finally:
+                scene.close()
+            best = max((1.0 / (v * s), key) for key, (v, s, _) in found.items() if key != "auto")
+            figures[name] = {key: {"variance_per_sample": v, "seconds_per_sample": s, "walked": f}
+                             for key, (v, s, f) in found.items()}
+            for key, (v, s, f) in found.items():
+                rows.append(f"| {name} | {key} | {', '.join(f)} | {v:.4g} | {1e3 * s:.3g} | "
+                            f"{1.0 / (v * s) / best[0]:.2f} |")
+            print(f"{name}: best fixed {best[1]}; auto walked {', '.join(found['auto'][2])}, efficiency "
+                  f"{1.0 / (found['auto'][0] * found['auto'][1]) / best[0]:.2f} of it", flush=True)
+    print("\n| scene | configuration | walked | variance per sample | ms per sample | efficiency / best fixed |")
+    print("|---|---|---|---|---|---|")
+    print("\n".join(rows))
+    if args.json:
+        args.json.write_text(json.dumps(figures, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
