@@ -818,16 +818,19 @@ typedef int32_t dwv_bump_shadowing_t;
 enum {
     DWV_BUMP_SHADOWING_NONE = 0, /* the mapped normal as it is */
     /* Blender 3.x: the closures' normal is kept such that the view's mirror reflection stays above
-     * the surface (ensure_valid_reflection, at the camera's hit), and diffuse lobes are multiplied
+     * the surface (ensure_valid_reflection, at the camera's hit; at a walk's exit with the walk's
+     * last direction as the view), and diffuse lobes are multiplied
      * by Chiang, Li and Burley 2019's term ("Taming the Shadow Terminator", bsdf.h
      * bump_shadowing_term): G = -g^3 + g^2 + g, g = (N_s . L) / ((N . L)(N_s . N)) clamped (1
      * from g >= 1, 0 below 0), N the mapped normal, N_s the smooth one; at the entry point and at
      * a walk's exit. */
     DWV_BUMP_SHADOWING_CHIANG2019 = 1,
-    /* Blender 4.x: Chiang 2019's term as above, without ensure_valid_reflection (4.x applies it
-     * to specular closures only; dwivedi's specular layer then uses the mapped normal as is). */
+    /* Blender 4.x: Chiang 2019's term as above; the diffuse lobe takes the mapped normal as is,
+     * the specular layer and the subsurface entry and exit the normal kept valid for reflection
+     * as above (4.x's maybe_ensure_valid_specular_reflection: specular closures and the BSSRDF). */
     DWV_BUMP_SHADOWING_CHIANG2019_MAPPED = 2,
-    /* Blender 5.x (measured against 5.2): the mapped normal as is; diffuse lobes are 0 where L is
+    /* Blender 5.x (measured against 5.2): normals as 4.x (the diffuse lobe's the mapped one as
+     * is, the specular layer's and the subsurface's kept valid for reflection); diffuse lobes are 0 where L is
      * on the other side of the smooth surface than N says ((N_s . L)(N_s . N)(N . L) < 0), else
      * times Conty Estevez, Lecocq and Stein 2019's microfacet shadowing ("A Microfacet-Based
      * Shadowing Function to Solve the Bump Terminator Problem"): the GGX G1 =
