@@ -429,6 +429,15 @@ def area_power_scale(version: Tuple[int, ...]) -> float:
     return 4.0 / math.pi if tuple(version) >= (4, 0, 0) else 1.0
 
 
+def point_shape(data: Any, version: Tuple[int, ...]) -> str:
+    """The shape of a point or spot light: Cycles 4.0 onward makes it a sphere unless Soft Falloff
+    is on (Blender's default; its sync: is_sphere = !use_soft_falloff), which keeps 3.x's disc
+    facing the shaded point."""
+    if tuple(version) < (4, 0, 0):
+        return "disc"
+    return "disc" if getattr(data, "use_soft_falloff", True) else "sphere"
+
+
 def _light(obj: Any, matrix: Any, dwivedi: Any, warnings: List[str]) -> Any:
     data = obj.data
     node_color, node_strength = _light_emission(obj, warnings)
@@ -440,7 +449,8 @@ def _light(obj: Any, matrix: Any, dwivedi: Any, warnings: List[str]) -> Any:
         direction = rot @ _vector((0.0, 0.0, -1.0))
         return dwivedi.SunLight(direction=tuple(direction), strength=energy, color=color, angle=data.angle)
     if data.type == 'POINT':
-        return dwivedi.PointLight(position=tuple(location), power=energy, color=color, radius=data.shadow_soft_size)
+        return dwivedi.PointLight(position=tuple(location), power=energy, color=color, radius=data.shadow_soft_size,
+                                  shape=point_shape(data, bpy.app.version))
     if data.type == 'SPOT':
         if abs(scale[0] - scale[1]) > 1e-6 * max(abs(scale[0]), abs(scale[1]), 1e-30):
             warnings.append(f"light '{obj.name}': the spot's cone is round in dwivedi (the object's unequal x and "
@@ -448,7 +458,7 @@ def _light(obj: Any, matrix: Any, dwivedi: Any, warnings: List[str]) -> Any:
         direction = rot @ _vector((0.0, 0.0, -1.0))
         return dwivedi.SpotLight(position=tuple(location), direction=tuple(direction), power=energy, color=color,
                                  radius=data.shadow_soft_size, spot_size=data.spot_size, spot_blend=data.spot_blend,
-                                 falloff=spot_falloff(bpy.app.version))
+                                 falloff=spot_falloff(bpy.app.version), shape=point_shape(data, bpy.app.version))
     if data.type == 'AREA':
         sx = data.size * abs(scale[0])
         sy = (data.size_y if data.shape in {'RECTANGLE', 'ELLIPSE'} else data.size) * abs(scale[1])
