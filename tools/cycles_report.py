@@ -374,7 +374,8 @@ def cycles_section(quick: bool, blender: str, size: int, scenes: Sequence[str], 
             (stage / "scenes").mkdir()
             shutil.copy2(scenes_dir / "scenes.py", stage / "scenes" / "scenes.py")
             (stage / "tools").mkdir()
-            shutil.copy2(SOURCE_DIR / "tools" / "benchmark_scenes.py", stage / "tools" / "benchmark_scenes.py")
+            for tool in ("benchmark_scenes.py", "make_example_meshes.py"):  # the second makes the first's spheres
+                shutil.copy2(SOURCE_DIR / "tools" / tool, stage / "tools" / tool)
             shutil.copy2(library, stage / "libdwivedi.so.1")
             paths = {"shim": stage / "shim", "addon": stage / "addon", "scenes": stage / "scenes",
                      "tools": stage / "tools"}
