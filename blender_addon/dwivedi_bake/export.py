@@ -16,7 +16,7 @@ from typing import Any, Dict, List, Optional, Tuple
 
 import bpy
 
-from . import evaluate, textures
+from . import evaluate, gather, textures
 
 
 class ExportError(Exception):
@@ -279,37 +279,27 @@ def _rows(matrix: Any) -> List[float]:
 
 def _mesh_arrays(mesh: Any, want_uvs: bool, texture_maps: Optional[List[Optional[str]]] = None) -> Dict[str, Any]:
     """Positions, triangle indices, per-corner UVs, normals and per-triangle material indices of
-    an evaluated mesh, in float32 / uint32 arrays (foreach_get fills them without Python loops).
-    texture_maps (a list, maybe empty, of the UV maps normal maps read; None: layer 0) asks for
-    all UV maps by name and those maps' tangents, for textured materials.
+    an evaluated mesh, in float32 / uint32 buffers: foreach_get fills them and gather.py picks
+    the corners' values, without a Python loop per element. texture_maps (a list, maybe empty, of
+    the UV maps normal maps read; None: layer 0) asks for all UV maps by name and those maps'
+    tangents, for textured materials.
 
     Smooth and flat faces both come out right: all-flat meshes share vertices without normals
-    (flat shading); otherwise every triangle corner gets its own vertex with Blender's corner
-    (split) normal, which is the face normal on flat faces and honours sharp edges."""
+    (flat shading); meshes whose every corner normal is its vertex's normal (all faces smooth, no
+    sharp edges or custom normals: _normals_domain 'POINT') share vertices with those normals;
+    otherwise every triangle corner gets its own vertex with Blender's corner (split) normal,
+    which is the face normal on flat faces and honours sharp edges."""
     mesh.calc_loop_triangles()
     tris = mesh.loop_triangles
     t = len(tris)
-    loops = array.array("i", [0]) * (3 * t)
+    loops = array.array("i", bytes(12 * t))
     tris.foreach_get("loops", loops)
-    material_index = array.array("i", [0]) * t
+    material_index = array.array("i", bytes(4 * t))
     tris.foreach_get("material_index", material_index)
     out: Dict[str, Any] = {"triangles": t, "material_index": material_index}
 
-    smooth = array.array("b", [0]) * len(mesh.polygons)
-    try:
-        mesh.polygons.foreach_get("use_smooth", smooth)
-    except (AttributeError, TypeError, RuntimeError):
-        smooth = array.array("b")
-    any_smooth = any(smooth)
-
     if want_uvs and mesh.uv_layers.active is not None:
-        loop_uv = array.array("f", [0.0]) * (2 * len(mesh.loops))
-        mesh.uv_layers.active.data.foreach_get("uv", loop_uv)
-        uvs = array.array("f", [0.0]) * (6 * t)
-        for c, loop in enumerate(loops):
-            uvs[2 * c] = loop_uv[2 * loop]
-            uvs[2 * c + 1] = loop_uv[2 * loop + 1]
-        out["uvs"] = uvs
+        out["uvs"] = gather.corner_uvs(mesh, mesh.uv_layers.active, loops)
     else:
         out["uvs"] = None
     out["layers"] = None
@@ -321,46 +311,68 @@ def _mesh_arrays(mesh: Any, want_uvs: bool, texture_maps: Optional[List[Optional
         out["layers"] = textures.uv_layers(mesh, loops, first, texture_maps)
         out["uvs"] = out["layers"]["uvs"]
 
-    vertex_co = array.array("f", [0.0]) * (3 * len(mesh.vertices))
+    vertex_co = array.array("f", bytes(12 * len(mesh.vertices)))
     mesh.vertices.foreach_get("co", vertex_co)
-    if not any_smooth:
-        indices = array.array("I", [0]) * (3 * t)
+    domain = _normals_domain(mesh)
+    if domain != 'CORNER':
+        indices = array.array("I", bytes(12 * t))
         tris.foreach_get("vertices", indices)
-        out.update(positions=vertex_co, indices=indices, normals=None)
+        out.update(positions=vertex_co, indices=indices,
+                   normals=_vertex_normals(mesh) if domain == 'POINT' else None)
         return out
 
     if hasattr(mesh, "calc_normals_split"):  # Blender < 4.1 computes corner normals on demand
         mesh.calc_normals_split()
-    corner_normals = array.array("f", [0.0]) * (9 * t)
+    corner_normals = array.array("f", bytes(36 * t))
     tris.foreach_get("split_normals", corner_normals)
-    corner_vertices = array.array("I", [0]) * (3 * t)
+    corner_vertices = array.array("I", bytes(12 * t))
     tris.foreach_get("vertices", corner_vertices)
-    positions = array.array("f", [0.0]) * (9 * t)
-    for c, v in enumerate(corner_vertices):
-        positions[3 * c:3 * c + 3] = vertex_co[3 * v:3 * v + 3]
-    out.update(positions=positions, indices=array.array("I", range(3 * t)), normals=corner_normals)
+    out.update(positions=gather.rows(vertex_co, 3, corner_vertices), indices=array.array("I", range(3 * t)),
+               normals=corner_normals)
     return out
 
 
-def _subset(arrays: Dict[str, Any], keep: List[int]) -> Dict[str, Any]:
+def _normals_domain(mesh: Any) -> str:
+    """Where the mesh's normals live, as Blender 4.1+'s Mesh.normals_domain says: 'FACE' (every
+    face flat), 'POINT' (every corner normal is its vertex's normal: all faces smooth, no sharp
+    edges, no custom normals) or 'CORNER'. Before 4.1 from the same rules: 3.x / 4.0 Auto Smooth
+    or custom normals make corner normals (calc_normals_split), otherwise a smooth face's corner
+    takes its vertex's normal and a flat face's its face normal."""
+    domain = getattr(mesh, "normals_domain", None)
+    if domain is not None:
+        return domain
+    smooth = array.array("b", bytes(len(mesh.polygons)))
+    mesh.polygons.foreach_get("use_smooth", smooth)
+    if not any(smooth):
+        return 'FACE'
+    if getattr(mesh, "use_auto_smooth", False) or mesh.has_custom_normals or not all(smooth):
+        return 'CORNER'
+    return 'POINT'
+
+
+def _vertex_normals(mesh: Any) -> Any:
+    """The mesh's vertex normals (Mesh.vertex_normals from 3.5 on, MeshVertex.normal before)."""
+    normals = array.array("f", bytes(12 * len(mesh.vertices)))
+    if hasattr(mesh, "vertex_normals"):
+        mesh.vertex_normals.foreach_get("vector", normals)
+    else:
+        mesh.vertices.foreach_get("normal", normals)
+    return normals
+
+
+def _subset(arrays: Dict[str, Any], keep: Any) -> Dict[str, Any]:
     """The triangles `keep` of a split-corner or shared-vertex mesh, as a mesh of their own
     (vertices are kept whole: unreferenced ones cost nothing to the library)."""
-    indices = array.array("I", [0]) * (3 * len(keep))
-    uvs = None if arrays["uvs"] is None else array.array("f", [0.0]) * (6 * len(keep))
-    for n, tri in enumerate(keep):
-        indices[3 * n:3 * n + 3] = arrays["indices"][3 * tri:3 * tri + 3]
-        if uvs is not None:
-            uvs[6 * n:6 * n + 6] = arrays["uvs"][6 * tri:6 * tri + 6]
+    def pick(values: Any, group: int) -> Any:
+        return gather.rows(values, group, keep)
+
+    uvs = None if arrays["uvs"] is None else pick(arrays["uvs"], 6)
     layers = arrays.get("layers")
     if layers is not None:
-        def pick(values: Any, group: int) -> Any:
-            out = array.array("f", [0.0]) * (group * len(keep))
-            for n, tri in enumerate(keep):
-                out[group * n:group * n + group] = values[group * tri:group * tri + group]
-            return out
         layers = {**layers, "uvs": uvs, "uv_layers": [(name, pick(v, 6)) for name, v in layers["uv_layers"]],
                   "tangents": {name: pick(v, 12) for name, v in layers["tangents"].items()}}
-    return {**arrays, "indices": indices, "uvs": uvs, "triangles": len(keep), "layers": layers}
+    return {**arrays, "indices": gather.rows(arrays["indices"], 3, keep, "I"), "uvs": uvs, "triangles": len(keep),
+            "layers": layers}
 
 
 def _layer_arguments(arrays: Dict[str, Any]) -> Dict[str, Any]:
@@ -853,9 +865,7 @@ def _export(context: Any, settings: Any, dwivedi: Any, out: Exported) -> Exporte
                 if arrays["layers"] is not None:
                     warnings.extend(arrays["layers"]["warnings"])
                 terminator = _shadow_terminator_geometry_offset(obj)
-                by_material: Dict[int, List[int]] = {}
-                for tri, index in enumerate(arrays["material_index"]):
-                    by_material.setdefault(index, []).append(tri)
+                by_material = dict(gather.groups(arrays["material_index"]))
                 transform = _rows(matrix)
                 if is_uv_target:
                     if arrays["uvs"] is None:
