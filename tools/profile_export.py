@@ -5,7 +5,8 @@
 
 Builds N subdivided Suzannes (Subdivision Surface at level L, smooth shading, two materials on
 every other one, a sun, a camera, a grey world), then runs the add-on's Bake operator K times
-(default 2: the second bake of an unchanged scene shows what the export cache saves) and prints
+(default 4: cold; unchanged; after the sun's strength changed; after one object's modifier
+changed: what the export cache, export.ExportCache, saves each time) and prints
 the seconds of each stage: Blender's own depsgraph evaluation, the export's parts (meshes read
 from Blender, their arrays, materials, lights, world, camera, add_mesh), the library's scene
 commit, the bake, and writing and loading the result. --profile FILE writes cProfile's listing
@@ -41,7 +42,8 @@ def arguments():
     parser.add_argument("--level", type=int, default=3, help="their Subdivision Surface level (default 3)")
     parser.add_argument("--size", type=int, default=32, help="the bake's width and height (default 32)")
     parser.add_argument("--samples", type=int, default=1, help="samples per pixel (default 1)")
-    parser.add_argument("--repeat", type=int, default=2, help="bakes in a row (default 2)")
+    parser.add_argument("--repeat", type=int, default=4, help="bakes in a row (default 4: cold, unchanged, a light "
+                        "changed, a modifier changed)")
     parser.add_argument("--profile", type=Path, default=None, help="cProfile listing of the first export")
     return parser.parse_args(argv)
 
@@ -142,7 +144,18 @@ def main():
     print(f"profile_export: Blender {bpy.app.version_string}, {args.objects} Suzannes at level {args.level}: "
           f"{triangles} triangles; depsgraph evaluation {evaluation:.3f} s; bake {args.size} x {args.size}, "
           f"{args.samples} spp, 2 threads")
+    changes = [("cold", None), ("unchanged", None),
+               ("sun changed (meshes kept, the scene committed again)",
+                lambda: setattr(bpy.data.lights["sun"], "energy", 2.0)),
+               ("one object's modifier changed (that mesh read again)",
+                lambda: setattr(bpy.data.objects["Suzanne"].modifiers[0], "levels", args.level))]
     for turn in range(args.repeat):
+        label, change = changes[min(turn, len(changes) - 1)]
+        if change is not None:
+            if turn == 3:  # the modifier's viewport level: its render level stays, so the bake is the same size
+                bpy.data.objects["Suzanne"].modifiers[0].levels = max(0, args.level - 1)
+            else:
+                change()
         stages = Stages()
         profile = cProfile.Profile() if args.profile is not None and turn == 0 else None
         start = time.perf_counter()
@@ -160,7 +173,7 @@ def main():
                                                                  "bake (library)", "evaluated inputs"))
         rest = seconds.get("export_scene", 0.0) - inner - seconds.get("scene commit (library)", 0.0) \
             - seconds.get("evaluated inputs", 0.0)
-        print(f"bake {turn + 1}: whole operator {whole:.3f} s")
+        print(f"bake {turn + 1} ({label}): whole operator {whole:.3f} s")
         for label in ("evaluated inputs", "mesh arrays", "materials", "texture uses", "lights", "world", "camera",
                       "add_mesh", "scene commit (library)"):
             print(f"  {label:40s} {seconds.get(label, 0.0):8.3f} s")
