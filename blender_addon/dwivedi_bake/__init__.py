@@ -567,11 +567,11 @@ class _Job:
         try:
             stats = image.stats
             if self.target == 'CAMERA':
-                self._write_files(image)
-                self.result = file_image(self.exr)
+                export.CACHE.own_updates(lambda: self._write_files(image))
+                self.result = export.CACHE.own_updates(lambda: file_image(self.exr))
                 where = self.exr
             else:
-                where = write_uv_image(image, self.uv_image, self.exr, self.dwivedi)
+                where = export.CACHE.own_updates(lambda: write_uv_image(image, self.uv_image, self.exr, self.dwivedi))
                 self.result = self.uv_image
         finally:
             image.close()

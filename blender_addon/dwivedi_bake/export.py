@@ -132,6 +132,20 @@ class ExportCache:
         out.owned, out.reused = False, True
         return out
 
+    def own_updates(self, work: Any) -> Any:
+        """Runs work() (writing a bake's result: a render setting set and put back for the PNG,
+        images loaded) and returns what it returns; the depsgraph updates it makes are the
+        add-on's own and leave the kept scene valid, if nothing else changed before them.
+        work() runs on Blender's main thread, so no edit of the artist's comes in between."""
+        bpy.context.evaluated_depsgraph_get()  # the updates before: the artist's, counted
+        before = self.generation
+        try:
+            return work()
+        finally:
+            bpy.context.evaluated_depsgraph_get()
+            if self._scene is not None and self._scene[1] == before:
+                self._scene = (self._scene[0], self.generation, self._scene[2])
+
     def keep_scene(self, key: Any, generation: int, exported: Exported) -> None:
         """Keeps `exported` (which the cache now owns: its scene is closed by the cache)."""
         if self._scene is not None and self._scene[2].scene is not exported.scene:

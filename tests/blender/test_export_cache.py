@@ -29,6 +29,13 @@ import harness  # noqa: E402
 WORK = harness.install_addon()
 
 
+def world_color(world, color):
+    if world.use_nodes:
+        world.node_tree.nodes["Background"].inputs["Color"].default_value = (*color, 1.0)
+    else:
+        world.color = color
+
+
 def build_scene():
     """Two Suzannes (the second subdivided, with two materials), a linked duplicate of a third,
     a sun, a camera, a grey world; 16 x 16 pixels."""
@@ -74,8 +81,8 @@ def build_scene():
     scene.collection.objects.link(camera)
     scene.camera = camera
     world = bpy.data.worlds.get("grey") or bpy.data.worlds.new("grey")
-    world.use_nodes = False
-    world.color = (0.1, 0.1, 0.1)
+    world.use_nodes = False  # Blender 5.x: worlds always use their nodes
+    world_color(world, (0.1, 0.1, 0.1))
     scene.world = world
     scene.render.resolution_x = scene.render.resolution_y = 16
     scene.render.resolution_percentage = 100
@@ -217,7 +224,7 @@ class CacheTest(harness.unittest.TestCase):
         self.check_change(lambda: setattr(self.scene.objects["sun"], "rotation_euler", (1.2, 0.0, 0.0)), 0)
 
     def test_world(self):
-        self.check_change(lambda: setattr(self.scene.world, "color", (0.6, 0.6, 0.8)), 0)
+        self.check_change(lambda: world_color(self.scene.world, (0.6, 0.6, 0.8)), 0)
 
     def test_camera(self):
         self.check_change(lambda: setattr(self.scene.camera.data, "lens", 35.0), 0)
