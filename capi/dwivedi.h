@@ -588,11 +588,11 @@ DWV_API dwv_result_t dwv_scene_add_mesh(dwv_scene_t *scene, const dwv_mesh_t *me
 typedef int32_t dwv_light_kind_t;
 enum {
     DWV_LIGHT_SUN = 0,   /* direction, strength (irradiance, W/m^2), angle (angular diameter) */
-    DWV_LIGHT_POINT = 1, /* position, power (W, Blender's convention), radius (a sphere light) */
+    DWV_LIGHT_POINT = 1, /* position, power (W, Blender's convention), radius, point_shape */
     DWV_LIGHT_AREA_RECTANGLE = 2, /* transform, size_x x size_y in its local xy plane, power */
     DWV_LIGHT_AREA_DISK = 3,      /* transform, diameter size_x (size_y for an ellipse), power */
     DWV_LIGHT_SPOT = 4            /* position, direction (of its axis), power, radius, spot_size,
-                                     spot_blend, spot_falloff: a point light within a cone */
+                                     spot_blend, spot_falloff, point_shape: a point light within a cone */
 };
 /* Lights in Blender's units and conventions; an area light emits along its local -z. */
 typedef struct dwv_light_desc_t {
@@ -620,16 +620,34 @@ typedef struct dwv_light_desc_t {
     double spot_blend;    /* spot: [0, 1] (Blender's Spot Blend) */
     int32_t spot_falloff; /* spot: DWV_SPOT_FALLOFF_* */
     uint32_t reserved;    /* 0 */
+    /* Added after the spot fields (issue 18; a caller whose struct_size ends before it gets the
+     * disc). Point and spot lights of radius > 0: DWV_POINT_SHAPE_*. */
+    int32_t point_shape;
+    uint32_t reserved_shape; /* 0 */
 } dwv_light_desc_t;
 typedef int32_t dwv_spot_falloff_t;
 enum {
     DWV_SPOT_FALLOFF_CYCLES3 = 0, /* Blender 3.x: the axis cosine x the smoothstep */
     DWV_SPOT_FALLOFF_CYCLES4 = 1  /* Blender 4.0 onward: the smoothstep alone */
 };
+/* The emitting shape of a point or spot light of radius r > 0; both have the radiance
+ * P c / (4 pi^2 r^2) (times a spot's attenuation), so both give the intensity P c / (4 pi) far
+ * away, and differ near the light: */
+typedef int32_t dwv_point_shape_t;
+enum {
+    /* A disc of radius r about the centre facing the shaded point (Cycles 3.x; 4.0 onward with
+     * the light's Soft Falloff, Blender's default): irradiance P / (4 pi (d^2 + r^2)) facing it
+     * at distance d from the centre. */
+    DWV_POINT_SHAPE_DISC = 0,
+    /* A sphere of radius r (Cycles 4.0 onward without Soft Falloff): P / (4 pi d^2) facing it;
+     * a point inside the sphere sees its radiance from every direction (a spot's without its
+     * attenuation). */
+    DWV_POINT_SHAPE_SPHERE = 1
+};
 #define DWV_LIGHT_DESC_INIT                                                                         \
     {sizeof(dwv_light_desc_t), DWV_LIGHT_SUN, {1.0, 1.0, 1.0}, 1.0, {0.0, 0.0, -1.0}, 0.0,          \
      {0.0, 0.0, 0.0}, 0.0, {1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0}, 1.0, 1.0,   \
-     0.78539816339744830962, 0.15, DWV_SPOT_FALLOFF_CYCLES3, 0u}
+     0.78539816339744830962, 0.15, DWV_SPOT_FALLOFF_CYCLES3, 0u, DWV_POINT_SHAPE_DISC, 0u}
 
 DWV_API dwv_result_t dwv_scene_add_light(dwv_scene_t *scene, const dwv_light_desc_t *light);
 
@@ -836,16 +854,19 @@ typedef int32_t dwv_bump_shadowing_t;
 enum {
     DWV_BUMP_SHADOWING_NONE = 0, /* the mapped normal as it is */
     /* Blender 3.x: the closures' normal is kept such that the view's mirror reflection stays above
-     * the surface (ensure_valid_reflection, at the camera's hit), and diffuse lobes are multiplied
+     * the surface (ensure_valid_reflection, at the camera's hit; at a walk's exit with the walk's
+     * last direction as the view), and diffuse lobes are multiplied
      * by Chiang, Li and Burley 2019's term ("Taming the Shadow Terminator", bsdf.h
      * bump_shadowing_term): G = -g^3 + g^2 + g, g = (N_s . L) / ((N . L)(N_s . N)) clamped (1
      * from g >= 1, 0 below 0), N the mapped normal, N_s the smooth one; at the entry point and at
      * a walk's exit. */
     DWV_BUMP_SHADOWING_CHIANG2019 = 1,
-    /* Blender 4.x: Chiang 2019's term as above, without ensure_valid_reflection (4.x applies it
-     * to specular closures only; dwivedi's specular layer then uses the mapped normal as is). */
+    /* Blender 4.x: Chiang 2019's term as above; the diffuse lobe takes the mapped normal as is,
+     * the specular layer and the subsurface entry and exit the normal kept valid for reflection
+     * as above (4.x's maybe_ensure_valid_specular_reflection: specular closures and the BSSRDF). */
     DWV_BUMP_SHADOWING_CHIANG2019_MAPPED = 2,
-    /* Blender 5.x (measured against 5.2): the mapped normal as is; diffuse lobes are 0 where L is
+    /* Blender 5.x (measured against 5.2): normals as 4.x (the diffuse lobe's the mapped one as
+     * is, the specular layer's and the subsurface's kept valid for reflection); diffuse lobes are 0 where L is
      * on the other side of the smooth surface than N says ((N_s . L)(N_s . N)(N . L) < 0), else
      * times Conty Estevez, Lecocq and Stein 2019's microfacet shadowing ("A Microfacet-Based
      * Shadowing Function to Solve the Bump Terminator Problem"): the GGX G1 =

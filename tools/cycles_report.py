@@ -201,10 +201,44 @@ import json, sys, time, math
 args = json.loads(sys.argv[sys.argv.index("--") + 1])
 sys.path[:0] = [args["shim"], args["addon"], args["scenes"], args["tools"]]
 import bpy, dwivedi, scenes, benchmark_scenes
+import dwivedi_bake
 import dwivedi_bake.export as export
+
+# dwivedi's bakes run through the add-on's operator (bpy.ops.dwivedi.bake), as an artist runs them:
+# export, scene commit, bake, EXR + PNG written and loaded as a Blender image. Its parts are timed
+# on the way through: the export (with the library's scene commit) and the library's bake.
+dwivedi_bake.register()
+parts = {}
+_export_scene, _bake = export.export_scene, dwivedi.bake
+
+def timed_export(*a, **k):
+    t = time.monotonic(); out = _export_scene(*a, **k); parts["export"] = time.monotonic() - t; return out
+
+def timed_bake(*a, **k):
+    image = _bake(*a, **k); parts["bake"] = image.stats.seconds; return image
+
+export.export_scene, dwivedi.bake = timed_export, timed_bake
 
 class Props:  # what export_scene reads of scene.dwivedi_bake
     target = 'CAMERA'; uv_object = None; uv_size = 0
+
+def operator_bake(scene, spp, seed, folder):
+    """The whole bake from the operator; (wall seconds, its parts, RGBA rows from the bottom)."""
+    props = scene.dwivedi_bake
+    props.target = 'CAMERA'; props.samples = spp; props.seed = seed; props.threads = 2
+    props.output_dir = folder; props.load_result = False
+    parts.clear()
+    # Cold, as Cycles renders without Persistent Data: the add-on's export cache (which would make
+    # a bake of the unchanged scene reuse the last one's export and commit) is emptied first.
+    export.CACHE.clear()
+    t = time.monotonic()
+    result = bpy.ops.dwivedi.bake()
+    seconds = time.monotonic() - t
+    if result != {'FINISHED'} or "bake" not in parts:
+        raise RuntimeError(f"the dwivedi operator returned {result}")
+    image = bpy.data.images["Dwivedi Camera"]
+    px = [0.0] * (4 * image.size[0] * image.size[1]); image.pixels.foreach_get(px)
+    return seconds, dict(parts), px
 
 def pixels_of(path):
     image = bpy.data.images.load(path, check_existing=False)
@@ -259,6 +293,7 @@ for name in args["scenes_list"]:
     own_spp = 4 * args["dwivedi_counts"][-1]
     own = dwivedi.bake(exported.scene, width=exported.width, height=exported.height, samples=own_spp, threads=2,
                        seed=1234, **paths)
+    exported.scene.close()
     own_ref = flip(list(own.pixels()), own.width, own.height)
     entry["dwivedi_reference_samples"] = own_spp
     entry["dwivedi_reference_seconds"] = own.stats.seconds
@@ -266,7 +301,11 @@ for name in args["scenes_list"]:
     entry["dwivedi_reference_mean_rgb"] = [sum(own_ref[c::4]) / (len(own_ref) // 4) for c in range(3)]
     # Timings: both renderers take turns, `repeats` rounds, and each count keeps its fastest time
     # (other load on the machine only ever adds time). Seeds are fixed, so every round makes the
-    # same images: the RMSE is taken from the first.
+    # same images: the RMSE is taken from the first. Both sides are timed the same way, as the
+    # whole operator an artist runs (seconds): Cycles' F12 (bpy.ops.render.render with the EXR
+    # written: scene sync, render, file) and dwivedi's Bake (export, commit, bake, EXR + PNG, the
+    # image loaded); each renderer's own part is kept beside it (own_seconds: Cycles' render less a
+    # 1-sample render's time, the scene sync; dwivedi's bake without the export and the files).
     for turn in range(args["repeats"]):
         if turn > 0:
             overhead = min(overhead, cycles(scene, 1, 0, f"{work}/{name}_c1.exr"))
@@ -278,22 +317,24 @@ for name in args["scenes_list"]:
             else:
                 entry["cycles"][i]["render_seconds"] = min(entry["cycles"][i]["render_seconds"], seconds)
         for i, spp in enumerate(args["dwivedi_counts"]):
-            image = dwivedi.bake(exported.scene, width=exported.width, height=exported.height, samples=spp,
-                                 threads=2, seed=7, **paths)
+            seconds, timed, ours = operator_bake(scene, spp, 7, f"{work}/{name}_out")
             if turn == 0:
-                ours = flip(list(image.pixels()), image.width, image.height)
                 n = len(ours) // 4
-                entry["dwivedi"].append({"samples": spp, "seconds": image.stats.seconds, "rmse": rmse(ours, own_ref),
+                entry["dwivedi"].append({"samples": spp, "seconds": seconds, "own_seconds": timed["bake"],
+                                         "export_seconds": timed["export"], "rmse": rmse(ours, own_ref),
                                          "rmse_against_cycles": rmse(ours, ref),
                                          "mean_rgb": [sum(ours[c::4]) / n for c in range(3)]})
             else:
-                entry["dwivedi"][i]["seconds"] = min(entry["dwivedi"][i]["seconds"], image.stats.seconds)
+                point = entry["dwivedi"][i]
+                point["seconds"] = min(point["seconds"], seconds)
+                point["own_seconds"] = min(point["own_seconds"], timed["bake"])
+                point["export_seconds"] = min(point["export_seconds"], timed["export"])
     entry["sync_seconds"] = overhead
     for point in entry["cycles"]:
-        point["seconds"] = max(point["render_seconds"] - overhead, 1e-3)
+        point["seconds"] = point["render_seconds"]
+        point["own_seconds"] = max(point["render_seconds"] - overhead, 1e-3)
     n = len(ref) // 4
     entry["cycles_reference_mean_rgb"] = [sum(ref[c::4]) / n for c in range(3)]
-    exported.scene.close()
     out[name] = entry
     print("scene", name, "done", file=sys.stderr, flush=True)
 with open(args["result"], "w") as f:
@@ -338,7 +379,8 @@ def cycles_section(quick: bool, blender: str, size: int, scenes: Sequence[str], 
             (stage / "scenes").mkdir()
             shutil.copy2(scenes_dir / "scenes.py", stage / "scenes" / "scenes.py")
             (stage / "tools").mkdir()
-            shutil.copy2(SOURCE_DIR / "tools" / "benchmark_scenes.py", stage / "tools" / "benchmark_scenes.py")
+            for tool in ("benchmark_scenes.py", "make_example_meshes.py"):  # the second makes the first's spheres
+                shutil.copy2(SOURCE_DIR / "tools" / tool, stage / "tools" / tool)
             shutil.copy2(library, stage / "libdwivedi.so.1")
             paths = {"shim": stage / "shim", "addon": stage / "addon", "scenes": stage / "scenes",
                      "tools": stage / "tools"}
@@ -506,8 +548,13 @@ def markdown(data: Dict[str, Any], made: List[str]) -> str:
                   "converged image (Cycles and dwivedi each at 4x their largest count, other seeds), so that "
                   "noise is compared with noise; how far the two converged images lie apart is its own column "
                   "(Cycles stops walks at 256 bounces and loses energy where dwivedi does not, "
-                  "docs/cycles_energy_loss.md). Cycles' seconds exclude its scene sync (a 1-sample render's "
-                  "time), dwivedi's are the bake's own (its auto pilot included); both take turns over "
+                  "docs/cycles_energy_loss.md). Both sides are timed the same way, as the whole operator an "
+                  "artist runs: Cycles' F12 (bpy.ops.render.render writing the EXR: scene sync, render, file) "
+                  "and dwivedi's Bake (bpy.ops.dwivedi.bake: the add-on's export and the library's scene commit, "
+                  "the bake with its auto pilot, EXR + PNG written and loaded as a Blender image; the add-on's "
+                  "export cache emptied before each, as Cycles syncs every render without Persistent Data); the speed-up "
+                  "of the renderers' own parts (Cycles' render less a 1-sample render's time, the scene sync; "
+                  "dwivedi's bake without export and files) is the last column. Both take turns over "
                   f"{next(iter(first['scenes'].values())).get('repeats', 1)} timing round(s) and each count "
                   "keeps its fastest time. RMSEs here are the noise alone: the reference's own noise, 1 / (4x) "
                   "of a point's variance at its largest count, is taken out of each (noise_only). Speed-up = "
@@ -522,6 +569,10 @@ def markdown(data: Dict[str, Any], made: List[str]) -> str:
             target = ours_clean[-2]["rmse"]
             entry["speedup_at_rmse"] = {"rmse": target, "cycles_seconds": time_to_rmse(theirs_clean, target),
                                         "dwivedi_seconds": time_to_rmse(ours_clean, target)}
+            if all("own_seconds" in p for p in theirs_clean + ours_clean):  # reports made before it lack it
+                own = [[{**p, "seconds": p["own_seconds"]} for p in side] for side in (theirs_clean, ours_clean)]
+                entry["speedup_at_rmse"]["cycles_own_seconds"] = time_to_rmse(own[0], target)
+                entry["speedup_at_rmse"]["dwivedi_own_seconds"] = time_to_rmse(own[1], target)
         names = list(dict.fromkeys(name for _, name, _ in cycles_entries(data)))
         lines += ["| scene | " + " | ".join(f"Blender {run['blender']} ({where})" for where, run in
                                              data["cycles"].items()) + " |",
@@ -536,26 +587,34 @@ def markdown(data: Dict[str, Any], made: List[str]) -> str:
         for where, run in data["cycles"].items():
             lines += ["", f"### Blender {run['blender']} ({where})", "",
                       "| scene | converged Cycles mean RGB | converged dwivedi mean RGB | RMSE between converged | "
-                      "target RMSE | Cycles s | dwivedi s | speed-up |", "|---|---|---|---|---|---|---|---|"]
+                      "target RMSE | Cycles s | dwivedi s | speed-up | speed-up, own parts |",
+                      "|---|---|---|---|---|---|---|---|---|"]
             for name, entry in run["scenes"].items():
                 speed = entry["speedup_at_rmse"]
                 tc, td = speed["cycles_seconds"], speed["dwivedi_seconds"]
+                oc, od = speed.get("cycles_own_seconds"), speed.get("dwivedi_own_seconds")
                 lines.append(f"| {name} | " + ", ".join(f"{v:.4f}" for v in entry["cycles_reference_mean_rgb"])
                              + " | " + ", ".join(f"{v:.4f}" for v in entry["dwivedi_reference_mean_rgb"]) +
                              f" | {entry['converged_rmse']:.3g} | {speed['rmse']:.4g} | {tc or math.nan:.3g} | "
-                             f"{td or math.nan:.3g} | " + (f"{tc / td:.2f}x" if tc and td else "n/a") + " |")
+                             f"{td or math.nan:.3g} | " + (f"{tc / td:.2f}x" if tc and td else "n/a") + " | "
+                             + (f"{oc / od:.2f}x" if oc and od else "n/a") + " |")
             lines += ["", "At equal samples per pixel the speed-up splits into variance per sample (independent of "
-                      "the machine's load) and time per sample:", "",
+                      "the machine's load) and time per sample (whole operator; in brackets the renderer's own "
+                      "part, and dwivedi's export with the scene commit):", "",
                       "| scene | spp | Cycles RMSE | dwivedi RMSE | variance ratio Cycles / dwivedi | Cycles s | "
-                      "dwivedi s |", "|---|---|---|---|---|---|---|"]
+                      "dwivedi s | dwivedi export s |", "|---|---|---|---|---|---|---|---|"]
+
+            def own(point):
+                return f" ({point['own_seconds']:.3g})" if "own_seconds" in point else ""
             for name in run["scenes"]:
                 ours = {p["samples"]: p for p in clean[where, name][1]}
                 for theirs in clean[where, name][0]:
                     if theirs["samples"] in ours:
                         mine = ours[theirs["samples"]]
                         lines.append(f"| {name} | {theirs['samples']} | {theirs['rmse']:.4g} | {mine['rmse']:.4g} | "
-                                     f"{(theirs['rmse'] / mine['rmse']) ** 2:.3g} | {theirs['seconds']:.3g} | "
-                                     f"{mine['seconds']:.3g} |")
+                                     f"{(theirs['rmse'] / mine['rmse']) ** 2:.3g} | {theirs['seconds']:.3g}"
+                                     f"{own(theirs)} | {mine['seconds']:.3g}{own(mine)} | "
+                                     f"{mine.get('export_seconds', math.nan):.3g} |")
             for name in run["scenes"]:
                 if f"cycles_{where}_{name}.png" in made:
                     lines += ["", f"![{name} against Blender {run['blender']}'s Cycles](cycles_{where}_{name}.png)"]

@@ -538,7 +538,7 @@ class _Job:
         lost = lost_at_quit(self.folder)
         size = tuple(self.uv_image.size) if self.uv_image is not None else (0, 0)
         self.exported = export.export_scene(context, _ExportSettings(settings, self.uv_object, size[0]),
-                                            self.dwivedi)
+                                            self.dwivedi, export.CACHE)
         if self.uv_image is not None:
             self.exported.width, self.exported.height = size  # the image's own size, as Cycles bakes
         self.warnings = [readable(w) for w in self.exported.warnings] + ([lost] if lost else [])
@@ -583,16 +583,18 @@ class _Job:
         try:
             stats = image.stats
             if self.target == 'CAMERA':
-                self._write_files(image)
-                self.result = file_image(self.exr)
+                export.CACHE.own_updates(lambda: self._write_files(image))
+                self.result = export.CACHE.own_updates(lambda: file_image(self.exr))
                 where = self.exr
             else:
                 if passes.is_full_combined(self.bake_type, self.pass_filter):
-                    where = write_uv_image(image, self.uv_image, self.exr, self.dwivedi)
+                    where = export.CACHE.own_updates(
+                        lambda: write_uv_image(image, self.uv_image, self.exr, self.dwivedi))
                 else:
                     typed = image.bake_type(self.bake_type, self.pass_filter)
                     try:
-                        where = write_uv_image(typed, self.uv_image, self.exr, self.dwivedi)
+                        where = export.CACHE.own_updates(
+                            lambda: write_uv_image(typed, self.uv_image, self.exr, self.dwivedi))
                     finally:
                         typed.close()
                 self.result = self.uv_image
@@ -637,7 +639,8 @@ class _Job:
             self.bake.close()
             self.bake = None
         if self.exported.scene is not None:
-            self.exported.scene.close()
+            if self.exported.owned:  # else export.CACHE keeps it for the next bake
+                self.exported.scene.close()
             self.exported.scene = None
 
 
@@ -1118,6 +1121,23 @@ def _stop_before_load(*_args):
     _RUN.say('INFO', "", None, [])
 
 
+@bpy.app.handlers.persistent
+def _note_updates(_scene, depsgraph):
+    """What changed, for the export cache (export.ExportCache.note). Persistent: it must see the
+    updates of every file loaded after it."""
+    export.CACHE.note(depsgraph)
+
+
+@bpy.app.handlers.persistent
+def _forget_exports(*_args):
+    """A file loaded, an undo or a redo: the data the cache was read from is gone."""
+    export.CACHE.clear()
+
+
+_CACHE_HANDLERS = (("depsgraph_update_post", _note_updates), ("load_post", _forget_exports),
+                   ("undo_post", _forget_exports), ("redo_post", _forget_exports))
+
+
 def _other_copy():
     """(module name, folder) of another copy of this add-on that is registered, else None."""
     import sys
@@ -1151,6 +1171,8 @@ def register():
     bpy.types.TOPBAR_MT_render.append(draw_render_menu)
     bpy.types.STATUSBAR_HT_header.append(draw_status_bar)
     bpy.app.handlers.load_pre.append(_stop_before_load)
+    for name, handler in _CACHE_HANDLERS:
+        getattr(bpy.app.handlers, name).append(handler)
     farm.register()  # its sub-panel's parent is DWIVEDI_PT_bake
     _DWIVEDI_BAKE_REGISTERED = True
     status = check_library()
@@ -1171,6 +1193,10 @@ def unregister():
     _RUN.say('INFO', "", None, [])
     if _stop_before_load in bpy.app.handlers.load_pre:
         bpy.app.handlers.load_pre.remove(_stop_before_load)
+    for name, handler in _CACHE_HANDLERS:
+        if handler in getattr(bpy.app.handlers, name):
+            getattr(bpy.app.handlers, name).remove(handler)
+    export.CACHE.clear()
     bpy.types.STATUSBAR_HT_header.remove(draw_status_bar)
     bpy.types.TOPBAR_MT_render.remove(draw_render_menu)
     del bpy.types.WindowManager.dwivedi_bake_progress

@@ -16,7 +16,7 @@ from typing import Any, Dict, List, Optional, Tuple
 
 import bpy
 
-from . import evaluate, normals, textures
+from . import evaluate, gather, normals, textures
 
 
 class ExportError(Exception):
@@ -35,6 +35,129 @@ class Exported:
         self.mesh_count = 0
         self.triangle_count = 0
         self.light_count = 0
+        # False where the scene belongs to an ExportCache (which closes it): the bake that uses
+        # it must not close it, since the next bake may use it again.
+        self.owned = True
+        self.reused = False  # the whole scene was the cache's, nothing exported again
+        self.images_read = 0  # textures and environment images the export read
+
+
+# ---------------------------------------------------------------------------------------------
+# What the last bake exported, kept for the next one
+# ---------------------------------------------------------------------------------------------
+
+class _Meshes:
+    """One object's mesh arrays (_mesh_arrays), read at a generation of an ExportCache."""
+
+    def __init__(self, generation: int, want_uvs: bool, maps: Any, uv_names: List[str], arrays: Any) -> None:
+        self.generation = generation
+        self.want_uvs = want_uvs
+        self.maps = maps
+        self.uv_names = uv_names
+        self.arrays = arrays  # None: the mesh has no faces
+
+
+class ExportCache:
+    """What the last bake exported, so that the next bake re-exports only what changed.
+
+    Blender says what changed through its depsgraph: the add-on's depsgraph_update_post handler
+    passes every update to note(), which counts generations. The cache keeps
+    - each object's mesh arrays, read at some generation: reused while no update since has
+      touched the object's geometry (an Object update with is_updated_geometry: a mesh edit, a
+      modifier, a driver) nor any data other than objects, materials, shader node trees,
+      lights, cameras, worlds, collections, scenes and images (a mesh, curve or geometry node
+      tree, which other objects' modifiers may read); transforms are read again every bake;
+    - the whole committed scene of the last bake: reused while no update at all has come since
+      (a material, light, world, camera, transform, render setting...) and the bake's export
+      settings are the same, and only when that export read no image (a texture, an environment
+      or rendered world, inputs Blender evaluated into images): Blender's depsgraph does not say
+      when an image's pixels change.
+    A file load, undo or redo forgets everything (clear()). Instances (particles, geometry nodes,
+    collection instances) are read again every bake."""
+
+    def __init__(self) -> None:
+        self.generation = 0
+        self._geometry = 0  # the generation of the last update of data any object may read
+        self._objects: Dict[str, int] = {}  # object -> the generation of its last geometry update
+        self._meshes: Dict[str, _Meshes] = {}
+        self._scene: Optional[Tuple[Any, int, Exported]] = None  # (key, generation, export)
+
+    # Types whose updates change no other object's evaluated mesh (their own effect is in the
+    # whole scene's generation; Image: see the class comment). An object's own data (a mesh, a
+    # curve) is among them: Blender updates the geometry of every object that uses it or reads
+    # it (linked duplicates, another object's modifier), which note() takes per object.
+    _NOT_GEOMETRY = ("Material", "Light", "Camera", "World", "Scene", "Collection", "Image", "Mesh", "Curve",
+                     "MetaBall", "Lattice")
+
+    def note(self, depsgraph: Any) -> None:
+        """Takes in a depsgraph's updates (the add-on's depsgraph_update_post handler)."""
+        for update in depsgraph.updates:
+            changed = update.id
+            if isinstance(changed, bpy.types.Image):
+                continue
+            self.generation += 1
+            if isinstance(changed, bpy.types.Object):
+                if update.is_updated_geometry:
+                    self._objects[changed.original.name_full] = self.generation
+            elif not (any(isinstance(changed, getattr(bpy.types, name)) for name in self._NOT_GEOMETRY)
+                      or isinstance(changed, bpy.types.NodeTree) and changed.bl_idname == "ShaderNodeTree"):
+                self._geometry = self.generation
+
+    def clear(self) -> None:
+        """Forgets everything (a file load, undo, redo, the add-on disabled)."""
+        self._meshes.clear()
+        self._objects.clear()
+        if self._scene is not None:
+            self._scene[2].scene.close()
+            self._scene = None
+
+    def meshes(self, name: str) -> Optional[_Meshes]:
+        """The object's arrays if nothing has changed its geometry since they were read."""
+        entry = self._meshes.get(name)
+        if entry is None or max(self._geometry, self._objects.get(name, 0)) > entry.generation:
+            return None
+        return entry
+
+    def keep_meshes(self, name: str, entry: _Meshes) -> None:
+        self._meshes[name] = entry
+
+    def scene(self, key: Any) -> Optional[Exported]:
+        """The last bake's export, as an Exported of its own, if it may be baked again."""
+        if self._scene is None or self._scene[0] != key or self._scene[1] != self.generation:
+            return None
+        kept = self._scene[2]
+        out = Exported()
+        out.__dict__.update(kept.__dict__)
+        out.warnings = list(kept.warnings)
+        out.owned, out.reused = False, True
+        return out
+
+    def own_updates(self, work: Any) -> Any:
+        """Runs work() (writing a bake's result: a render setting set and put back for the PNG,
+        images loaded) and returns what it returns; the depsgraph updates it makes are the
+        add-on's own and leave the kept scene valid, if nothing else changed before them.
+        work() runs on Blender's main thread, so no edit of the artist's comes in between."""
+        bpy.context.evaluated_depsgraph_get()  # the updates before: the artist's, counted
+        before = self.generation
+        try:
+            return work()
+        finally:
+            bpy.context.evaluated_depsgraph_get()
+            if self._scene is not None and self._scene[1] == before:
+                self._scene = (self._scene[0], self.generation, self._scene[2])
+
+    def keep_scene(self, key: Any, generation: int, exported: Exported) -> None:
+        """Keeps `exported` (which the cache now owns: its scene is closed by the cache)."""
+        if self._scene is not None and self._scene[2].scene is not exported.scene:
+            self._scene[2].scene.close()
+        exported.owned = False
+        kept = Exported()
+        kept.__dict__.update(exported.__dict__)
+        kept.warnings = list(exported.warnings)
+        self._scene = (key, generation, kept)
+
+
+CACHE = ExportCache()
 
 
 # ---------------------------------------------------------------------------------------------
@@ -279,37 +402,27 @@ def _rows(matrix: Any) -> List[float]:
 
 def _mesh_arrays(mesh: Any, want_uvs: bool, texture_maps: Optional[List[Optional[str]]] = None) -> Dict[str, Any]:
     """Positions, triangle indices, per-corner UVs, normals and per-triangle material indices of
-    an evaluated mesh, in float32 / uint32 arrays (foreach_get fills them without Python loops).
-    texture_maps (a list, maybe empty, of the UV maps normal maps read; None: layer 0) asks for
-    all UV maps by name and those maps' tangents, for textured materials.
+    an evaluated mesh, in float32 / uint32 buffers: foreach_get fills them and gather.py picks
+    the corners' values, without a Python loop per element. texture_maps (a list, maybe empty, of
+    the UV maps normal maps read; None: layer 0) asks for all UV maps by name and those maps'
+    tangents, for textured materials.
 
     Smooth and flat faces both come out right: all-flat meshes share vertices without normals
-    (flat shading); otherwise every triangle corner gets its own vertex with Blender's corner
-    (split) normal, which is the face normal on flat faces and honours sharp edges."""
+    (flat shading); meshes whose every corner normal is its vertex's normal (all faces smooth, no
+    sharp edges or custom normals: _normals_domain 'POINT') share vertices with those normals;
+    otherwise every triangle corner gets its own vertex with Blender's corner (split) normal,
+    which is the face normal on flat faces and honours sharp edges."""
     mesh.calc_loop_triangles()
     tris = mesh.loop_triangles
     t = len(tris)
-    loops = array.array("i", [0]) * (3 * t)
+    loops = array.array("i", bytes(12 * t))
     tris.foreach_get("loops", loops)
-    material_index = array.array("i", [0]) * t
+    material_index = array.array("i", bytes(4 * t))
     tris.foreach_get("material_index", material_index)
     out: Dict[str, Any] = {"triangles": t, "material_index": material_index}
 
-    smooth = array.array("b", [0]) * len(mesh.polygons)
-    try:
-        mesh.polygons.foreach_get("use_smooth", smooth)
-    except (AttributeError, TypeError, RuntimeError):
-        smooth = array.array("b")
-    any_smooth = any(smooth)
-
     if want_uvs and mesh.uv_layers.active is not None:
-        loop_uv = array.array("f", [0.0]) * (2 * len(mesh.loops))
-        mesh.uv_layers.active.data.foreach_get("uv", loop_uv)
-        uvs = array.array("f", [0.0]) * (6 * t)
-        for c, loop in enumerate(loops):
-            uvs[2 * c] = loop_uv[2 * loop]
-            uvs[2 * c + 1] = loop_uv[2 * loop + 1]
-        out["uvs"] = uvs
+        out["uvs"] = gather.corner_uvs(mesh, mesh.uv_layers.active, loops)
     else:
         out["uvs"] = None
     out["layers"] = None
@@ -321,50 +434,72 @@ def _mesh_arrays(mesh: Any, want_uvs: bool, texture_maps: Optional[List[Optional
         out["layers"] = textures.uv_layers(mesh, loops, first, texture_maps)
         out["uvs"] = out["layers"]["uvs"]
 
-    vertex_co = array.array("f", [0.0]) * (3 * len(mesh.vertices))
+    vertex_co = array.array("f", bytes(12 * len(mesh.vertices)))
     mesh.vertices.foreach_get("co", vertex_co)
-    if not any_smooth:
-        indices = array.array("I", [0]) * (3 * t)
+    domain = _normals_domain(mesh)
+    if domain != 'CORNER':
+        indices = array.array("I", bytes(12 * t))
         tris.foreach_get("vertices", indices)
-        out.update(positions=vertex_co, indices=indices, normals=None)
+        out.update(positions=vertex_co, indices=indices,
+                   normals=_vertex_normals(mesh) if domain == 'POINT' else None)
         return out
 
     if hasattr(mesh, "calc_normals_split"):  # Blender < 4.1 computes corner normals on demand
         mesh.calc_normals_split()
-    corner_normals = array.array("f", [0.0]) * (9 * t)
+    corner_normals = array.array("f", bytes(36 * t))
     tris.foreach_get("split_normals", corner_normals)
-    corner_vertices = array.array("I", [0]) * (3 * t)
+    corner_vertices = array.array("I", bytes(12 * t))
     tris.foreach_get("vertices", corner_vertices)
     # Blender 3.x's vertex normals vary in their last bits from one evaluation to the next (threads
-    # add into them in any order): the same normals in a fixed order, so that a scene bakes the same
-    # bits every time (normals.py).
-    normals.settle_corner_normals(mesh, corner_vertices, corner_normals, smooth, bpy.app.version)
-    positions = array.array("f", [0.0]) * (9 * t)
-    for c, v in enumerate(corner_vertices):
-        positions[3 * c:3 * c + 3] = vertex_co[3 * v:3 * v + 3]
-    out.update(positions=positions, indices=array.array("I", range(3 * t)), normals=corner_normals)
+    # add into them in any order): the smooth faces' corners get the same normals summed in a fixed
+    # order, so that a scene exports, and bakes, the same bits every time (normals.py).
+    normals.settle_corner_normals(mesh, corner_vertices, corner_normals, bpy.app.version)
+    out.update(positions=gather.rows(vertex_co, 3, corner_vertices), indices=array.array("I", range(3 * t)),
+               normals=corner_normals)
     return out
 
 
-def _subset(arrays: Dict[str, Any], keep: List[int]) -> Dict[str, Any]:
+def _normals_domain(mesh: Any) -> str:
+    """Where the mesh's normals live, as Blender 4.1+'s Mesh.normals_domain says: 'FACE' (every
+    face flat), 'POINT' (every corner normal is its vertex's normal: all faces smooth, no sharp
+    edges, no custom normals) or 'CORNER'. Before 4.1 from the same rules: 3.x / 4.0 Auto Smooth
+    or custom normals make corner normals (calc_normals_split), otherwise a smooth face's corner
+    takes its vertex's normal and a flat face's its face normal."""
+    domain = getattr(mesh, "normals_domain", None)
+    if domain is not None:
+        return domain
+    smooth = array.array("b", bytes(len(mesh.polygons)))
+    mesh.polygons.foreach_get("use_smooth", smooth)
+    if not any(smooth):
+        return 'FACE'
+    if getattr(mesh, "use_auto_smooth", False) or mesh.has_custom_normals or not all(smooth):
+        return 'CORNER'
+    return 'POINT'
+
+
+def _vertex_normals(mesh: Any) -> Any:
+    """The mesh's vertex normals (Mesh.vertex_normals from 4.1 on; before, Blender's vary in their
+    last bits from one evaluation to the next, and normals.py sums them in a fixed order)."""
+    if tuple(bpy.app.version) < (4, 1, 0):
+        return normals.mesh_vertex_normals(mesh)
+    out = array.array("f", bytes(12 * len(mesh.vertices)))
+    mesh.vertex_normals.foreach_get("vector", out)
+    return out
+
+
+def _subset(arrays: Dict[str, Any], keep: Any) -> Dict[str, Any]:
     """The triangles `keep` of a split-corner or shared-vertex mesh, as a mesh of their own
     (vertices are kept whole: unreferenced ones cost nothing to the library)."""
-    indices = array.array("I", [0]) * (3 * len(keep))
-    uvs = None if arrays["uvs"] is None else array.array("f", [0.0]) * (6 * len(keep))
-    for n, tri in enumerate(keep):
-        indices[3 * n:3 * n + 3] = arrays["indices"][3 * tri:3 * tri + 3]
-        if uvs is not None:
-            uvs[6 * n:6 * n + 6] = arrays["uvs"][6 * tri:6 * tri + 6]
+    def pick(values: Any, group: int) -> Any:
+        return gather.rows(values, group, keep)
+
+    uvs = None if arrays["uvs"] is None else pick(arrays["uvs"], 6)
     layers = arrays.get("layers")
     if layers is not None:
-        def pick(values: Any, group: int) -> Any:
-            out = array.array("f", [0.0]) * (group * len(keep))
-            for n, tri in enumerate(keep):
-                out[group * n:group * n + group] = values[group * tri:group * tri + group]
-            return out
         layers = {**layers, "uvs": uvs, "uv_layers": [(name, pick(v, 6)) for name, v in layers["uv_layers"]],
                   "tangents": {name: pick(v, 12) for name, v in layers["tangents"].items()}}
-    return {**arrays, "indices": indices, "uvs": uvs, "triangles": len(keep), "layers": layers}
+    return {**arrays, "indices": gather.rows(arrays["indices"], 3, keep, "I"), "uvs": uvs, "triangles": len(keep),
+            "layers": layers}
 
 
 def _layer_arguments(arrays: Dict[str, Any]) -> Dict[str, Any]:
@@ -433,6 +568,15 @@ def area_power_scale(version: Tuple[int, ...]) -> float:
     return 4.0 / math.pi if tuple(version) >= (4, 0, 0) else 1.0
 
 
+def point_shape(data: Any, version: Tuple[int, ...]) -> str:
+    """The shape of a point or spot light: Cycles 4.0 onward makes it a sphere unless Soft Falloff
+    is on (Blender's default; its sync: is_sphere = !use_soft_falloff), which keeps 3.x's disc
+    facing the shaded point."""
+    if tuple(version) < (4, 0, 0):
+        return "disc"
+    return "disc" if getattr(data, "use_soft_falloff", True) else "sphere"
+
+
 def _light(obj: Any, matrix: Any, dwivedi: Any, warnings: List[str]) -> Any:
     data = obj.data
     node_color, node_strength = _light_emission(obj, warnings)
@@ -444,7 +588,8 @@ def _light(obj: Any, matrix: Any, dwivedi: Any, warnings: List[str]) -> Any:
         direction = rot @ _vector((0.0, 0.0, -1.0))
         return dwivedi.SunLight(direction=tuple(direction), strength=energy, color=color, angle=data.angle)
     if data.type == 'POINT':
-        return dwivedi.PointLight(position=tuple(location), power=energy, color=color, radius=data.shadow_soft_size)
+        return dwivedi.PointLight(position=tuple(location), power=energy, color=color, radius=data.shadow_soft_size,
+                                  shape=point_shape(data, bpy.app.version))
     if data.type == 'SPOT':
         if abs(scale[0] - scale[1]) > 1e-6 * max(abs(scale[0]), abs(scale[1]), 1e-30):
             warnings.append(f"light '{obj.name}': the spot's cone is round in dwivedi (the object's unequal x and "
@@ -452,7 +597,7 @@ def _light(obj: Any, matrix: Any, dwivedi: Any, warnings: List[str]) -> Any:
         direction = rot @ _vector((0.0, 0.0, -1.0))
         return dwivedi.SpotLight(position=tuple(location), direction=tuple(direction), power=energy, color=color,
                                  radius=data.shadow_soft_size, spot_size=data.spot_size, spot_blend=data.spot_blend,
-                                 falloff=spot_falloff(bpy.app.version))
+                                 falloff=spot_falloff(bpy.app.version), shape=point_shape(data, bpy.app.version))
     if data.type == 'AREA':
         sx = data.size * abs(scale[0])
         sy = (data.size_y if data.shape in {'RECTANGLE', 'ELLIPSE'} else data.size) * abs(scale[1])
@@ -767,21 +912,38 @@ def camera_from_blender(scene: Any, width: int, height: int, dwivedi: Any, warni
 # The whole scene
 # ---------------------------------------------------------------------------------------------
 
-def export_scene(context: Any, settings: Any, dwivedi: Any) -> Exported:
+def export_scene(context: Any, settings: Any, dwivedi: Any, cache: Optional[ExportCache] = None) -> Exported:
     """Builds and commits the dwivedi scene of `context.scene` for the bake `settings`
-    (scene.dwivedi_bake); ExportError if it cannot be baked as asked."""
+    (scene.dwivedi_bake); ExportError if it cannot be baked as asked. With a `cache` (the
+    add-on's CACHE, which its depsgraph handler keeps up to date) only what changed since the
+    last bake is exported again, and an unchanged scene is the last bake's committed scene
+    (then exported.owned is False: the cache closes it)."""
     scene = context.scene
+    key = None
+    if cache is not None:
+        context.evaluated_depsgraph_get()  # Blender hands the pending updates to the handler now
+        uv_object = getattr(settings, "uv_object", None)
+        key = (scene.name_full, context.view_layer.name, settings.target, uv_object.name_full if uv_object else None,
+               getattr(settings, "uv_size", 0), getattr(settings, "world_resolution", 1024),
+               getattr(settings, "texture_bake_size", 256), id(dwivedi), dwivedi.library_path())
+        kept = cache.scene(key)
+        if kept is not None:
+            return kept
+    generation = cache.generation if cache is not None else 0
     out = Exported()
     warnings = out.warnings
     # Inputs driven by node trees are evaluated by Blender (an emission bake) before the depsgraph
     # is read: the bake re-evaluates it.
     evaluated_images = _evaluate_inputs(context, settings, warnings)
     try:
-        return _export(context, settings, dwivedi, out)
+        out = _export(context, settings, dwivedi, out, cache)
     finally:
         textures.EVALUATED.clear()
         for image in evaluated_images:
             bpy.data.images.remove(image)
+    if cache is not None and not evaluated_images and out.images_read == 0:
+        cache.keep_scene(key, generation, out)
+    return out
 
 
 def _evaluate_inputs(context: Any, settings: Any, warnings: List[str]) -> List[Any]:
@@ -799,7 +961,7 @@ def _evaluate_inputs(context: Any, settings: Any, warnings: List[str]) -> List[A
     return images
 
 
-def _export(context: Any, settings: Any, dwivedi: Any, out: Exported) -> Exported:
+def _export(context: Any, settings: Any, dwivedi: Any, out: Exported, cache: Optional[ExportCache]) -> Exported:
     scene = context.scene
     depsgraph = context.evaluated_depsgraph_get()
     warnings = out.warnings
@@ -836,9 +998,10 @@ def _export(context: Any, settings: Any, dwivedi: Any, out: Exported) -> Exporte
                     raise ExportError(str(error)) from None
             return material_ids[key]
 
-        def texture_maps(obj: Any, slots: List[Any], mesh: Any) -> Optional[List[Optional[str]]]:
+        def texture_maps(obj: Any, slots: List[Any], uv_names: List[str]) -> Optional[List[Optional[str]]]:
             """None if no material of the object is textured; else the UV maps its normal maps
-            read, after checking that every UV map a texture names is on the mesh."""
+            read, after checking that every UV map a texture names is on the mesh (whose UV maps
+            are `uv_names`)."""
             maps: Optional[List[Optional[str]]] = None
             for material in slots:
                 material_id(material)
@@ -846,14 +1009,13 @@ def _export(context: Any, settings: Any, dwivedi: Any, out: Exported) -> Exporte
                 if not uses:
                     continue
                 maps = maps or []
-                if len(mesh.uv_layers) == 0:
+                if not uv_names:
                     raise ExportError(f"object '{obj.name}' has no UV map, which the image textures of material "
                                       f"'{material.name}' need (UV > Unwrap)")
                 for use in uses:
-                    if use.uv_map is not None and mesh.uv_layers.get(use.uv_map) is None:
+                    if use.uv_map is not None and use.uv_map not in uv_names:
                         raise ExportError(f"material '{material.name}' reads UV map '{use.uv_map}', which object "
-                                          f"'{obj.name}' does not have (its UV maps: "
-                                          f"{', '.join(layer.name for layer in mesh.uv_layers)})")
+                                          f"'{obj.name}' does not have (its UV maps: {', '.join(uv_names)})")
                     if use.input == "normal_map":
                         maps.append(use.uv_map)
             return maps
@@ -877,18 +1039,31 @@ def _export(context: Any, settings: Any, dwivedi: Any, out: Exported) -> Exporte
                 continue
             original = obj.original if hasattr(obj, "original") else obj
             is_uv_target = (uv_object is not None and original == uv_object and not instance.is_instance)
-            mesh = obj.to_mesh()
+            # The mesh arrays of the last bake where nothing changed the object's geometry since
+            # (ExportCache), else the evaluated mesh read again.
+            name = original.name_full
+            kept = cache.meshes(name) if cache is not None and not instance.is_instance else None
+            mesh = None if kept is not None else obj.to_mesh()
             try:
-                if mesh is None or len(mesh.polygons) == 0:
+                if kept is None and (mesh is None or len(mesh.polygons) == 0):
                     continue
                 slots = [slot.material for slot in obj.material_slots]
-                arrays = _mesh_arrays(mesh, want_uvs=is_uv_target, texture_maps=texture_maps(obj, slots or [None], mesh))
+                uv_names = kept.uv_names if kept is not None else [layer.name for layer in mesh.uv_layers]
+                maps = texture_maps(obj, slots or [None], uv_names)
+                if kept is not None and (kept.want_uvs != is_uv_target or kept.maps != maps):
+                    kept, mesh = None, obj.to_mesh()
+                if kept is not None:
+                    arrays = kept.arrays
+                    if arrays is None:
+                        continue
+                else:
+                    arrays = _mesh_arrays(mesh, want_uvs=is_uv_target, texture_maps=maps)
+                    if cache is not None and not instance.is_instance:
+                        cache.keep_meshes(name, _Meshes(cache.generation, is_uv_target, maps, uv_names, arrays))
                 if arrays["layers"] is not None:
                     warnings.extend(arrays["layers"]["warnings"])
                 terminator = _shadow_terminator_geometry_offset(obj)
-                by_material: Dict[int, List[int]] = {}
-                for tri, index in enumerate(arrays["material_index"]):
-                    by_material.setdefault(index, []).append(tri)
+                by_material = dict(gather.groups(arrays["material_index"]))
                 transform = _rows(matrix)
                 if is_uv_target:
                     if arrays["uvs"] is None:
@@ -916,14 +1091,17 @@ def _export(context: Any, settings: Any, dwivedi: Any, out: Exported) -> Exporte
                     out.mesh_count += 1
                     out.triangle_count += part["triangles"]
             finally:
-                obj.to_mesh_clear()
+                if mesh is not None:
+                    obj.to_mesh_clear()
         if skipped:
             warnings.append(f"objects that are not geometry were left out: {', '.join(sorted(skipped)[:8])}")
         if out.mesh_count == 0:
             raise ExportError("the scene has no visible mesh objects to bake")
         if target == 'UV' and not uv_found:
             raise ExportError(f"'{uv_object.name}' is not rendered in this view layer (hidden or excluded)")
-        world_from_blender(scene, warnings, getattr(settings, "world_resolution", 1024)).apply(dw_scene)
+        world = world_from_blender(scene, warnings, getattr(settings, "world_resolution", 1024))
+        world.apply(dw_scene)
+        out.images_read = len(texture_cache.ids) + (world.texels is not None)
         if target == 'CAMERA':
             dw_scene.set_camera(camera_from_blender(scene, out.width, out.height, dwivedi, warnings))
         elif scene.camera is not None and scene.camera.type == 'CAMERA' and scene.camera.data.type in {'PERSP', 'ORTHO'}:

@@ -133,16 +133,9 @@ def _vertex_normals_python(positions: Sequence[float], loop_vertices: Sequence[i
     return out
 
 
-def settle_corner_normals(mesh: Any, corner_vertices: Sequence[int], corner_normals: Any, smooth: Sequence[int],
-                          version: Sequence[int]) -> None:
-    """Replaces, in place, the corner normals (3 per loop-triangle corner, from
-    MeshLoopTriangle.split_normals) of a Blender `mesh` of `version` before 4.1 by vertex_normals
-    where they are their vertices' normals: the corners of smooth faces (`smooth`: use_smooth per
-    polygon) of a mesh without Auto Smooth and custom normals. Flat faces keep their face normal
-    (one face's, no accumulation), and Auto Smooth's or custom corner normals stay Blender's.
-    4.1 on gathers each vertex's faces in one thread, in a fixed order, and is left alone."""
-    if tuple(version) >= (4, 1, 0) or getattr(mesh, "use_auto_smooth", False) or mesh.has_custom_normals:
-        return
+def mesh_vertex_normals(mesh: Any) -> "array.array[float]":
+    """vertex_normals of a Blender mesh (its vertices' co, loops' vertex_index, polygons'
+    loop_start and loop_total)."""
     positions = array.array("f", bytes(12 * len(mesh.vertices)))
     mesh.vertices.foreach_get("co", positions)
     loop_vertices = array.array("i", bytes(4 * len(mesh.loops)))
@@ -151,10 +144,25 @@ def settle_corner_normals(mesh: Any, corner_vertices: Sequence[int], corner_norm
     totals = array.array("i", bytes(4 * len(mesh.polygons)))
     mesh.polygons.foreach_get("loop_start", starts)
     mesh.polygons.foreach_get("loop_total", totals)
+    return vertex_normals(positions, loop_vertices, starts, totals)
+
+
+def settle_corner_normals(mesh: Any, corner_vertices: Sequence[int], corner_normals: Any,
+                          version: Sequence[int]) -> None:
+    """Replaces, in place, the corner normals (3 per loop-triangle corner, from
+    MeshLoopTriangle.split_normals) of a Blender `mesh` of `version` before 4.1 by vertex_normals
+    where they are their vertices' normals: the corners of smooth faces of a mesh without Auto
+    Smooth and custom normals. Flat faces keep their face normal (one face's, no accumulation),
+    and Auto Smooth's or custom corner normals stay Blender's. 4.1 on gathers each vertex's faces
+    in one thread, in a fixed order, and is left alone."""
+    if tuple(version) >= (4, 1, 0) or getattr(mesh, "use_auto_smooth", False) or mesh.has_custom_normals:
+        return
+    smooth = array.array("b", bytes(len(mesh.polygons)))
+    mesh.polygons.foreach_get("use_smooth", smooth)
     tris = mesh.loop_triangles
     polygon = array.array("i", bytes(4 * len(tris)))
     tris.foreach_get("polygon_index", polygon)
-    normals = vertex_normals(positions, loop_vertices, starts, totals)
+    normals = mesh_vertex_normals(mesh)
     if numpy is not None:
         corner_smooth = numpy.repeat(numpy.asarray(smooth, dtype=bool)[numpy.asarray(polygon)], 3)
         out = numpy.frombuffer(corner_normals, dtype=numpy.float32).reshape(-1, 3)

@@ -15,6 +15,8 @@ from __future__ import annotations
 import array
 from typing import Any, Dict, List, Optional, Tuple
 
+from . import gather
+
 
 class MissingImage(Exception):
     """An Image Texture's image has no pixels (its file is missing or unreadable), or pixels the
@@ -322,20 +324,12 @@ def uv_layers(mesh: Any, loops: Any, first: Any, tangent_maps: List[Optional[str
     """A mesh's UV maps per triangle corner for the library: `first` (the map that is layer 0,
     what bindings without a UV map read: the active render map) and the others by name, plus
     Blender's MikkTSpace tangents (Mesh.calc_tangents) of the maps normal maps read."""
-    def corner_uvs(layer: Any) -> Any:
-        loop_uv = array.array("f", [0.0]) * (2 * len(mesh.loops))
-        layer.data.foreach_get("uv", loop_uv)
-        out = array.array("f", [0.0]) * (2 * len(loops))
-        for c, loop in enumerate(loops):
-            out[2 * c] = loop_uv[2 * loop]
-            out[2 * c + 1] = loop_uv[2 * loop + 1]
-        return out
-
-    result: Dict[str, Any] = {"uv_name": first.name, "uvs": corner_uvs(first), "uv_layers": [], "tangents": {},
+    result: Dict[str, Any] = {"uv_name": first.name, "uvs": gather.corner_uvs(mesh, first, loops), "uv_layers": [],
+                              "tangents": {},
                               "warnings": []}
     for layer in mesh.uv_layers:
         if layer.name != first.name:
-            result["uv_layers"].append((layer.name, corner_uvs(layer)))
+            result["uv_layers"].append((layer.name, gather.corner_uvs(mesh, layer, loops)))
     for name in sorted({first.name if n is None else n for n in tangent_maps}):
         if mesh.uv_layers.get(name) is None:
             continue  # the library refuses the binding with the mesh's layer names
@@ -345,13 +339,9 @@ def uv_layers(mesh: Any, loops: Any, first: Any, tangent_maps: List[Optional[str
             result["warnings"].append(f"no MikkTSpace tangents for UV map '{name}' ({error}): the library makes "
                                       "them from the UVs")
             continue
-        tangent = array.array("f", [0.0]) * (3 * len(mesh.loops))
-        sign = array.array("f", [0.0]) * len(mesh.loops)
+        tangent = array.array("f", bytes(12 * len(mesh.loops)))
+        sign = array.array("f", bytes(4 * len(mesh.loops)))
         mesh.loops.foreach_get("tangent", tangent)
-        mesh.loops.foreach_get("bitangent_sign", sign)
-        out = array.array("f", [0.0]) * (4 * len(loops))
-        for c, loop in enumerate(loops):
-            out[4 * c:4 * c + 3] = tangent[3 * loop:3 * loop + 3]
-            out[4 * c + 3] = 1.0 if sign[loop] >= 0.0 else -1.0
-        result["tangents"][name] = out
+        mesh.loops.foreach_get("bitangent_sign", sign)  # MikkTSpace's orientation: exactly 1 or -1
+        result["tangents"][name] = gather.rows(gather.interleave(tangent, 3, sign), 4, loops)
     return result

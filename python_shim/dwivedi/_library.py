@@ -223,6 +223,8 @@ class LightDesc(_SizedStructure):
         ("spot_blend", ctypes.c_double),
         ("spot_falloff", ctypes.c_int32),
         ("reserved", ctypes.c_uint32),
+        ("point_shape", ctypes.c_int32),
+        ("reserved_shape", ctypes.c_uint32),
     ]
 
 

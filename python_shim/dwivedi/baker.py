@@ -261,19 +261,25 @@ class SunLight:
 
 @dataclass
 class PointLight:
-    """A point (sphere of `radius`) light of `power` watts, Blender's convention (radiant
-    intensity power / (4 pi) W/sr)."""
+    """A point light of `power` watts, Blender's convention (radiant intensity power / (4 pi)
+    W/sr), of `radius`: `shape` "disc" (a disc facing the shaded point: Blender 3.x, and 4.0
+    onward with Soft Falloff) or "sphere" (4.0 onward without Soft Falloff); dwv_point_shape_t."""
 
     position: Vector = (0.0, 0.0, 0.0)
     power: float = 100.0
     color: Color = (1.0, 1.0, 1.0)
     radius: float = 0.0
+    shape: str = "disc"
 
     def _to_c(self) -> _library.LightDesc:
         out = _light_base(1, self.color, _real("power", self.power))
         out.position[:] = real_tuple(self.position, "position", 3)
         out.radius = _real("radius", self.radius)
+        out.point_shape = _name_code("point light shape", self.shape, POINT_SHAPES)
         return out
+
+
+POINT_SHAPES = {"disc": 0, "sphere": 1}
 
 
 @dataclass
@@ -300,7 +306,7 @@ class AreaLight:
 
 @dataclass
 class SpotLight:
-    """A spot light as Blender's: a point (sphere of `radius`) light of `power` watts within a cone
+    """A spot light as Blender's: a point light (`radius`, `shape` as PointLight's) of `power` watts within a cone
     about `direction` (the way its axis points, Blender's local -z), of full angle `spot_size`
     (radians, Blender's Spot Size) with a soft edge of `spot_blend` (0 to 1). `falloff` is the
     attenuation's form: "cycles3" (Blender 3.x: the axis cosine x a smoothstep) or "cycles4"
@@ -314,6 +320,7 @@ class SpotLight:
     spot_size: float = math.pi / 4.0
     spot_blend: float = 0.15
     falloff: str = "cycles3"
+    shape: str = "disc"
 
     def _to_c(self) -> _library.LightDesc:
         out = _light_base(4, self.color, _real("power", self.power))
@@ -323,6 +330,7 @@ class SpotLight:
         out.spot_size = _real("spot_size", self.spot_size)
         out.spot_blend = _real("spot_blend", self.spot_blend)
         out.spot_falloff = _name_code("spot falloff", self.falloff, {"cycles3": 0, "cycles4": 1})
+        out.point_shape = _name_code("spot light shape", self.shape, POINT_SHAPES)
         return out
 
 

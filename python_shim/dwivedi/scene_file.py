@@ -169,7 +169,7 @@ class SceneFileWriter:
         elif isinstance(light, PointLight):
             self.lights.append({"kind": "point", "color": color, "strength": float(light.power),
                                 "position": list(real_tuple(light.position, "position", 3)),
-                                "radius": float(light.radius)})
+                                "radius": float(light.radius), **_point_shape(light)})
         elif isinstance(light, AreaLight):
             self.lights.append({"kind": "area", "color": color, "strength": float(light.power), "shape": light.shape,
                                 "size_x": float(light.size_x), "size_y": float(light.size_y),
@@ -179,7 +179,8 @@ class SceneFileWriter:
                                 "position": list(real_tuple(light.position, "position", 3)),
                                 "direction": list(real_tuple(light.direction, "direction", 3)),
                                 "radius": float(light.radius), "spot_size": degrees_for(float(light.spot_size)),
-                                "spot_blend": float(light.spot_blend), "spot_falloff": light.falloff})
+                                "spot_blend": float(light.spot_blend), "spot_falloff": light.falloff,
+                                **_point_shape(light)})
         else:
             raise TypeError(f"light must be a SunLight, PointLight, AreaLight or SpotLight, not {type(light).__name__}")
 
@@ -335,3 +336,11 @@ def _write_replacing(path: str, data: bytes) -> None:
         if os.path.exists(temporary):
             os.unlink(temporary)
         raise
+
+
+def _point_shape(light: Any) -> dict:
+    """A point or spot light's "point_shape" key, written for the sphere only (a disc's scene file
+    stays as before the key existed)."""
+    if light.shape not in ("disc", "sphere"):
+        raise ValueError(f"point light shape {light.shape!r}: 'disc' or 'sphere'")
+    return {"point_shape": "sphere"} if light.shape == "sphere" else {}

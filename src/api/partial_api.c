@@ -55,7 +55,7 @@ static void fnv_add(fnv *f, const void *data, size_t size)
  * and not hashed lets chunks of two different scenes merge. These sizes (LP64) make such an
  * addition fail to compile here until the field is added below (or said to change no image). */
 _Static_assert(sizeof(dwv_material_t) == 192, "a new dwv_material_t field: hash it in dwv_scene_hash");
-_Static_assert(sizeof(dwv_light_desc_t) == 240, "a new dwv_light_desc_t field: hash it in dwv_scene_hash");
+_Static_assert(sizeof(dwv_light_desc_t) == 248, "a new dwv_light_desc_t field: hash it in dwv_scene_hash");
 _Static_assert(sizeof(dwv_camera_t) == 128, "a new dwv_camera_t field: hash it in dwv_scene_hash");
 _Static_assert(sizeof(dwvb_texture) == 64, "a new dwvb_texture field: hash it in dwv_scene_hash");
 _Static_assert(sizeof(dwvb_binding) == 56, "a new dwvb_binding field: hash it in dwv_scene_hash");
@@ -171,6 +171,8 @@ uint64_t dwv_scene_hash(const dwvb_scene *s)
             ADD(&f, l->spot_blend);
             ADD(&f, l->spot_falloff);
         }
+        /* The sphere only (the disc is how every scene before it was lit: those hash as before). */
+        if (l->point_shape == DWV_POINT_SHAPE_SPHERE) ADD(&f, l->point_shape);
     }
     fnv_add(&f, s->world, sizeof s->world);
     if (s->envmap) {

@@ -342,13 +342,22 @@ dwv_result_t dwv_scene_add_mesh(dwv_scene_t *scene, const dwv_mesh_t *mesh_in, u
     return DWV_SUCCESS;
 }
 
+static dwv_result_t check_point_shape(const char *fn, const dwv_light_desc_t *light)
+{
+    if (light->point_shape != DWV_POINT_SHAPE_DISC && light->point_shape != DWV_POINT_SHAPE_SPHERE)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: point_shape %d is neither the disc (0) nor the sphere (1)", fn,
+                        (int)light->point_shape);
+    return DWV_SUCCESS;
+}
+
 dwv_result_t dwv_scene_add_light(dwv_scene_t *scene, const dwv_light_desc_t *light_in)
 {
     static const char fn[] = "dwv_scene_add_light";
     dwvb_scene *s;
     DWV_TRY(open_scene(fn, scene, &s));
-    /* The struct before issue 18 ended at size_y: such callers keep working, with the spot
-     * fields' defaults. Only the caller's struct_size bytes are read. */
+    /* The struct before issue 18 ended at size_y, then at `reserved` (before point_shape): such
+     * callers keep working, with the later fields' defaults. Only the caller's struct_size bytes
+     * are read. */
     DWV_TRY(dwv_check_struct(fn, "light", light_in, (uint32_t)offsetof(dwv_light_desc_t, spot_size)));
     dwv_light_desc_t resolved = DWV_LIGHT_DESC_INIT;
     size_t given = light_in->struct_size < sizeof resolved ? light_in->struct_size : sizeof resolved;
@@ -370,6 +379,7 @@ dwv_result_t dwv_scene_add_light(dwv_scene_t *scene, const dwv_light_desc_t *lig
     case DWV_LIGHT_POINT:
         DWV_TRY(check_array(fn, "position", light->position, 3, -HUGE_VAL, HUGE_VAL));
         DWV_TRY(dwv_check_range(fn, "radius", light->radius, 0.0, HUGE_VAL));
+        DWV_TRY(check_point_shape(fn, light));
         break;
     case DWV_LIGHT_SPOT: {
         DWV_TRY(check_array(fn, "position", light->position, 3, -HUGE_VAL, HUGE_VAL));
@@ -387,6 +397,7 @@ dwv_result_t dwv_scene_add_light(dwv_scene_t *scene, const dwv_light_desc_t *lig
             return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
                             "%s: spot_falloff %d is neither Cycles 3.x (0) nor Cycles 4.0 onward (1)", fn,
                             (int)light->spot_falloff);
+        DWV_TRY(check_point_shape(fn, light));
         break;
     }
     case DWV_LIGHT_AREA_RECTANGLE:

@@ -186,6 +186,7 @@ typedef struct surface_lobes {
     double diffuse[3]; /* the diffuse lobe's weight per channel (layered) */
     int bumped;        /* DWV_BUMP_SHADOWING_* where a normal map tilted lobe.n from smooth_n, else 0 */
     dwvu_vec3 smooth_n;
+    dwvu_vec3 specular_n; /* the specular layer's normal (4.x+: lobe.n kept valid for reflection) */
 } surface_lobes;
 
 /* The surface's glossy (f[0]: the specular layer) and diffuse (f[1]) lobes. */
@@ -203,7 +204,7 @@ static void surface_factor(const void *context, dwvu_vec3 light, double f[2][3])
     /* Cycles 3.x shadows its diffuse closures (the Lambertian, Principled diffuse and
      * retro-reflection), not the specular, where a normal map tilted them (textured.h). */
     double shadow = s->bumped ? dwvb_bump_shadowing(s->bumped, s->smooth_n, s->lobe.n, light) : 1.0;
-    dwvb_specular_factor(m, s->lobe.n, light, s->lobe.to_view, f[0]);
+    dwvb_specular_factor(m, s->specular_n, light, s->lobe.to_view, f[0]);
     for (int c = 0; c < 3; ++c) f[1][c] = (s->diffuse[c] * diffuse + m->retro_albedo[c] * retro) * shadow;
 }
 
@@ -253,8 +254,14 @@ static void exit_light(const dwvb_shader *shader, uint32_t mesh_id, const dwvb_m
     /* Cycles evaluates the exit's shader for its normal (SD_HAS_BSSRDF_BUMP): the normal map and
      * bump there, the rest of the material being the entry's. */
     dwvu_vec3 exit_smooth_n = exit_n;
-    if (dwvb_textured_normal_bound(scene, mesh_id))
+    if (dwvb_textured_normal_bound(scene, mesh_id)) {
+        /* The BSSRDF's normal there is kept valid for reflection (3.x: every closure's; 4.x+:
+         * maybe_ensure_valid_specular_reflection) with the exit's incoming direction: Cycles
+         * shades the exit as seen along the walk's last step, from outside. */
         exit_n = dwvb_textured_normal(scene, mesh_id, exit->prim, exit->u, exit->v, exit_n);
+        if (dwvb_textured_bump_shadowing(scene, mesh_id) != DWV_BUMP_SHADOWING_NONE)
+            exit_n = dwvb_valid_reflection(exit_ng, walk->direction, exit_n);
+    }
     /* Cycles shades the exit as a surface point of its triangle: the same terminator offset. */
     double cutoff = scene->terminator_offsets[mesh_id];
     dwvl_terminator exit_terminator = {mesh, exit->prim, exit->u, exit->v, cutoff};
@@ -543,12 +550,17 @@ static void shade_point(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec
     dwvu_vec3 x = dwvg_point(mesh, hit->prim, hit->u, hit->v);
     dwvu_vec3 n = dwvg_shading_normal(mesh, hit->prim, hit->u, hit->v, ng);
     dwvu_vec3 smooth_n = n;
+    /* The normal of the specular layer and of the walk's entry (the BSSRDF's); n is the diffuse lobes'. */
+    dwvu_vec3 specular_n = n;
     if (dwvb_textured_normal_bound(scene, hit->mesh)) {
-        /* Cycles 3.x's closures keep a mapped normal's mirror reflection of the view above the
-         * surface (svm_closure.h, ensure_valid_reflection); 4.x's diffuse and subsurface ones do not. */
+        /* Cycles keeps a mapped normal's mirror reflection of the view above the surface
+         * (ensure_valid_reflection): 3.x for every closure of the Principled BSDF (svm_closure.h),
+         * 4.x+ for the specular ones and the BSSRDF (maybe_ensure_valid_specular_reflection), not
+         * for the diffuse one. */
+        int mode = dwvb_textured_bump_shadowing(scene, hit->mesh);
         n = dwvb_textured_normal(scene, hit->mesh, hit->prim, hit->u, hit->v, n);
-        if (dwvb_textured_bump_shadowing(scene, hit->mesh) == DWV_BUMP_SHADOWING_CHIANG2019)
-            n = dwvb_valid_reflection(ng, dwvu_scale(view, -1.0), n);
+        specular_n = mode != DWV_BUMP_SHADOWING_NONE ? dwvb_valid_reflection(ng, dwvu_scale(view, -1.0), n) : n;
+        if (mode == DWV_BUMP_SHADOWING_CHIANG2019) n = specular_n;
     }
     int tilted = n.x != smooth_n.x || n.y != smooth_n.y || n.z != smooth_n.z;
     int bumped = tilted ? dwvb_textured_bump_shadowing(scene, hit->mesh) : DWV_BUMP_SHADOWING_NONE;
@@ -578,7 +590,8 @@ static void shade_point(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec
     double top = ng_flipped ? INFINITY : dwvg_world_top(&scene->geometry, hit->mesh, hit->prim);
     /* The layers under a 4.x+ specular keep 1 - its albedo toward the viewer (1 otherwise). */
     double cos_view = -dwvu_dot(n, view);
-    double layer = material->specular ? dwvb_specular_layer_weight(material, cos_view) : 1.0;
+    double cos_specular = -dwvu_dot(specular_n, view);
+    double layer = material->specular ? dwvb_specular_layer_weight(material, cos_specular) : 1.0;
     /* The colour passes (Cycles' surface_shader_diffuse / _glossy): the diffuse closures' weights,
      * the Lambertian's, the retro-reflection's (3.x: a diffuse BSDF of the BSSRDF's whole weight,
      * beside the BSSRDF) and the walking channels' BSSRDF (w x subsurface colour, a channel that
@@ -591,10 +604,10 @@ static void shade_point(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec
                                 : 0.0;
             color[DWVB_LOBE_DIFFUSE][c] = layer * (diffuse_albedo[c] + bssrdf) + material->retro_albedo[c];
         }
-        if (material->specular) dwvb_specular_color(material, cos_view, color[DWVB_LOBE_GLOSSY]);
+        if (material->specular) dwvb_specular_color(material, cos_specular, color[DWVB_LOBE_GLOSSY]);
     }
     surface_lobes lobes = {material, {n, dwvu_scale(view, -1.0), cos_view, material->roughness}, {0.0, 0.0, 0.0},
-                           bumped, smooth_n};
+                           bumped, smooth_n, specular_n};
     for (int c = 0; c < 3; ++c) lobes.diffuse[c] = layer * diffuse_albedo[c];
     if (material->specular || bumped) {
         /* (A tilted normal's shadowing goes through the general lobe too.) */
@@ -625,18 +638,19 @@ static void shade_point(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec
     /* The surface's lobes send a path on (the same BRDF as their direct light above). */
     if (rays && surface_path_ray(shader, &lobes, x, ng, top, onward, onward_pair, &rays[*ray_count])) ++*ray_count;
     if (!walks_left) return;
-    /* Entry: cosine-weighted about -n, rejected (no contribution, as Cycles) where it would not
-     * go below the geometric surface. The pdf cos/pi cancels the diffuse transmission f = 1/pi. */
+    /* Entry: cosine-weighted about minus the BSSRDF's normal (specular_n), rejected (no
+     * contribution, as Cycles) where it would not go below the geometric surface. The pdf cos/pi
+     * cancels the diffuse transmission f = 1/pi. */
     double u[2];
     dwvk_sampler_pair(sampler, pair, u);
     dwvu_vec3 inward;
     if (material->entry == DWVB_ENTRY_DIFFUSE) {
         double mu = sqrt(u[0]);
-        inward = dwvk_direction_about(dwvu_scale(n, -1.0), mu, 1.0 - mu, 1.0 + mu, u[1]);
+        inward = dwvk_direction_about(dwvu_scale(specular_n, -1.0), mu, 1.0 - mu, 1.0 + mu, u[1]);
     } else {
         /* Cycles 4.x+: GGX refraction (Skin: half of it), a direction distribution of unit weight
          * (subsurface_entry_bounce); none where the viewer is below the shading normal. */
-        dwvu_frame frame = dwvu_frame_about(n);
+        dwvu_frame frame = dwvu_frame_about(specular_n);
         dwvu_vec3 to_view = dwvu_scale(view, -1.0);
         dwvu_vec3 wi = dwvu_v(dwvu_dot(frame.t, to_view), dwvu_dot(frame.s, to_view), dwvu_dot(frame.n, to_view));
         dwvu_vec3 wo;

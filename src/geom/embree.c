@@ -102,32 +102,68 @@ static int failed(dwvg_world *world, char *message, size_t size, const char *wha
     return -1;
 }
 
-static int edge_order(const void *a, const void *b)
+/* Sorts the n keys of `keys`, each below 2^bits, by LSD radix sort, 16 bits a pass (scratch: n
+ * keys; counts: 65536); returns the array that holds them sorted (keys or scratch). The
+ * closed-mesh test sorts three keys per triangle: a million triangles took qsort 0.4-0.8 s. */
+static uint64_t *sort_keys(uint64_t *keys, uint64_t *scratch, size_t n, int bits, size_t *counts)
 {
-    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
-    return (x > y) - (x < y);
+    for (int shift = 0; shift < bits; shift += 16) {
+        memset(counts, 0, 65536 * sizeof *counts);
+        for (size_t e = 0; e < n; ++e) ++counts[(keys[e] >> shift) & 0xffffu];
+        size_t start = 0;
+        for (size_t d = 0; d < 65536; ++d) {
+            size_t count = counts[d];
+            counts[d] = start;
+            start += count;
+        }
+        for (size_t e = 0; e < n; ++e) scratch[counts[(keys[e] >> shift) & 0xffffu]++] = keys[e];
+        uint64_t *swap = keys;
+        keys = scratch;
+        scratch = swap;
+    }
+    return keys;
 }
 
 int dwvg_mesh_closed(const dwvg_mesh *mesh)
 {
     size_t edges = 3u * (size_t)mesh->triangle_count;
     if (edges == 0) return 0;
-    uint64_t *directed = malloc(edges * sizeof *directed);
-    if (!directed) return -1;
+    uint64_t *directed = malloc(3 * edges * sizeof *directed);
+    size_t *counts = malloc(65536 * sizeof *counts);
+    if (!directed || !counts) {
+        free(directed);
+        free(counts);
+        return -1;
+    }
+    /* An edge (from, to) as the key from * 2^b + to, b the bits of the vertex numbers: the fewer
+     * the bits, the fewer the radix passes. */
+    int b = 1;
+    while (b < 32 && (uint64_t)mesh->vertex_count > (uint64_t)1 << b) ++b;
+    uint64_t *reversed = directed + edges, *scratch = directed + 2 * edges;
     for (uint32_t t = 0; t < mesh->triangle_count; ++t) {
         const uint32_t *i = mesh->indices + 3u * (size_t)t;
-        for (int k = 0; k < 3; ++k) directed[3u * (size_t)t + (size_t)k] = (uint64_t)i[k] << 32 | i[(k + 1) % 3];
+        for (int k = 0; k < 3; ++k) {
+            uint64_t from = i[k], to = i[(k + 1) % 3];
+            directed[3u * (size_t)t + (size_t)k] = from << b | to;
+            reversed[3u * (size_t)t + (size_t)k] = to << b | from;
+        }
     }
-    qsort(directed, edges, sizeof *directed, edge_order);
-    /* Closed: no directed edge twice, and each one's reverse present (then, with the first, its
-     * undirected edge has exactly two triangles, one each way). */
+    uint64_t *sorted = sort_keys(directed, scratch, edges, 2 * b, counts);
+    if (sorted == scratch) memcpy(directed, scratch, edges * sizeof *directed);
+    sorted = sort_keys(reversed, scratch, edges, 2 * b, counts);
+    if (sorted == scratch) memcpy(reversed, scratch, edges * sizeof *reversed);
+    /* Closed: no directed edge twice, none from a vertex to itself, and each one's reverse present
+     * (then, with the first, its undirected edge has exactly two triangles, one each way). With no
+     * edge twice, the reverses are as many distinct edges, so "each reverse present" is "the
+     * sorted reverses are the sorted edges". */
     int closed = 1;
     for (size_t e = 0; e < edges && closed; ++e) {
-        uint64_t edge = directed[e], reverse = edge << 32 | edge >> 32;
-        closed = (e + 1 == edges || directed[e + 1] != edge) && (edge >> 32) != (edge & 0xffffffffu) &&
-                 bsearch(&reverse, directed, edges, sizeof *directed, edge_order) != NULL;
+        uint64_t edge = directed[e];
+        closed = (e + 1 == edges || directed[e + 1] != edge) && (edge >> b) != (edge & (((uint64_t)1 << b) - 1)) &&
+                 reversed[e] == edge;
     }
     free(directed);
+    free(counts);
     for (uint32_t t = 0; t < mesh->triangle_count && closed; ++t) closed = dwvg_triangle_area(mesh, t) > 0.0;
     return closed;
 }

@@ -28,6 +28,7 @@ void dwvl_light_init(dwvl_light *light, const dwv_light_desc_t *desc)
     light->position = light->direction = light->axis_x = light->axis_y = light->spot_axis = dwvu_v(0.0, 0.0, 0.0);
     light->spot_cos_half = light->spot_smooth = 0.0;
     light->spot_axis_cosine = 0;
+    light->sphere = 0;
     for (int c = 0; c < 3; ++c) light->emission[c] = desc->color[c] * desc->strength;
     switch (desc->kind) {
     case DWV_LIGHT_SUN: {
@@ -50,6 +51,7 @@ void dwvl_light_init(dwvl_light *light, const dwv_light_desc_t *desc)
         }
         light->position = dwvu_v(desc->position[0], desc->position[1], desc->position[2]);
         light->radius = desc->radius;
+        light->sphere = desc->point_shape == DWV_POINT_SHAPE_SPHERE && desc->radius > 0.0;
         for (int c = 0; c < 3; ++c) light->emission[c] *= INV_FOUR_PI;
         break;
     default: {
@@ -79,6 +81,63 @@ double dwvl_spot_attenuation(const dwvl_light *light, double c)
     return a;
 }
 
+/* 1 - cos of the half-angle a sphere of radius r subtends at distance d > r, from
+ * sin^2 = r^2 / d^2 without cancellation: s / (1 + sqrt(1 - s)). */
+static double sphere_one_minus_cos(double r, double d)
+{
+    double s = (r / d) * (r / d);
+    return s / (1.0 + sqrt(fmax(1.0 - s, 0.0)));
+}
+
+/* A sphere light (Cycles 4.0+ without Soft Falloff) seen from x at distance d from its centre,
+ * toward it along unit `axis`: outside, a direction uniform in the cone it subtends (pdf
+ * 1 / (2 pi (1 - cos theta_max)), dwvl_light_pdf), the nearer intersection; inside, uniform over
+ * the sphere of directions (pdf 1 / (4 pi)), the intersection ahead. Returns f with radiance /
+ * pdf = I f for the radiance I / (pi r^2), I = light->emission: 2 (1 - cos theta_max) / r^2
+ * outside, 4 / r^2 inside; *outside says which. */
+static double sphere_sample(const dwvl_light *light, dwvu_vec3 axis, double d, double u1, double u2,
+                            dwvl_sample *sample, int *outside)
+{
+    double r = light->radius, r2 = r * r;
+    *outside = d > r;
+    double mu, omc, factor;
+    if (*outside) {
+        double omc_max = sphere_one_minus_cos(r, d);
+        omc = u1 * omc_max;
+        mu = 1.0 - omc;
+        factor = 2.0 * omc_max / r2;
+    } else {
+        mu = 1.0 - 2.0 * u1;
+        omc = 2.0 * u1;
+        factor = 4.0 / r2;
+    }
+    sample->direction = dwvk_direction_about(axis, mu, omc, 2.0 - omc, u2);
+    /* Law of cosines: |x + t w - centre| = r, t = d mu -+ sqrt(r^2 - d^2 (1 - mu^2)). */
+    double root = sqrt(fmax(r2 - d * d * (1.0 - mu) * (1.0 + mu), 0.0));
+    sample->distance = *outside ? d * mu - root : d * mu + root;
+    return factor;
+}
+
+double dwvl_light_pdf(const dwvl_light *light, dwvu_vec3 x, dwvu_vec3 direction)
+{
+    if ((light->kind != DWV_LIGHT_POINT && light->kind != DWV_LIGHT_SPOT) || !(light->radius > 0.0)) return 0.0;
+    dwvu_vec3 to_centre = dwvu_sub(light->position, x);
+    double d = dwvu_length(to_centre), r = light->radius;
+    if (!(d > 0.0)) return light->sphere ? 0.25 / PI : 0.0;
+    double mu = dwvu_dot(direction, to_centre) / d;
+    if (light->sphere) {
+        if (!(d > r)) return 0.25 / PI;
+        double omc_max = sphere_one_minus_cos(r, d);
+        return 1.0 - mu <= omc_max ? 1.0 / (2.0 * PI * omc_max) : 0.0;
+    }
+    /* The disc through the centre facing x: the direction meets its plane at t = d / mu, at
+     * d tan(theta) from the centre; area density 1 / (pi r^2) -> solid angle t^2 / (pi r^2 mu). */
+    if (!(mu > 0.0)) return 0.0;
+    double t = d / mu, off2 = t * t - d * d;
+    if (!(off2 <= r * r)) return 0.0;
+    return t * t / (PI * r * r * mu);
+}
+
 void dwvl_light_sample(const dwvl_light *light, dwvu_vec3 x, double u1, double u2, dwvl_sample *sample)
 {
     double factor = 0.0;
@@ -101,6 +160,14 @@ void dwvl_light_sample(const dwvl_light *light, dwvu_vec3 x, double u1, double u
         double d = dwvu_length(to_centre);
         if (!(d > 0.0)) break;
         dwvu_vec3 axis = dwvu_scale(to_centre, 1.0 / d), t, s;
+        if (light->sphere) {
+            int outside;
+            factor = sphere_sample(light, axis, d, u1, u2, sample, &outside);
+            if (light->kind == DWV_LIGHT_SPOT && outside)
+                factor *= dwvl_spot_attenuation(light, -dwvu_dot(light->spot_axis, sample->direction));
+            if (!(sample->distance > 0.0)) factor = 0.0;
+            break;
+        }
         dwvu_vec3 q = light->position;
         if (light->radius > 0.0) {
             basis(axis, &t, &s);

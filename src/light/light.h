@@ -1,7 +1,10 @@
 /* Lights in Blender's units, as Cycles 3.4 evaluates them (intern/cycles/kernel/light/,
  * scene/light.cpp), with emission closures of value 1 x strength (kernel/closure/emissive.h):
  *   point, power P, colour c: intensity I = P c / (4 pi) W/sr (eval_fac 1/(4 pi) x 1/(pi r^2) on a
- *       disc of radius r facing the shaded point, radiance P c / (4 pi^2 r^2));
+ *       disc of radius r facing the shaded point, radiance P c / (4 pi^2 r^2)); Cycles 4.0 onward
+ *       without Soft Falloff (kernel/light/point.h, is_sphere): a sphere of radius r with that
+ *       radiance, sampled uniformly in the cone it subtends (inside it: uniformly over all
+ *       directions);
  *   area, power P: one-sided radiance L = P c / (4 A) along the light's local -z
  *       (eval_fac 0.25 / A), A the rectangle's or ellipse's area;
  *   sun, strength S (W/m^2): irradiance S c on a surface facing it, from a cone of the angular
@@ -11,7 +14,8 @@
  *       from the light toward the shaded point (Cycles' spot_light_attenuation, with
  *       spot_angle = cos(spot_size / 2) and spot_smooth = (1 - spot_angle) x spot_blend as
  *       scene/light.cpp sets them): c = axis.w; 0 for c <= spot_angle; else c (Cycles 3.x) or 1
- *       (4.0 onward), times smoothstep((c - spot_angle) / spot_smooth) where that is below 1;
+ *       (4.0 onward), times smoothstep((c - spot_angle) / spot_smooth) where that is below 1
+ *       (a sphere spot: the same, none from inside the sphere, as Cycles' spot.h);
  *   world: constant radiance colour x strength.
  * A sample returns the direction toward the light, the distance, and the radiance divided by the
  * solid-angle pdf: for a Lambertian surface of albedo rho, rho/pi x value x cos x visibility
@@ -37,6 +41,7 @@ typedef struct dwvl_light {
     double spot_cos_half;      /* spot: cos(spot_size / 2) */
     double spot_smooth;        /* spot: (1 - spot_cos_half) x spot_blend */
     int spot_axis_cosine;      /* spot: 1 for Cycles 3.x's extra factor c */
+    int sphere;                /* point, spot of radius > 0: DWV_POINT_SHAPE_SPHERE (else the disc) */
 } dwvl_light;
 
 /* The spot attenuation of a spot light for c, the cosine between its axis and the direction from
@@ -62,5 +67,10 @@ static inline int dwvl_light_below(const dwvl_light *light, dwvu_vec3 n)
 
 /* Samples the light as seen from x with two uniform numbers. */
 void dwvl_light_sample(const dwvl_light *light, dwvu_vec3 x, double u1, double u2, dwvl_sample *sample);
+/* The solid-angle density at x of dwvl_light_sample's direction `direction` (unit) for a point or
+ * spot light of radius > 0 (disc or sphere); 0 for a direction it never gives, and for the other
+ * kinds (a point of radius 0 and a sun of angle 0 are deltas; the area lights are sampled by area).
+ * A sample's value is the light's radiance along its direction divided by this. */
+double dwvl_light_pdf(const dwvl_light *light, dwvu_vec3 x, dwvu_vec3 direction);
 
 #endif

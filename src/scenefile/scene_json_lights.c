@@ -11,11 +11,13 @@ static dwv_result_t read_light(dwvs_parser *ps, const cJSON *item, const char *p
     static const char *const kinds[] = {"sun", "point", "area", "spot"};
     static const char *const shapes[] = {"rectangle", "disk"};
     static const char *const sun_keys[] = {"kind", "color", "strength", "direction", "angle"};
-    static const char *const point_keys[] = {"kind", "color", "strength", "position", "radius"};
+    static const char *const point_keys[] = {"kind", "color", "strength", "position", "radius", "point_shape"};
     static const char *const area_keys[] = {"kind", "shape", "color", "strength", "transform", "size_x", "size_y"};
     static const char *const spot_keys[] = {"kind",       "color",      "strength", "position",    "radius",
-                                            "direction",  "spot_size",  "spot_blend", "spot_falloff"};
+                                            "direction",  "spot_size",  "spot_blend", "spot_falloff",
+                                            "point_shape"};
     static const char *const falloffs[] = {"cycles3", "cycles4"};
+    static const char *const point_shapes[] = {"disc", "sphere"}; /* DWV_POINT_SHAPE_* in order */
     if (!cJSON_IsObject(item))
         return dwvs_fail_at(DWV_ERROR_FORMAT, path, "expected an object, found %s", dwvs_type_name(item));
     const cJSON *kind_item = dwvs_member(item, "kind");
@@ -46,6 +48,9 @@ static dwv_result_t read_light(dwvs_parser *ps, const cJSON *item, const char *p
         light.kind = DWV_LIGHT_POINT;
         DWV_TRY(dwvs_opt_vector(item, path, "position", 3, light.position));
         DWV_TRY(dwvs_opt_number(item, path, "radius", &light.radius));
+        size_t point_shape = 0;
+        DWV_TRY(dwvs_opt_choice(item, path, "point_shape", point_shapes, 2, &point_shape));
+        light.point_shape = (int32_t)point_shape;
     } else if (kind == 3) {
         light.kind = DWV_LIGHT_SPOT;
         DWV_TRY(dwvs_opt_vector(item, path, "position", 3, light.position));
@@ -58,6 +63,9 @@ static dwv_result_t read_light(dwvs_parser *ps, const cJSON *item, const char *p
         size_t falloff = 0;
         DWV_TRY(dwvs_opt_choice(item, path, "spot_falloff", falloffs, 2, &falloff));
         light.spot_falloff = falloff == 0 ? DWV_SPOT_FALLOFF_CYCLES3 : DWV_SPOT_FALLOFF_CYCLES4;
+        size_t point_shape = 0;
+        DWV_TRY(dwvs_opt_choice(item, path, "point_shape", point_shapes, 2, &point_shape));
+        light.point_shape = (int32_t)point_shape;
     } else {
         size_t shape = 0;
         DWV_TRY(dwvs_opt_choice(item, path, "shape", shapes, 2, &shape));

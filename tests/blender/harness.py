@@ -201,3 +201,15 @@ def compare_two_seeds(cycles_pair, ours_pair):
         "noise_ratio_rgb": ratios, "relative_standard_error_rgb": errors,
         "nan_pixels": sum(1 for v in ours if v != v),
     }
+
+
+def assert_agreement(test, figures, mean_tolerance=0.02, noise_ratio_limit=1.5):
+    """The bounds of the Cycles comparisons (compare_two_seeds' figures) on unittest case `test`:
+    every channel has signal in Cycles, its mean within `mean_tolerance` of Cycles' and its noise
+    ratio below `noise_ratio_limit`."""
+    for c in range(3):
+        cm, om = figures["cycles_mean_rgb"][c], figures["dwivedi_mean_rgb"][c]
+        test.assertGreater(cm, 1e-3, f"channel {c} has signal in Cycles")
+        test.assertLess(abs(om / cm - 1.0), mean_tolerance, f"channel {'RGB'[c]}: dwivedi {om:.5f} vs Cycles {cm:.5f}")
+        test.assertLess(figures["noise_ratio_rgb"][c], noise_ratio_limit,
+                        f"channel {'RGB'[c]}: per-pixel differences exceed the noise")

@@ -1,10 +1,12 @@
-"""Image textures against Cycles, headless (Blender on the host): a smooth UV sphere whose
+"""Image textures against Cycles, headless (the host's Blender 3.4, and through
+tests/blender/run_package_tests.py --script test_textures.py the chroots' 4.3 and 5.2: ctest
+blender.test_textures, blender.textures.trixie, .sid): a smooth UV sphere whose
 Principled BSDF takes its Base Color from a generated colour-grid Image Texture (8-bit sRGB, the
 sphere's UV map) and its Normal from a Normal Map node fed by a generated tangent-space normal
 map (8-bit Non-Color, through a UV Map node), lit by a sun; once as wax (Blender 3.x Subsurface
-0.5: the walk's colour is mix(Base Color, Subsurface Color, 0.5) per entry point) and once as
-diffuse (Subsurface 0). Rendered by Cycles and baked by the add-on twice with different seeds at
-32 x 32, then:
+0.5: the walk's colour is mix(Base Color, Subsurface Color, 0.5) per entry point; 4.x+ Subsurface
+Weight 0.5: half Lambertian, half a walk of the Base Color) and once as diffuse (Subsurface 0). Rendered by Cycles and baked by the add-on (with Cycles' cap of 256
+events per walk) twice with different seeds at 32 x 32, then (harness.compare_two_seeds):
 
 - mean radiance per channel within 2%;
 - per-pixel differences consistent with noise: R = sum (ours - cycles)^2 / sum (var_ours +
@@ -35,7 +37,8 @@ CYCLES_SAMPLES = 256       # per seed; two seeds
 DWIVEDI_SAMPLES = 128      # per seed; two seeds
 MEAN_TOLERANCE = 0.02
 NOISE_RATIO_LIMIT = 1.5
-FIGURES = {}
+CYCLES_EVENT_CAP = 256
+FIGURES = {"blender_version": list(bpy.app.version)}
 
 
 def colour_grid():
@@ -94,33 +97,21 @@ def textured_sphere(resolution, samples, subsurface, base=True, normal=True):
 
 def compare(name, build):
     scene = build(RESOLUTION, CYCLES_SAMPLES)
-    c1, tc1 = harness.cycles_render(scene, 1, CYCLES_SAMPLES, WORK / f"{name}_cycles_1.exr")
-    c2, tc2 = harness.cycles_render(scene, 2, CYCLES_SAMPLES, WORK / f"{name}_cycles_2.exr")
-    o1, to1 = harness.dwivedi_bake(scene, 1, DWIVEDI_SAMPLES, WORK / f"{name}_dwivedi_1")
-    o2, to2 = harness.dwivedi_bake(scene, 2, DWIVEDI_SAMPLES, WORK / f"{name}_dwivedi_2")
-    cycles = [(a + b) / 2 for a, b in zip(c1, c2)]
-    ours = [(a + b) / 2 for a, b in zip(o1, o2)]
-    n = len(ours) // 4
-    cm = [sum(cycles[c::4]) / n for c in range(3)]
-    om = [sum(ours[c::4]) / n for c in range(3)]
-    ratios = []
-    for c in range(3):
-        num = sum((ours[i] - cycles[i]) ** 2 for i in range(c, len(ours), 4))
-        den = sum(((o1[i] - o2[i]) ** 2 + (c1[i] - c2[i]) ** 2) / 4 for i in range(c, len(ours), 4))
-        ratios.append(num / den if den > 0 else (0.0 if num == 0 else math.inf))
+    cycles = [harness.cycles_render(scene, seed, CYCLES_SAMPLES, WORK / f"{name}_cycles_{seed}.exr") for seed in (1, 2)]
+    # Cycles' own cap of 256 events per walk (BSSRDF_MAX_BOUNCES), as test_fidelity.py.
+    ours = [harness.dwivedi_bake(scene, seed, DWIVEDI_SAMPLES, WORK / f"{name}_dwivedi_{seed}", CYCLES_EVENT_CAP)
+            for seed in (1, 2)]
+    figures = harness.compare_two_seeds([p for p, _ in cycles], [p for p, _ in ours])
     # The exported scene's texture memory, as the add-on builds it (its own modules and shim).
-    import importlib
-    addon = importlib.import_module("dwivedi_bake")
+    addon = harness.addon_module()
     exported = addon.export.export_scene(bpy.context, scene.dwivedi_bake, addon.shim())
     size, texels = exported.scene.texture_memory()
     exported.scene.close()
-    texture_warnings = [w for w in exported.warnings if "material" in w]
-    figures = {
-        "cycles_mean_rgb": cm, "dwivedi_mean_rgb": om,
-        "relative_difference_rgb": [(o - c) / c if c > 0 else None for o, c in zip(om, cm)],
-        "noise_ratio_rgb": ratios, "cycles_seconds": tc1 + tc2, "dwivedi_seconds": to1 + to2,
-        "texture_bytes_per_texel": size / texels if texels else None, "warnings": texture_warnings,
-    }
+    figures.update({
+        "cycles_seconds": sum(t for _, t in cycles), "dwivedi_seconds": sum(t for _, t in ours),
+        "texture_bytes_per_texel": size / texels if texels else None,
+        "warnings": [w for w in exported.warnings if "material" in w],
+    })
     FIGURES[name] = figures
     print(f"\n{name}: " + json.dumps(figures, indent=1), flush=True)
     (harness.HOME / "texture_figures.json").write_text(json.dumps(FIGURES, indent=2))

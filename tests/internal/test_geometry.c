@@ -112,8 +112,47 @@ static void test_memory(void)
     test_mesh_free(&sphere);
 }
 
+/* dwvg_mesh_closed (a radix sort of the directed edges against their reverses since issue 20,
+ * qsort and bsearch before): a tetrahedron is closed; one face left out, a face twice, a face
+ * turned over, an edge from a vertex to itself or a face of zero area make it not. A UV sphere
+ * of 36,480 triangles (vertex numbers past 2^16: every radix pass sorts) is closed, and open
+ * with one triangle taken out. */
+static int closed_of(const float *positions, uint32_t vertex_count, const uint32_t *indices, uint32_t triangles)
+{
+    static const double identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+    dwvg_mesh mesh;
+    CHECK(dwvg_mesh_init(&mesh, vertex_count, triangles, 0, positions, indices, NULL, NULL, identity) == 0,
+          "mesh init");
+    int closed = dwvg_mesh_closed(&mesh);
+    dwvg_mesh_free(&mesh);
+    return closed;
+}
+
+static void test_closed(void)
+{
+    static const float p[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 1, 1};
+    static const uint32_t tetra[] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+    CHECK(closed_of(p, 4, tetra, 4) == 1, "a tetrahedron is closed");
+    CHECK(closed_of(p, 4, tetra, 3) == 0, "a tetrahedron without a face is open");
+    static const uint32_t twice[] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3, 1, 2, 3};
+    CHECK(closed_of(p, 4, twice, 5) == 0, "a face twice is not closed");
+    static const uint32_t turned[] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 3, 2};
+    CHECK(closed_of(p, 4, turned, 4) == 0, "a face turned over is not closed");
+    static const uint32_t self_edge[] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3, 4, 4, 4, 4, 4, 4};
+    CHECK(closed_of(p, 5, self_edge, 6) == 0, "an edge from a vertex to itself is not closed");
+    static const float flat[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0.5f, 0, 0}; /* face 0, 1, 3 on a line */
+    CHECK(closed_of(flat, 4, tetra, 4) == 0, "a face of zero area: not closed");
+    test_mesh sphere = test_sphere(0.0, 0.0, 0.0, 1.0, 96, 192);
+    CHECK(closed_of(sphere.positions, sphere.vertex_count, sphere.indices, sphere.triangle_count) == 1,
+          "a UV sphere of %u triangles is closed", sphere.triangle_count);
+    CHECK(closed_of(sphere.positions, sphere.vertex_count, sphere.indices + 3, sphere.triangle_count - 1) == 0,
+          "the UV sphere without its first triangle is open");
+    test_mesh_free(&sphere);
+}
+
 int main(void)
 {
+    test_closed();
     test_closest_and_rays();
     test_warnings();
     test_memory();

@@ -102,7 +102,8 @@ class FakeMesh:
         loops, starts, totals = polygon_arrays(faces, reverse=True)
         self.vertices = Collection(len(points), co=flat(points))
         self.loops = Collection(len(loops), vertex_index=loops)
-        self.polygons = Collection(len(faces), loop_start=starts, loop_total=totals)
+        self.smooth = [1] * len(faces)
+        self.polygons = Collection(len(faces), loop_start=starts, loop_total=totals, use_smooth=self.smooth)
         self.corner_vertices, polygon = [], []
         for p, face in enumerate(faces):
             for k in range(1, len(face) - 1):
@@ -153,14 +154,14 @@ class SettleCornerNormalsTest(unittest.TestCase):
     def setUp(self):
         points, faces = uv_sphere()
         self.mesh = FakeMesh(points, faces)
-        self.smooth = array.array("b", [1] * len(faces))
+        self.smooth = self.mesh.smooth
         self.smooth[3] = 0  # a flat pole triangle keeps its face normal
         self.blender = array.array("f", [c for v in self.mesh.corner_vertices for c in points[v]])
         self.rng = random.Random(5)
 
     def settle(self, given, version=(3, 4, 1)):
         out = array.array("f", given)
-        normals.settle_corner_normals(self.mesh, self.mesh.corner_vertices, out, self.smooth, version)
+        normals.settle_corner_normals(self.mesh, self.mesh.corner_vertices, out, version)
         return out
 
     def test_the_same_bits_whatever_the_jitter(self):
