@@ -348,13 +348,15 @@ def evaluate_objects(objects: List[Any], shader_of: Any, blender4: bool, size: i
     for material, sockets, evaluations in made.values():
         maps = sorted({uv for uv, _ in evaluations.values()})
         users = sum(len(names) for _, names in evaluations.values())
-        each = (f"once for its {users} objects" if len(evaluations) == 1 and users > 1 else
-                f"{len(evaluations)} times (per object{'' if len(evaluations) == users else ' or mesh'}: each "
-                "object's own images)" if len(evaluations) > 1 else "")
+        if len(evaluations) > 1:
+            each = (f" {len(evaluations)} times (each object's own images"
+                    f"{'' if len(evaluations) == users else ', shared by the objects of one mesh'})")
+        else:
+            each = f" once for its {users} objects (one mesh)" if users > 1 else ""
+        uv_maps = f"UV map{'s' if len(maps) > 1 else ''} {', '.join(repr(m) for m in maps)}"
+        normal = any(s.name == "Normal" for s in sockets)
         warnings.append(f"material '{material.name}': {', '.join(repr(s.name) for s in sockets)} driven by node "
-                        f"trees, evaluated by Blender into {size} x {size} images on UV map"
-                        f"{'s' if len(maps) > 1 else ''} {', '.join(repr(m) for m in maps)}{' ' + each if each else ''} "
-                        "(detail finer than that is lost; set Texture Bake Size)"
-                        + ("; the Normal as a tangent-space normal map" + BUMP_FIGURES
-                           if any(s.name == "Normal" for s in sockets) else ""))
+                        f"trees, evaluated by Blender into {size} x {size} images on {uv_maps}{each} (detail finer "
+                        "than that is lost; set Texture Bake Size)"
+                        + ("; the Normal as a tangent-space normal map" + BUMP_FIGURES if normal else ""))
     return images

@@ -8,7 +8,8 @@ interpolation, and the UV map it reads (the UV Map node's, else the mesh's activ
 Anything else linked to an input (a Mapping node, a procedural texture, a Mix node..., and a
 Normal input fed by anything but those nodes) is evaluated by Blender into an image first
 (evaluate.py: an emission bake, or for the Normal a tangent-space normal bake bound as a normal
-map), per material of each object.
+map), per material of each object, or once for the objects of one mesh where the result cannot
+differ; each object's material then reads its own evaluation's images (OWNERS, evaluation_of).
 """
 from __future__ import annotations
 
