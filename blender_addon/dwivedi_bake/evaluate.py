@@ -19,7 +19,8 @@ every other slot (another material, an empty slot, a material without nodes or f
 a throwaway material whose faces Cycles writes into a throwaway image (Cycles writes each face
 into its own material's active image). The bake's settings are the operator's arguments; the
 render engine and samples, the selection and the active object are set for it and put back.
-The copies and images are removed once the pixels are read. The resolution is the user's
+The copies and images are removed once the pixels are read. (An Object Info node's Random is
+the copy's, not the object's: warned.) The resolution is the user's
 (scene.dwivedi_bake.texture_bake_size) and the warning states it; texture detail finer than it
 is lost.
 """
@@ -294,6 +295,21 @@ def _bake_socket(obj: Any, material: Any, socket: Any, size: int, warnings: Opti
     return image
 
 
+def _reads_object_random(tree: Any, seen: Optional[set] = None) -> bool:
+    """Whether a node tree (or a group in it) reads an Object Info node's Random, which Cycles
+    hashes from the object's name: the evaluation's copy of the object has a name of its own."""
+    seen = set() if seen is None else seen
+    if tree is None or tree.as_pointer() in seen:
+        return False
+    seen.add(tree.as_pointer())
+    for node in tree.nodes:
+        if node.type == 'OBJECT_INFO' and node.outputs["Random"].is_linked:
+            return True
+        if node.type == 'GROUP' and _reads_object_random(node.node_tree, seen):
+            return True
+    return False
+
+
 def _owner(obj: Any, sockets: List[Any]) -> str:
     """Whose images an object's material reads: its mesh's, shared by every object of that mesh
     data block, when the mesh alone decides the evaluated inputs (no modifiers, and inputs that
@@ -333,6 +349,10 @@ def evaluate_objects(objects: List[Any], shader_of: Any, blender4: bool, size: i
                 owner = _owner(original, sockets)
                 evaluation = (material.name_full, owner)
                 textures.OWNERS[(material.name_full, original.name_full)] = evaluation
+                if material.name_full not in made and _reads_object_random(material.node_tree):
+                    warnings.append(f"material '{material.name}': an Object Info node's Random is evaluated on a "
+                                    "copy of each object, whose random number is not the object's (Cycles hashes "
+                                    "it from the name)")
                 entry = made.setdefault(material.name_full, (material, sockets, {}))
                 if owner in entry[2]:
                     entry[2][owner][1].append(original.name)

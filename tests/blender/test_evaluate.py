@@ -12,7 +12,8 @@ host's Blender 3.4 (ctest blender.test_evaluate) and through tests/blender/run_p
 - which inputs are evaluated once for every object: reads_only_mesh on UV, generated and
   attribute trees (also through a node group) is true, on the world position, a Bump and
   another object's coordinates false; linked duplicates (one mesh, no modifiers) share one
-  evaluation, a modifier or a world-position tree makes one per object;
+  evaluation, a modifier or a world-position tree makes one per object; an Object Info's
+  Random (the copy's, evaluated) is warned about;
 - a strong procedural bump (Bump of Distance 0.3 over a Wave Texture, tilts past the 45 degrees
   Blender's normal bake keeps): its mean within 2% of Cycles' (the bump moves it by more than
   4%), and a bump that cannot be scaled past that limit is warned about with its share;
@@ -170,7 +171,11 @@ class SharedMaterialTest(harness.unittest.TestCase):
         self.assertIn("2 times", evaluation_warning(export(scene), "Clay"))
         twin.modifiers.clear()
         tree.links.new(tree.nodes.new("ShaderNodeNewGeometry").outputs["Position"], base)
-        self.assertIn("2 times", evaluation_warning(export(scene), "Clay"))
+        warnings = export(scene)
+        self.assertIn("2 times", evaluation_warning(warnings, "Clay"))
+        self.assertFalse([w for w in warnings if "Object Info" in w], warnings)
+        tree.links.new(tree.nodes.new("ShaderNodeObjectInfo").outputs["Random"], base)
+        self.assertTrue([w for w in export(scene) if "Object Info node's Random" in w])
 
 
 def bumped_sphere(distance, resolution=24, samples=128, strength_linked=False, size=512):
