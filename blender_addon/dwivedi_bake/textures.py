@@ -60,9 +60,10 @@ class EvaluatedImage:
 
 
 # What an object's material was evaluated as (evaluate.py): the evaluation (material name, owner)
-# whose images it reads, owner None for a material evaluated once for every object, else the
-# object or mesh the images were made on. Per (material name, object name); an object missing
-# here reads the owner-less images (none, if its material was evaluated per object).
+# whose images it reads, the owner "mesh NAME" (images shared by the objects of that mesh) or
+# "object NAME". Per (material name, object name); an object missing here (its material had
+# nothing to evaluate, or the object was not evaluated) has the evaluation (material name, None),
+# which has no images.
 Evaluation = Tuple[str, Optional[str]]
 OWNERS: Dict[Tuple[str, str], Evaluation] = {}
 # Inputs whose node trees Blender evaluated into images, per (evaluation, node name, input
