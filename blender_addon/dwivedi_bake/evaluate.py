@@ -6,21 +6,163 @@ Image Texture through a Normal Map or Bump node is baked as Blender's normal bak
 NORMAL, tangent space of the active UV map: the shading normal as 0.5 + 0.5 (x, y, z) in its
 MikkTSpace frame) and bound as a tangent-space normal map of that UV map, which maps it back.
 
-An object with several materials is baked per material: the material being evaluated gets the
-target image, every other material of the object a throwaway image for its own faces (Cycles
-writes each face into its own material's active image), so each material's image holds its
-faces only. The materials are changed only for the bake and restored (their links, nodes, the
-scene's render settings, the selection), and the images are removed once their pixels are read.
-The resolution is the user's (scene.dwivedi_bake.texture_bake_size) and the warning states it;
-texture detail finer than it is lost.
+Per object: an image in UV space holds the input at the object's own surface points, so it is
+right only for the UVs it was baked on. A material shared by several objects is evaluated once
+for all the objects that evaluate the same surface the same way (the same mesh data without
+modifiers, when the input reads nothing but the mesh: see reads_only_mesh), and otherwise once
+per object; each library material of those (export.py) is bound to its own images.
+
+Nothing of the user's is changed: the bake runs on a temporary copy of the object (same mesh,
+modifiers, transform and parent) whose material slots are its own, holding a temporary copy of
+the evaluated material (the emission wiring and the target image node are made there) and, on
+every other slot (another material, an empty slot, a material without nodes or from a library),
+a throwaway material whose faces Cycles writes into a throwaway image (Cycles writes each face
+into its own material's active image). The bake's settings are the operator's arguments; the
+render engine and samples, the selection and the active object are set for it and put back.
+The copies and images are removed once the pixels are read. (An Object Info node's Random is
+the copy's, not the object's: warned.) The resolution is the user's
+(scene.dwivedi_bake.texture_bake_size) and the warning states it; texture detail finer than it
+is lost.
 """
 from __future__ import annotations
 
-from typing import Any, List
+import array
+from typing import Any, Dict, List, Optional, Tuple
 
 import bpy
 
 from . import textures
+
+
+class EvaluationError(Exception):
+    """Blender could not evaluate an input (its bake failed): the message says which and why."""
+
+
+# Nodes whose outputs depend on their inputs only (and on their own settings).
+_PURE = {"MATH", "VECT_MATH", "MIX_RGB", "MIX", "VALTORGB", "RGB", "VALUE", "SEPRGB", "COMBRGB", "SEPXYZ",
+         "COMBXYZ", "SEPHSV", "COMBHSV", "SEPARATE_COLOR", "COMBINE_COLOR", "HUE_SAT", "BRIGHTCONTRAST", "GAMMA",
+         "INVERT", "CURVE_RGB", "CURVE_VEC", "CURVE_FLOAT", "MAP_RANGE", "CLAMP", "RGBTOBW", "BLACKBODY",
+         "WAVELENGTH", "MAPPING", "NORMAL", "REROUTE", "VECTOR_ROTATE", "FRAME", "GROUP_INPUT"}
+# Textures: their Vector input (or, unlinked, the mesh's generated coordinates or UV map).
+_TEXTURES = {"TEX_NOISE", "TEX_VORONOI", "TEX_WAVE", "TEX_MAGIC", "TEX_CHECKER", "TEX_BRICK", "TEX_GRADIENT",
+             "TEX_MUSGRAVE", "TEX_WHITE_NOISE", "TEX_IMAGE", "TEX_GABOR"}
+# Sources read from the mesh alone (the same for every object of one mesh without modifiers).
+_MESH_SOURCES = {"UVMAP", "VERTEX_COLOR", "TANGENT"}
+# Texture Coordinate outputs in the mesh's own space (Object: unless the node names another object).
+_MESH_COORDINATES = {"Generated", "UV", "Normal", "Object"}
+
+
+def _node_reads_only_mesh(node: Any, output: Any, groups: Tuple[Any, ...], seen: set) -> bool:
+    kind = node.type
+    if kind == 'TEX_COORD':
+        return output.name in _MESH_COORDINATES and (output.name != "Object" or node.object is None)
+    if kind == 'ATTRIBUTE':
+        return getattr(node, "attribute_type", 'GEOMETRY') == 'GEOMETRY'
+    if kind == 'UVMAP' and getattr(node, "from_instancer", False):
+        return False
+    if kind == 'GROUP_INPUT':
+        # The group node's input of that identifier, in the tree around the group.
+        if not groups:
+            return False
+        outer = groups[-1]
+        socket = next((s for s in outer.inputs if s.identifier == output.identifier), None)
+        return socket is None or _socket_reads_only_mesh(socket, groups[:-1], seen)
+    if kind == 'GROUP':
+        if node.node_tree is None:
+            return True
+        inner = next((n for n in node.node_tree.nodes if n.type == 'GROUP_OUTPUT' and n.is_active_output),
+                     next((n for n in node.node_tree.nodes if n.type == 'GROUP_OUTPUT'), None))
+        socket = None if inner is None else next((s for s in inner.inputs if s.identifier == output.identifier), None)
+        return socket is None or _socket_reads_only_mesh(socket, groups + (node,), seen)
+    if kind not in _PURE and kind not in _TEXTURES and kind not in _MESH_SOURCES:
+        return False  # the camera, a light path, the world position, an object's info, a bump...
+    return all(_socket_reads_only_mesh(s, groups, seen) for s in node.inputs)
+
+
+def _socket_reads_only_mesh(socket: Any, groups: Tuple[Any, ...], seen: set) -> bool:
+    for link in socket.links:
+        if not link.is_valid or link.is_muted:
+            continue
+        key = (tuple(g.as_pointer() for g in groups), link.from_node.as_pointer(), link.from_socket.identifier)
+        if key in seen:
+            continue
+        seen.add(key)
+        if not _node_reads_only_mesh(link.from_node, link.from_socket, groups, seen):
+            return False
+    return True
+
+
+def reads_only_mesh(socket: Any) -> bool:
+    """Whether the value linked into `socket` depends on the shaded mesh alone (its UV maps,
+    generated and object-space coordinates, attributes, tangents, through nodes that compute
+    from their inputs): then every object of one mesh data block without modifiers evaluates it
+    to the same image. Anything else (world positions, a Bump's world-space gradient, another
+    object's space, an object's info, the camera, a node not known here) may differ per object."""
+    return _socket_reads_only_mesh(socket, (), set())
+
+
+# Blender's normal bake looks at each texel along the smooth normal, and its BSDFs keep the normal
+# valid for reflection of that direction (Cycles' ensure_valid_reflection: R = 2 (N.I) N - I above
+# the surface, so N within about 45 degrees of it): a bump tilted further comes out at 45 degrees
+# (measured in 3.4: a Wave bump of Distance 0.3 has tangents of its tilt up to 3.0, the bake gave
+# 1.08 and a third of its texels at the limit; the bake was 3-5% brighter than Cycles). A Bump
+# node's tilt is linear in its Distance in the tangent frame (svm_node_set_bump: the normal is
+# normalize(|det| N - Distance sign(det) surfgrad), surfgrad orthogonal to N), so the bump is
+# baked with Distance x BUMP_SCALE, within the limit up to tangents of 1 / BUMP_SCALE, and its
+# tangent-space x and y divided by BUMP_SCALE after; its Strength mix is applied after too.
+BUMP_SCALE = 1.0 / 16.0
+# What evaluating a bump into an image leaves (said with every evaluated Normal): the image's
+# texels hold the bump's normal at their centres, interpolated linearly between them, and Cycles'
+# render takes the bump's finite differences over each pixel's footprint (ray differentials).
+# Measured (tests/blender/test_evaluate.py's sphere, a Wave Texture bump of Distance 0.3, tilts
+# up to 70 degrees, 24 x 24 pixels, one seed of 64 samples each, 512: the test's two seeds; the
+# three channels' means differ alike). Evaluated without BUMP_SCALE, 3.4 gave +4.8% / +3.8% / +3.3%
+# at 128 / 256 / 1024.
+BUMP_FIGURES = ("; a strong bump comes out smoother than Cycles renders it: a Wave bump of Distance 0.3 gave "
+                "means +1.7% (Blender 3.4), +5.1% (4.3), +8.1% (5.2) above Cycles' at 128 x 128, "
+                "+1.1% / +1.7% / +2.9% at 256 x 256, +0.7% / +0.3% / +1.0% at 512 x 512 and +0.7% / +0.2% / +0.7% at "
+                "1024 x 1024")
+# The z (cosine to the smooth normal) at or below which a baked normal is taken as clamped.
+CLAMPED_Z = 0.72
+
+
+def _scalable_bump(socket: Any) -> Optional[Any]:
+    """The Bump node feeding the Normal input `socket` straight, if its tilt can be scaled (its
+    Strength and Distance unlinked, its own Normal input unlinked: the smooth normal)."""
+    node = socket.links[0].from_node if socket.is_linked else None
+    if node is None or node.type != 'BUMP':
+        return None
+    if node.inputs["Strength"].is_linked or node.inputs["Distance"].is_linked or node.inputs["Normal"].is_linked:
+        return None
+    return node
+
+
+def _baked_normals(image: Any, strength: Optional[float]) -> float:
+    """The fraction of a normal bake's covered texels (the others hold the cleared black, not of
+    unit length) at the bake's limit (CLAMPED_Z). With a `strength`, the image was baked with
+    BUMP_SCALE and is rewritten: (x, y) / BUMP_SCALE, renormalised, then mixed with the smooth
+    normal (0, 0, 1) by the Bump's strength (svm_node_set_bump: normalize(strength N_bump +
+    (1 - strength) N))."""
+    pixels = array.array("f", [0.0]) * len(image.pixels)
+    image.pixels.foreach_get(pixels)
+    covered = clamped = 0
+    scale = 1.0 / BUMP_SCALE
+    for k in range(0, len(pixels), 4):
+        x, y, z = 2.0 * pixels[k] - 1.0, 2.0 * pixels[k + 1] - 1.0, 2.0 * pixels[k + 2] - 1.0
+        if abs(x * x + y * y + z * z - 1.0) >= 0.05:
+            continue
+        covered += 1
+        clamped += z <= CLAMPED_Z
+        if strength is None:
+            continue
+        x, y = x * scale, y * scale
+        length = (x * x + y * y + z * z) ** 0.5
+        x, y, z = strength * x / length, strength * y / length, strength * z / length + (1.0 - strength)
+        half = 0.5 / (x * x + y * y + z * z) ** 0.5
+        pixels[k], pixels[k + 1], pixels[k + 2] = 0.5 + half * x, 0.5 + half * y, 0.5 + half * z
+    if strength is not None:
+        image.pixels.foreach_set(pixels)
+    return clamped / max(covered, 1)
 
 
 def _active_output(tree: Any) -> Any:
@@ -30,117 +172,214 @@ def _active_output(tree: Any) -> Any:
     return next((node for node in tree.nodes if node.type == 'OUTPUT_MATERIAL'), None)
 
 
-def _bake_socket(obj: Any, material: Any, socket: Any, size: int) -> Any:
+def _matching_socket(tree: Any, socket: Any) -> Any:
+    node = tree.nodes.get(socket.node.name)
+    return None if node is None else next((s for s in node.inputs if s.identifier == socket.identifier), None)
+
+
+class _SceneState:
+    """What the bake sets on the scene and view layer (the render engine and samples, the
+    selection and the active object), taken before and put back after."""
+
+    def __init__(self, scene: Any, view_layer: Any) -> None:
+        self.scene, self.view_layer = scene, view_layer
+        self.engine, self.samples = scene.render.engine, scene.cycles.samples
+        self.selected = [o for o in view_layer.objects if o.select_get()]
+        self.active = view_layer.objects.active
+
+    def restore(self) -> None:
+        self.scene.render.engine, self.scene.cycles.samples = self.engine, self.samples
+        for o in self.view_layer.objects:
+            if o.select_get():
+                o.select_set(False)
+        for o in self.selected:
+            o.select_set(True)
+        self.view_layer.objects.active = self.active
+
+
+def _bake_socket(obj: Any, material: Any, socket: Any, size: int, warnings: Optional[List[str]] = None) -> Any:
     """A float image of `socket`'s value (the Normal input: the tangent-space normal map of the
-    shading normal) over the object's active UV map, on the faces of `material`."""
+    shading normal, a Bump's scaled: BUMP_SCALE) over the object's active UV map, on the faces of
+    `material`; baked on a copy of the object (the module's comment). EvaluationError if
+    Blender's bake fails. A normal still at the bake's limit is said in `warnings`."""
     normal = socket.name == "Normal"
-    tree = material.node_tree
-    output = _active_output(tree)
+    scene = bpy.context.scene
+    view_layer = bpy.context.view_layer
     image = bpy.data.images.new(f"dwivedi {material.name} {socket.name}", size, size, alpha=False, float_buffer=True)
     image.colorspace_settings.name = 'Non-Color'
-    emission = None if normal else tree.nodes.new("ShaderNodeEmission")
-    target = tree.nodes.new("ShaderNodeTexImage")
-    target.image = image
-    surface = output.inputs["Surface"]
-    previous = [link.from_socket for link in surface.links]
-    active = tree.nodes.active
-    # The object's other materials write their faces into a throwaway image.
-    others = []
-    spare = None
-    for slot in obj.material_slots:
-        other = slot.material
-        if other is None or other == material or other.node_tree is None or any(o[0] == other for o in others):
-            continue
-        if spare is None:
-            spare = bpy.data.images.new("dwivedi spare", 8, 8, alpha=False, float_buffer=True)
-        node = other.node_tree.nodes.new("ShaderNodeTexImage")
-        node.image = spare
-        others.append((other, node, other.node_tree.nodes.active))
-        other.node_tree.nodes.active = node
-    scene = bpy.context.scene
-    bake = scene.render.bake
-    saved = (scene.render.engine, scene.cycles.samples, bake.margin, bake.use_clear, bake.target, bake.normal_space,
-             bake.normal_r, bake.normal_g, bake.normal_b)
-    view_layer = bpy.context.view_layer
-    selected = [o for o in view_layer.objects if o.select_get()]
-    was_active = view_layer.objects.active
+    made_materials: List[Any] = []
+    spare_image = None
+    proxy = None
+    state = _SceneState(scene, view_layer)
     try:
+        evaluated = material.copy()  # a library material's copy is local: it can be wired
+        made_materials.append(evaluated)
+        tree = evaluated.node_tree
+        output = _active_output(tree)
+        target_socket = _matching_socket(tree, socket)
+        if output is None or target_socket is None or not target_socket.is_linked:
+            raise EvaluationError(f"material '{material.name}' has no material output or no linked "
+                                  f"'{socket.name}' to evaluate")
+        surface = output.inputs["Surface"]
+        bump = _scalable_bump(target_socket) if normal else None
+        if bump is not None:
+            strength = min(max(float(bump.inputs["Strength"].default_value), 0.0), 1.0)
+            bump.inputs["Strength"].default_value = 1.0
+            bump.inputs["Distance"].default_value *= BUMP_SCALE
         if not normal:
-            tree.links.new(socket.links[0].from_socket, emission.inputs["Color"])
+            emission = tree.nodes.new("ShaderNodeEmission")
+            source = target_socket.links[0].from_socket
+            tree.links.new(source, emission.inputs["Color"])
             emission.inputs["Strength"].default_value = 1.0
+            for link in list(surface.links):
+                tree.links.remove(link)
             tree.links.new(emission.outputs["Emission"], surface)
+        target = tree.nodes.new("ShaderNodeTexImage")
+        target.image = image
         tree.nodes.active = target
+        proxy = obj.copy()  # shares the mesh; its slots become its own (the mesh is not touched)
+        proxy.name = f"{obj.name} (dwivedi evaluation)"
+        scene.collection.objects.link(proxy)
+        spare = None
+        for slot in proxy.material_slots:
+            mine = slot.material == material
+            slot.link = 'OBJECT'
+            if not mine and spare is None:
+                spare_image = bpy.data.images.new("dwivedi spare", 8, 8, alpha=False, float_buffer=True)
+                spare = bpy.data.materials.new("dwivedi spare")
+                made_materials.append(spare)
+                spare.use_nodes = True
+                node = spare.node_tree.nodes.new("ShaderNodeTexImage")
+                node.image = spare_image
+                spare.node_tree.nodes.active = node
+            slot.material = evaluated if mine else spare
+        proxy.hide_render = False
+        proxy.hide_viewport = False
+        proxy.hide_select = False
         scene.render.engine = 'CYCLES'
         scene.cycles.samples = 1
-        bake.margin = 4
-        bake.use_clear = True
-        bake.target = 'IMAGE_TEXTURES'
-        bake.normal_space, bake.normal_r, bake.normal_g, bake.normal_b = 'TANGENT', 'POS_X', 'POS_Y', 'POS_Z'
-        for o in selected:
+        for o in state.selected:
             o.select_set(False)
-        obj.select_set(True)
-        view_layer.objects.active = obj
-        bpy.ops.object.bake(type='NORMAL' if normal else 'EMIT')
+        proxy.select_set(True)
+        view_layer.objects.active = proxy
+        try:
+            result = bpy.ops.object.bake(type='NORMAL' if normal else 'EMIT', margin=4, use_clear=True,
+                                         target='IMAGE_TEXTURES', save_mode='INTERNAL', use_selected_to_active=False,
+                                         use_split_materials=False, use_automatic_name=False,
+                                         normal_space='TANGENT', normal_r='POS_X', normal_g='POS_Y', normal_b='POS_Z')
+        except RuntimeError as error:
+            raise EvaluationError(f"Blender could not evaluate '{socket.name}' of material '{material.name}' on "
+                                  f"object '{obj.name}': {str(error).strip()}") from None
+        if result != {'FINISHED'}:
+            raise EvaluationError(f"Blender could not evaluate '{socket.name}' of material '{material.name}' on "
+                                  f"object '{obj.name}' (its bake returned {sorted(result)})")
+        if normal:
+            clamped = _baked_normals(image, strength if bump is not None else None)
+            if clamped > 0.001 and warnings is not None:
+                warnings.append(f"material '{material.name}': {100.0 * clamped:.1f}% of the texels of its Normal "
+                                f"on object '{obj.name}' are at Blender's normal bake's limit (about 45 degrees "
+                                "from the smooth normal): the bump is baked flatter than Cycles renders it"
+                                + ("" if bump is not None else " (only a Bump node of unlinked Strength, Distance "
+                                   "and Normal feeding the Normal straight is baked past that limit)"))
     except BaseException:
         bpy.data.images.remove(image)
         raise
     finally:
-        if not normal:
-            for link in list(surface.links):
-                tree.links.remove(link)
-            for source in previous:
-                tree.links.new(source, surface)
-            tree.nodes.remove(emission)
-        tree.nodes.remove(target)
-        tree.nodes.active = active
-        for other, node, other_active in others:
-            other.node_tree.nodes.remove(node)
-            other.node_tree.nodes.active = other_active
-        if spare is not None:
-            bpy.data.images.remove(spare)
-        (scene.render.engine, scene.cycles.samples, bake.margin, bake.use_clear, bake.target, bake.normal_space,
-         bake.normal_r, bake.normal_g, bake.normal_b) = saved
-        obj.select_set(False)
-        for o in selected:
-            o.select_set(True)
-        view_layer.objects.active = was_active
+        if proxy is not None:
+            bpy.data.objects.remove(proxy)
+        for made in made_materials:
+            bpy.data.materials.remove(made)
+        if spare_image is not None:
+            bpy.data.images.remove(spare_image)
+        state.restore()
     return image
 
 
-def evaluate_object(obj: Any, materials: List[Any], shader_of: Any, blender4: bool, size: int,
-                    done: set, warnings: List[str]) -> List[Any]:
-    """Bakes the evaluable inputs (textures.evaluable_inputs) of the object's materials not yet
-    evaluated into images registered in textures.EVALUATED; returns the images (for removal)."""
-    images = []
-    original = obj.original if hasattr(obj, "original") else obj
-    for material in materials:
-        if material is None or material.name_full in done:
-            continue
-        node = shader_of(material)
-        if node is None:
-            continue
-        sockets = textures.evaluable_inputs(node, blender4)
-        if not sockets:
-            continue
-        done.add(material.name_full)
-        mesh = original.data
-        if getattr(mesh, "uv_layers", None) is None or len(mesh.uv_layers) == 0:
-            warnings.append(f"material '{material.name}': {', '.join(repr(s.name) for s in sockets)} driven by node "
-                            f"trees could not be evaluated by Blender (object '{original.name}' has no UV map): "
-                            "their own values are used")
-            continue
-        users = [o for o in bpy.data.objects if any(slot.material == material for slot in o.material_slots)]
-        if len(users) > 1:
-            warnings.append(f"material '{material.name}' is used by {len(users)} objects: its node-tree inputs are "
-                            f"evaluated on '{original.name}''s UV map and used for all of them")
-        uv_map = mesh.uv_layers.active.name
-        for socket in sockets:
-            image = _bake_socket(original, material, socket, size)
-            images.append(image)
-            textures.EVALUATED[textures.evaluated_key(material.name_full, socket)] = (textures.EvaluatedImage(image), uv_map)
+def _reads_object_random(tree: Any, seen: Optional[set] = None) -> bool:
+    """Whether a node tree (or a group in it) reads an Object Info node's Random, which Cycles
+    hashes from the object's name: the evaluation's copy of the object has a name of its own."""
+    seen = set() if seen is None else seen
+    if tree is None or tree.as_pointer() in seen:
+        return False
+    seen.add(tree.as_pointer())
+    for node in tree.nodes:
+        if node.type == 'OBJECT_INFO' and node.outputs["Random"].is_linked:
+            return True
+        if node.type == 'GROUP' and _reads_object_random(node.node_tree, seen):
+            return True
+    return False
+
+
+def _owner(obj: Any, sockets: List[Any]) -> str:
+    """Whose images an object's material reads: its mesh's, shared by every object of that mesh
+    data block, when the mesh alone decides the evaluated inputs (no modifiers, and inputs that
+    read only the mesh: reads_only_mesh); else the object's own."""
+    if not obj.modifiers and all(reads_only_mesh(s) for s in sockets):
+        return f"mesh {obj.data.name_full}"
+    return f"object {obj.name_full}"
+
+
+def evaluate_objects(objects: List[Any], shader_of: Any, blender4: bool, size: int,
+                     warnings: List[str]) -> List[Any]:
+    """Bakes the evaluable inputs (textures.evaluable_inputs) of the objects' materials into
+    images registered in textures.EVALUATED, per evaluation (textures.OWNERS: per material and
+    object or mesh, _owner); returns the images (for removal). EvaluationError if a bake fails
+    (the images made so far are removed first)."""
+    images: List[Any] = []
+    # Per material: its evaluated inputs, the UV maps and the objects each evaluation was made for.
+    made: Dict[str, Tuple[Any, List[Any], Dict[str, Tuple[str, List[str]]]]] = {}
+    try:
+        for obj in objects:
+            original = obj.original if hasattr(obj, "original") else obj
+            for material in dict.fromkeys(slot.material for slot in original.material_slots):
+                if material is None:
+                    continue
+                node = shader_of(material)
+                if node is None:
+                    continue
+                sockets = textures.evaluable_inputs(node, blender4)
+                if not sockets:
+                    continue
+                mesh = original.data
+                if getattr(mesh, "uv_layers", None) is None or len(mesh.uv_layers) == 0:
+                    warnings.append(f"material '{material.name}': {', '.join(repr(s.name) for s in sockets)} driven "
+                                    f"by node trees could not be evaluated by Blender on object '{original.name}' (it "
+                                    "has no UV map): their own values are used there")
+                    continue
+                owner = _owner(original, sockets)
+                evaluation = (material.name_full, owner)
+                textures.OWNERS[(material.name_full, original.name_full)] = evaluation
+                if material.name_full not in made and _reads_object_random(material.node_tree):
+                    warnings.append(f"material '{material.name}': an Object Info node's Random is evaluated on a "
+                                    "copy of each object, whose random number is not the object's (Cycles hashes "
+                                    "it from the name)")
+                entry = made.setdefault(material.name_full, (material, sockets, {}))
+                if owner in entry[2]:
+                    entry[2][owner][1].append(original.name)
+                    continue
+                uv_map = mesh.uv_layers.active.name
+                for socket in sockets:
+                    image = _bake_socket(original, material, socket, size, warnings)
+                    images.append(image)
+                    textures.EVALUATED[textures.evaluated_key(evaluation, socket)] = (textures.EvaluatedImage(image),
+                                                                                    uv_map)
+                entry[2][owner] = (uv_map, [original.name])
+    except BaseException:
+        for image in images:
+            bpy.data.images.remove(image)
+        raise
+    for material, sockets, evaluations in made.values():
+        maps = sorted({uv for uv, _ in evaluations.values()})
+        users = sum(len(names) for _, names in evaluations.values())
+        if len(evaluations) > 1:
+            each = (f" {len(evaluations)} times (each object's own images"
+                    f"{'' if len(evaluations) == users else ', shared by the objects of one mesh'})")
+        else:
+            each = f" once for its {users} objects (one mesh)" if users > 1 else ""
+        uv_maps = f"UV map{'s' if len(maps) > 1 else ''} {', '.join(repr(m) for m in maps)}"
+        normal = any(s.name == "Normal" for s in sockets)
         warnings.append(f"material '{material.name}': {', '.join(repr(s.name) for s in sockets)} driven by node "
-                        f"trees, evaluated by Blender into {size} x {size} images on UV map '{uv_map}' (detail "
-                        "finer than that is lost; set Texture Bake Size)"
-                        + ("; the Normal as a tangent-space normal map" if any(s.name == "Normal" for s in sockets)
-                           else ""))
+                        f"trees, evaluated by Blender into {size} x {size} images on {uv_maps}{each} (detail finer "
+                        "than that is lost; set Texture Bake Size)"
+                        + ("; the Normal as a tangent-space normal map" + BUMP_FIGURES if normal else ""))
     return images

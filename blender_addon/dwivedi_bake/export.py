@@ -258,14 +258,16 @@ _UNMODELLED_4X = (("Metallic", ("Metallic",)), ("Transmission", ("Transmission W
 
 
 def material_from_blender(material: Any, dwivedi: Any, warnings: List[str],
-                          version: Optional[Tuple[int, ...]] = None) -> Any:
+                          version: Optional[Tuple[int, ...]] = None, evaluation: Optional[Any] = None) -> Any:
     """A dwivedi.Material from a Blender material (None: Blender's default grey surface), as the
     Cycles of Blender `version` (default bpy.app.version) shades it: the subsurface model of the
     node's method (subsurface_model), the Principled specular layer (3.x v1 or 4.x+ v2) and exit.
 
     Blender 4.x+: Subsurface Weight, Subsurface Scale, Subsurface Radius, the base colour is the
     subsurface colour. Blender 3.x: Subsurface (a factor that also scales the radius), Subsurface
-    Color mixed with Base Color by it, Subsurface Radius (see dwv_material_t)."""
+    Color mixed with Base Color by it, Subsurface Radius (see dwv_material_t). `evaluation`: whose
+    images of the inputs Blender evaluated it reads (textures.evaluation_of; default the
+    material's own, evaluated once for every object)."""
     if version is None:
         version = tuple(bpy.app.version) if bpy is not None else (3, 4, 0)
     version = tuple(version)
@@ -352,7 +354,8 @@ def material_from_blender(material: Any, dwivedi: Any, warnings: List[str],
             warnings.append(f"material '{name}': Multiscatter GGX (3.x's stochastic microsurface walk) is not "
                             "modelled: its specular is baked as GGX")
     weight_socket = _input(node, ("Subsurface Weight",))
-    if blender4 and out.kind == "diffuse" and weight_socket is not None and textures.passes(weight_socket, material.name_full):
+    if blender4 and out.kind == "diffuse" and weight_socket is not None and textures.passes(
+            weight_socket, evaluation or (material.name_full, None)):
         out.kind = "subsurface"  # a textured weight may be above 0 anywhere
     if out.kind == "subsurface":
         model, note = subsurface_model(version, method)
@@ -365,10 +368,11 @@ def material_from_blender(material: Any, dwivedi: Any, warnings: List[str],
 
 
 def texture_uses(material: Any, converted: Any, warnings: List[str],
-                 version: Optional[Tuple[int, ...]] = None) -> List[Any]:
-    """The image textures on the material's inputs (textures.Use, in binding order), adjusting
-    `converted` where a texture changes what its constants mean; warns about linked inputs that are
-    not passed (their own values are used)."""
+                 version: Optional[Tuple[int, ...]] = None, evaluation: Optional[Any] = None) -> List[Any]:
+    """The image textures on the material's inputs (textures.Use, in binding order; the inputs
+    Blender evaluated: `evaluation`'s images, as material_from_blender), adjusting `converted`
+    where a texture changes what its constants mean; warns about linked inputs that are not
+    passed (their own values are used)."""
     if material is None:
         return []
     if version is None:
@@ -377,8 +381,9 @@ def texture_uses(material: Any, converted: Any, warnings: List[str],
     if node is None:
         return []
     blender4 = tuple(version) >= (4, 0, 0)
-    uses = textures.material_uses(node, blender4, converted, material.name_full)
-    unpassed = textures.linked_unpassed(node, blender4, material.name_full)
+    evaluation = evaluation or (material.name_full, None)
+    uses = textures.material_uses(node, blender4, converted, evaluation)
+    unpassed = textures.linked_unpassed(node, blender4, evaluation)
     if unpassed:
         warnings.append(f"material '{material.name}': {', '.join(repr(n) for n in unpassed)} linked to nodes other "
                         "than an Image Texture (with a UV Map, a Normal Map or a Bump node): not evaluated, the "
@@ -934,11 +939,13 @@ def export_scene(context: Any, settings: Any, dwivedi: Any, cache: Optional[Expo
     warnings = out.warnings
     # Inputs driven by node trees are evaluated by Blender (an emission bake) before the depsgraph
     # is read: the bake re-evaluates it.
-    evaluated_images = _evaluate_inputs(context, settings, warnings)
+    evaluated_images: List[Any] = []
     try:
+        evaluated_images = _evaluate_inputs(context, settings, warnings)
         out = _export(context, settings, dwivedi, out, cache)
     finally:
         textures.EVALUATED.clear()
+        textures.OWNERS.clear()
         for image in evaluated_images:
             bpy.data.images.remove(image)
     if cache is not None and not evaluated_images and out.images_read == 0:
@@ -946,19 +953,30 @@ def export_scene(context: Any, settings: Any, dwivedi: Any, cache: Optional[Expo
     return out
 
 
+def _warn_instanced_evaluation(original: Any, slots: List[Any], warnings: List[str]) -> None:
+    """An instance (a collection instance, particles, geometry nodes) of an object whose inputs
+    Blender evaluated per object reads that object's images, made where the object itself is."""
+    for material in slots:
+        if material is None:
+            continue
+        owner = textures.evaluation_of(material.name_full, original.name_full)[1]
+        message = (f"material '{material.name}': its inputs evaluated by Blender on object '{original.name}' are used "
+                   "for the object's instances too (evaluated where the object itself is)")
+        if owner is not None and owner.startswith("object ") and message not in warnings:
+            warnings.append(message)
+
+
 def _evaluate_inputs(context: Any, settings: Any, warnings: List[str]) -> List[Any]:
     """Bakes the material inputs of the render-visible meshes that node trees other than Image
     Textures drive into images (evaluate.py); returns them."""
-    blender4 = tuple(bpy.app.version) >= (4, 0, 0)
-    size = int(getattr(settings, "texture_bake_size", 256))
-    images: List[Any] = []
-    done: set = set()
-    for obj in context.view_layer.objects:
-        if obj.type != 'MESH' or obj.hide_render or not obj.visible_get():
-            continue
-        materials = [slot.material for slot in obj.material_slots]
-        images.extend(evaluate.evaluate_object(obj, materials, _surface_shader, blender4, size, done, warnings))
-    return images
+    context.evaluated_depsgraph_get()  # the view layer's objects include those linked since its last update
+    objects = [obj for obj in context.view_layer.objects
+               if obj.type == 'MESH' and not obj.hide_render and obj.visible_get()]
+    try:
+        return evaluate.evaluate_objects(objects, _surface_shader, tuple(bpy.app.version) >= (4, 0, 0),
+                                         int(getattr(settings, "texture_bake_size", 256)), warnings)
+    except evaluate.EvaluationError as error:
+        raise ExportError(f"{error}; nothing was baked") from None
 
 
 def _export(context: Any, settings: Any, dwivedi: Any, out: Exported, cache: Optional[ExportCache]) -> Exported:
@@ -984,11 +1002,14 @@ def _export(context: Any, settings: Any, dwivedi: Any, out: Exported, cache: Opt
         material_textures: Dict[Any, List[Any]] = {}
         texture_cache = textures.TextureCache(dw_scene)
 
-        def material_id(material: Any) -> int:
-            key = None if material is None else material.name_full
+        def material_id(material: Any, obj: Any) -> int:
+            """The library's material for `material` on object `obj`: one per material, or per
+            material and object (or mesh) where its inputs were evaluated per object (evaluate.py:
+            the object's own images are bound to it)."""
+            key = None if material is None else textures.evaluation_of(material.name_full, obj.original.name_full)
             if key not in material_ids:
-                converted = material_from_blender(material, dwivedi, warnings)
-                uses = texture_uses(material, converted, warnings)
+                converted = material_from_blender(material, dwivedi, warnings, evaluation=key)
+                uses = texture_uses(material, converted, warnings, evaluation=key)
                 material_ids[key] = dw_scene.add_material(converted)
                 material_textures[key] = uses
                 try:
@@ -1004,8 +1025,9 @@ def _export(context: Any, settings: Any, dwivedi: Any, out: Exported, cache: Opt
             are `uv_names`)."""
             maps: Optional[List[Optional[str]]] = None
             for material in slots:
-                material_id(material)
-                uses = material_textures[None if material is None else material.name_full]
+                material_id(material, obj)
+                uses = material_textures[None if material is None else textures.evaluation_of(
+                    material.name_full, obj.original.name_full)]
                 if not uses:
                     continue
                 maps = maps or []
@@ -1048,6 +1070,8 @@ def _export(context: Any, settings: Any, dwivedi: Any, out: Exported, cache: Opt
                 if kept is None and (mesh is None or len(mesh.polygons) == 0):
                     continue
                 slots = [slot.material for slot in obj.material_slots]
+                if instance.is_instance:
+                    _warn_instanced_evaluation(original, slots, warnings)
                 uv_names = kept.uv_names if kept is not None else [layer.name for layer in mesh.uv_layers]
                 maps = texture_maps(obj, slots or [None], uv_names)
                 if kept is not None and (kept.want_uvs != is_uv_target or kept.maps != maps):
@@ -1074,7 +1098,7 @@ def _export(context: Any, settings: Any, dwivedi: Any, out: Exported, cache: Opt
                         warnings.append(f"'{obj.name}' has {len(by_material)} materials: the UV bake uses "
                                         f"slot {main + 1}'s for the whole object")
                     material = slots[main] if main < len(slots) else None
-                    out.uv_mesh = dw_scene.add_mesh(arrays["positions"], arrays["indices"], material_id(material),
+                    out.uv_mesh = dw_scene.add_mesh(arrays["positions"], arrays["indices"], material_id(material, obj),
                                                     normals=arrays["normals"], uvs=arrays["uvs"], transform=transform,
                                                     shadow_terminator_geometry_offset=terminator,
                                                     **_layer_arguments(arrays))
@@ -1085,7 +1109,7 @@ def _export(context: Any, settings: Any, dwivedi: Any, out: Exported, cache: Opt
                 for index, tris in sorted(by_material.items()):
                     part = arrays if len(by_material) == 1 else _subset(arrays, tris)
                     material = slots[index] if index < len(slots) else None
-                    dw_scene.add_mesh(part["positions"], part["indices"], material_id(material),
+                    dw_scene.add_mesh(part["positions"], part["indices"], material_id(material, obj),
                                       normals=part["normals"], uvs=part["uvs"], transform=transform,
                                       shadow_terminator_geometry_offset=terminator, **_layer_arguments(part))
                     out.mesh_count += 1

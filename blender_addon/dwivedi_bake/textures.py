@@ -8,7 +8,8 @@ interpolation, and the UV map it reads (the UV Map node's, else the mesh's activ
 Anything else linked to an input (a Mapping node, a procedural texture, a Mix node..., and a
 Normal input fed by anything but those nodes) is evaluated by Blender into an image first
 (evaluate.py: an emission bake, or for the Normal a tangent-space normal bake bound as a normal
-map), per material of each object.
+map), per material of each object, or once for the objects of one mesh where the result cannot
+differ; each object's material then reads its own evaluation's images (OWNERS, evaluation_of).
 """
 from __future__ import annotations
 
@@ -58,23 +59,35 @@ class EvaluatedImage:
         self.extension = 'EXTEND'
 
 
-# Inputs whose node trees Blender evaluated into images (evaluate.py), per (material name, node
-# name, input identifier): (EvaluatedImage, UV map). Filled before the materials are exported
-# (the depsgraph's copies of a material share its name); cleared after.
-EVALUATED: Dict[Tuple[str, str, str], Tuple[EvaluatedImage, str]] = {}
+# What an object's material was evaluated as (evaluate.py): the evaluation (material name, owner)
+# whose images it reads, the owner "mesh NAME" (images shared by the objects of that mesh) or
+# "object NAME". Per (material name, object name); an object missing here (its material had
+# nothing to evaluate, or the object was not evaluated) has the evaluation (material name, None),
+# which has no images.
+Evaluation = Tuple[str, Optional[str]]
+OWNERS: Dict[Tuple[str, str], Evaluation] = {}
+# Inputs whose node trees Blender evaluated into images, per (evaluation, node name, input
+# identifier): (EvaluatedImage, UV map). Filled before the materials are exported (the
+# depsgraph's copies of a material and an object share their names); cleared after.
+EVALUATED: Dict[Tuple[Evaluation, str, str], Tuple[EvaluatedImage, str]] = {}
 
 
-def evaluated_key(material_name: str, socket: Any) -> Tuple[str, str, str]:
-    return material_name, socket.node.name, socket.identifier
+def evaluation_of(material_name: str, object_name: str) -> Evaluation:
+    """The evaluation whose images the material of object `object_name` reads."""
+    return OWNERS.get((material_name, object_name), (material_name, None))
 
 
-def _image_source(socket: Any, material_name: str = "") -> Optional[Tuple[Any, str, Optional[str]]]:
+def evaluated_key(evaluation: Evaluation, socket: Any) -> Tuple[Evaluation, str, str]:
+    return evaluation, socket.node.name, socket.identifier
+
+
+def _image_source(socket: Any, evaluation: Optional[Evaluation] = None) -> Optional[Tuple[Any, str, Optional[str]]]:
     """(Image Texture node, its output name, UV map or None) when `socket` is fed straight by an
     Image Texture node that the library can look up as Blender does, or was evaluated into an
     image (EVALUATED); None otherwise."""
     if socket is None or not socket.is_linked:
         return None
-    evaluated = EVALUATED.get(evaluated_key(material_name, socket))
+    evaluated = EVALUATED.get(evaluated_key(evaluation, socket)) if evaluation else None
     if evaluated is not None:
         return evaluated[0], "Color", evaluated[1]
     link = socket.links[0]
@@ -96,21 +109,22 @@ def _image_source(socket: Any, material_name: str = "") -> Optional[Tuple[Any, s
     return node, link.from_socket.name, uv_map
 
 
-def passes(socket: Any, material_name: str = "") -> bool:
-    """Whether a linked input is one this module passes on (no warning about it)."""
-    return _image_source(socket, material_name) is not None or _normal_uses(socket, material_name) is not None
+def passes(socket: Any, evaluation: Optional[Evaluation] = None) -> bool:
+    """Whether a linked input is one this module passes on (no warning about it), for a material
+    whose evaluated inputs are `evaluation`'s (evaluation_of)."""
+    return _image_source(socket, evaluation) is not None or _normal_uses(socket, evaluation) is not None
 
 
 def _plain(socket: Any, default: float) -> float:
     return float(socket.default_value) if socket is not None and not socket.is_linked else default
 
 
-def _normal_uses(socket: Any, material_name: str = "") -> Optional[List[Use]]:
+def _normal_uses(socket: Any, evaluation: Optional[Evaluation] = None) -> Optional[List[Use]]:
     """The normal map and bump feeding a Normal input (or the tangent-space normal map Blender
     baked of it, EVALUATED), or None if it is fed otherwise."""
     if socket is None or not socket.is_linked:
         return None
-    evaluated = EVALUATED.get(evaluated_key(material_name, socket)) if material_name else None
+    evaluated = EVALUATED.get(evaluated_key(evaluation, socket)) if evaluation else None
     if evaluated is not None:
         return [Use("normal_map", evaluated[0], "Color", evaluated[1])]
     node = socket.links[0].from_node
@@ -147,14 +161,14 @@ def _socket(node: Any, names: Tuple[str, ...]) -> Any:
     return None
 
 
-def material_uses(node: Any, blender4: bool, material: Any, material_name: str = "") -> List[Use]:
-    """The textures of a Principled BSDF or Subsurface Scattering node's inputs, in the order the
-    library applies them; `material` (a dwivedi.Material made from the node's own values) is
+def material_uses(node: Any, blender4: bool, material: Any, evaluation: Optional[Evaluation] = None) -> List[Use]:
+    """The textures of a Principled BSDF or Subsurface Scattering node's inputs (those Blender
+    evaluated: `evaluation`'s images), in the order the library applies them; `material` (a dwivedi.Material made from the node's own values) is
     adjusted where a texture changes what a constant meant (Blender 3.x's subsurface colour mix)."""
     uses: List[Use] = []
 
     def add(input_name: str, names: Tuple[str, ...], blend: float = 1.0) -> Optional[Tuple[Any, str, Optional[str]]]:
-        found = _image_source(_socket(node, names), material_name)
+        found = _image_source(_socket(node, names), evaluation)
         if found is not None:
             uses.append(Use(input_name, found[0], found[1], found[2], blend=blend))
         return found
@@ -182,7 +196,7 @@ def material_uses(node: Any, blender4: bool, material: Any, material_name: str =
         factor = _plain(node.inputs.get("Subsurface"), 0.0)
         base_socket, colour_socket = node.inputs.get("Base Color"), node.inputs.get("Subsurface Color")
         base = add("base_color", ("Base Color",))
-        colour = _image_source(colour_socket, material_name)
+        colour = _image_source(colour_socket, evaluation)
         if factor > 0.0 and (base is not None or colour is not None):
             if base is not None:
                 material.subsurface_color = tuple(colour_socket.default_value)[:3]
@@ -196,7 +210,7 @@ def material_uses(node: Any, blender4: bool, material: Any, material_name: str =
         add("specular", ("Specular",))
     if node.type != 'SUBSURFACE_SCATTERING':
         add("roughness", ("Roughness",))
-    normal = _normal_uses(node.inputs.get("Normal"), material_name)
+    normal = _normal_uses(node.inputs.get("Normal"), evaluation)
     if normal:
         uses.extend(normal)
     return uses
@@ -223,7 +237,7 @@ def evaluable_inputs(node: Any, blender4: bool) -> List[Any]:
     return out
 
 
-def linked_unpassed(node: Any, blender4: bool, material_name: str = "") -> List[str]:
+def linked_unpassed(node: Any, blender4: bool, evaluation: Optional[Evaluation] = None) -> List[str]:
     """The names of the node's linked inputs that no texture use covers (their own values are
     used): for the warning."""
     covered = {"Base Color", "Color", "Radius", "Scale", "Anisotropy", "Subsurface Radius", "Normal", "Roughness"}
@@ -236,8 +250,8 @@ def linked_unpassed(node: Any, blender4: bool, material_name: str = "") -> List[
     for socket in node.inputs:
         if not socket.is_linked:
             continue
-        if socket.name in covered and (passes(socket, material_name) if socket.name != "Normal"
-                                       else _normal_uses(socket, material_name) is not None):
+        if socket.name in covered and (passes(socket, evaluation) if socket.name != "Normal"
+                                       else _normal_uses(socket, evaluation) is not None):
             continue
         names.append(socket.name)
     return names
@@ -270,8 +284,10 @@ class TextureCache:
         image.pixels.foreach_get(pixels)
         if channels == 4 and use.output == "Color" and int(image.depth) in (24, 96):
             # An RGB image (Image.pixels always has 4 channels): its constant alpha is left out.
-            pixels = array.array("f", (v for i, v in enumerate(pixels) if i % 4 != 3))
-            channels = 3
+            rgb = array.array("f", [0.0]) * (width * height * 3)
+            for c in range(3):
+                rgb[c::3] = pixels[c::4]
+            pixels, channels = rgb, 3
         if use.output == "Alpha" or channels == 2:
             alpha = channels - 1
             pixels = array.array("f", pixels[alpha::channels]) if channels in (2, 4) else array.array("f", [1.0]) * (width * height)

@@ -7,7 +7,7 @@
 - a Normal input driven by a procedural tree (a Bump node of Distance 0.1 fed by a Wave
   Texture): baked by Blender as a tangent-space normal map (256 x 256) and bound as one; against
   Cycles, means within 2% (measured 0.3%; figures printed), and the bump moves Cycles' own mean
-  by 11%, more than the tolerance (the test can fail). At Distance 0.3 the gap grows to 3.7%;
+  by 11%, more than the tolerance (the test can fail). Distance 0.3: test_evaluate.py;
 - the farm export's scene file of a scene with evaluated and image textures and an HDRI world
   bakes the same bits as the add-on's scene in memory;
 - bad input: an image whose file is not an image (0 x 0 pixels) cancels the bake with a message
