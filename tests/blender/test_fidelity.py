@@ -158,8 +158,9 @@ class MappingTest(harness.unittest.TestCase):
         model, note = export.subsurface_model((4, 3, 0), 'BURLEY')
         self.assertEqual(model, "fixed_radius")
         self.assertIn("Christensen-Burley", note)
-        self.assertEqual([export.footprint_rule(v) for v in ((3, 4, 1), (4, 0, 0), (4, 4, 9), (4, 5, 0), (5, 2, 2))],
-                         [0.0, 0.25, 0.25, 0.0, 0.0])
+        self.assertEqual([export.footprint_rule(v) for v in ((3, 4, 1), (4, 0, 0), (4, 3, 2), (4, 4, 0), (4, 5, 0),
+                                                             (5, 2, 2))],
+                         [0.0, 0.25, 0.25, 0.0, 0.0, 0.0])
 
 
 harness.run(FidelityTest, MappingTest)
