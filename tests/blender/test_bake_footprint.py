@@ -11,7 +11,8 @@ spp; the bounds of test_fidelity (harness.compare_two_seeds): per channel within
 signal, the standard error of the difference below 0.67%, the noise ratio below 1.5, no NaN.
 DWIVEDI_FOOTPRINT_PLANTED=1 bakes as the library did before UV bakes had a footprint (the add-on
 passes no footprint rule): in 4.3 green and blue then come out about 3% dark and the test fails.
-Run in the chroots (blender.bake_footprint.trixie / .sid) and on the host (3.4) on demand:
+Run in the chroots (blender.bake_footprint.trixie / .sid; not by ctest on the host: in 3.x the scene
+is test_bake_passes' Diffuse case) and on demand:
 tests/blender/run_package_tests.py --script test_bake_footprint.py --blender trixie|sid|host.
 """
 import json

@@ -8,7 +8,11 @@
  * - a UV bake with subsurface_min_footprint 0.25 (Cycles 4.0-4.3) walks no channel whose radius
  *   is 10% below a quarter of the texel's footprint, and walks where it is 10% above (the box's
  *   faces: footprint 1/4 (L / (0.23 W) + L / (0.40 H))); the bake's jittered image is the same on
- *   1 and 2 threads. Runs in well under a second. */
+ *   1 and 2 threads;
+ * - along a path the footprint is the first ray's grown as Cycles' differentials: with an
+ *   orthographic camera it stays a pixel's width, so a cube whose radii are below a quarter of it,
+ *   seen directly and in a rough glossy floor, never walks (it did at the floor's rays' hits before
+ *   the rule applied along paths). Runs in about a second. */
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -187,10 +191,76 @@ static void test_bake_footprint_rule(void)
     dwv_image_release(two);
 }
 
+/* Along a path (Cycles' compact differentials): an orthographic camera (footprint a pixel's width at
+ * every distance, dD = 0) over a rough glossy-only floor (no diffuse lobe, so the floor's rays keep
+ * no diffuse ancestor) with a subsurface cube standing on it, radii `factor` x a quarter of the
+ * pixel: the walks of a 16 x 16 camera bake. The cube's camera hits and the floor's glossy rays'
+ * hits on it obey the rule alike. */
+static uint64_t glossy_path_walks(double factor)
+{
+    const uint32_t size = 16u;
+    const double scale = 3.0, pixel = scale / size;
+    dwv_material_t floor = DWV_MATERIAL_INIT, wax = DWV_MATERIAL_INIT;
+    floor.subsurface_weight = 0.0;
+    floor.base_color[0] = floor.base_color[1] = floor.base_color[2] = 0.0;
+    floor.specular_model = DWV_SPECULAR_PRINCIPLED_V2;
+    floor.specular = 0.5;
+    floor.roughness = 0.5;
+    floor.ior = 1.5;
+    wax.subsurface_model = DWV_SUBSURFACE_MODEL_BLENDER4_RANDOM_WALK;
+    wax.subsurface_weight = 1.0;
+    wax.subsurface_scale = 1.0;
+    wax.subsurface_min_footprint = 0.25;
+    wax.specular = 0.0;
+    for (int c = 0; c < 3; ++c) wax.subsurface_radius[c] = factor * 0.25 * pixel;
+    dwv_scene_t *scene;
+    if (dwv_scene_create(&scene) != DWV_SUCCESS) exit(2);
+    test_mesh ground = test_box(-2.0, -2.0, -0.1, 2.0, 2.0, 0.0), cube = test_box(-0.5, -0.5, 0.0, 0.5, 0.5, 1.0);
+    test_add(scene, &ground, &floor);
+    test_add(scene, &cube, &wax);
+    test_mesh_free(&ground);
+    test_mesh_free(&cube);
+    dwv_light_desc_t sun = DWV_LIGHT_DESC_INIT;
+    sun.strength = 3.0;
+    sun.direction[0] = -0.5;
+    sun.direction[2] = -0.8;
+    dwv_camera_t camera = test_ortho_camera(0.0, 0.0, 5.0, scale);
+    if (dwv_scene_add_light(scene, &sun) || dwv_scene_set_camera(scene, &camera) || dwv_scene_commit(scene)) {
+        fprintf(stderr, "test scene: %s\n", dwv_last_error_message());
+        exit(2);
+    }
+    dwv_bake_options_t o = DWV_BAKE_OPTIONS_INIT;
+    o.target = DWV_BAKE_CAMERA;
+    o.width = o.height = size;
+    o.samples = 8u;
+    o.threads = 2u;
+    o.seed = 5u;
+    o.technique = DWV_TECHNIQUE_CLASSICAL;
+    dwv_image_t *image = NULL;
+    if (dwv_bake(scene, &o, &image) != DWV_SUCCESS) {
+        fprintf(stderr, "bake: %s\n", dwv_last_error_message());
+        exit(2);
+    }
+    dwv_bake_stats_t stats = DWV_BAKE_STATS_INIT;
+    if (dwv_image_stats(image, &stats) != DWV_SUCCESS) exit(2);
+    dwv_image_release(image);
+    dwv_scene_release(scene);
+    return stats.walks;
+}
+
+static void test_path_footprint_rule(void)
+{
+    uint64_t below = glossy_path_walks(0.9), above = glossy_path_walks(1.1);
+    CHECK(below == 0u, "radii 10%% below a quarter of the footprint walked %llu times (glossy paths' hits?)",
+          (unsigned long long)below);
+    CHECK(above > 0u, "radii 10%% above a quarter of the footprint never walked");
+}
+
 int main(void)
 {
     test_footprint_closed_form();
     test_jitter_box();
     test_bake_footprint_rule();
+    test_path_footprint_rule();
     return check_report("test_uv_texel");
 }
