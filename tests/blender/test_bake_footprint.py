@@ -27,7 +27,6 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import bpy  # noqa: E402
 
 import harness  # noqa: E402
-import scenes  # noqa: E402
 import uv_bakes  # noqa: E402
 
 WORK = harness.install_addon()
@@ -48,13 +47,7 @@ class DefaultScaleUVBake(unittest.TestCase):
         if PLANTED:
             export = harness.addon_module("export")
             export.footprint_rule = lambda version: 0.0
-        scene = scenes.default_sphere_scene(SIZE, scenes.methods()[0], roughness=0.5)
-        scenes.set_world(scene, (0.2, 0.2, 0.2), 1.0)
-        sphere = bpy.data.objects["Sphere"]
-        image = scenes.bake_image(sphere, (SIZE, SIZE))
-        scene.render.bake.margin = 0
-        scene.dwivedi_bake.target = 'UV'
-        scene.dwivedi_bake.uv_margin = 0
+        scene, image = uv_bakes.sphere_bake(SIZE)
         uv_bakes.set_filter(scene, *BAKE)
         start = time.monotonic()
         cycles = [uv_bakes.cycles_bake(scene, image, *BAKE, seed, CYCLES_SAMPLES) for seed in (1, 2)]

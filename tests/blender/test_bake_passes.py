@@ -65,18 +65,10 @@ CASES = {
 
 
 def make_scene():
-    # 4.x+: Subsurface Scale 1 (radius 1, 0.2, 0.1 m) keeps every channel above 4.0-4.4's
-    # quarter-footprint rule, which Cycles applies to UV bakes by the texel's footprint and the
-    # library to camera bakes only (docs/blender-compatibility.md).
-    scene = scenes.default_sphere_scene(SIZE, scenes.methods()[0], roughness=0.5,
-                                        amount=1.0 if scenes.blender4() else None)
-    scenes.set_world(scene, (0.2, 0.2, 0.2), 1.0)
-    sphere = bpy.data.objects["Sphere"]
-    image = scenes.bake_image(sphere, (SIZE, SIZE))
-    scene.render.bake.margin = 0
-    scene.dwivedi_bake.target = 'UV'
-    scene.dwivedi_bake.uv_margin = 0
-    return scene, image
+    # 4.x+: Subsurface Scale 1 (radius 1, 0.2, 0.1 m) keeps every channel above 4.0-4.3's
+    # quarter-footprint rule (UV bakes by the texel's footprint): the passes apart from it;
+    # test_bake_footprint.py bakes the default Scale.
+    return uv_bakes.sphere_bake(SIZE, 1.0 if scenes.blender4() else None)
 
 
 def cycles_bake(scene, image, bake_type, pass_filter, seed, samples=CYCLES_SAMPLES):

@@ -4,8 +4,22 @@ image cleared before each bake and read back after, and the texels to compare.""
 import bpy
 
 import harness
+import scenes
 
 LIGHT_FILTERS = ("direct", "indirect", "color", "diffuse", "glossy", "transmission", "emit")
+
+
+def sphere_bake(size, amount=None):
+    """scenes.default_sphere_scene's 1 m smooth sphere (this Blender's default Principled
+    subsurface material at Roughness 0.5, Subsurface / Scale `amount` or the default) in a grey
+    world, set up for a UV bake into a new size x size image without margins: (scene, image)."""
+    scene = scenes.default_sphere_scene(size, scenes.methods()[0], roughness=0.5, amount=amount)
+    scenes.set_world(scene, (0.2, 0.2, 0.2), 1.0)
+    image = scenes.bake_image(bpy.data.objects["Sphere"], (size, size))
+    scene.render.bake.margin = 0
+    scene.dwivedi_bake.target = 'UV'
+    scene.dwivedi_bake.uv_margin = 0
+    return scene, image
 
 
 def set_filter(scene, bake_type, pass_filter):

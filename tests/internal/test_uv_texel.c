@@ -124,6 +124,32 @@ static void test_jitter_box(void)
     CHECK(inside > 0 && outside > 0, "near a corner: %d kept, %d refused", inside, outside);
 }
 
+/* Bakes `scene` (target, size x size, `samples`, `threads`, classical walks) and releases it; the
+ * walks the bake ran, and its image in *kept where kept is not NULL (else released). */
+static uint64_t bake_walks(dwv_scene_t *scene, dwv_bake_target_t target, uint32_t size, uint32_t samples,
+                           uint32_t threads, dwv_image_t **kept)
+{
+    dwv_bake_options_t o = DWV_BAKE_OPTIONS_INIT;
+    o.target = target;
+    o.width = o.height = size;
+    o.samples = samples;
+    o.threads = threads;
+    o.seed = 3u;
+    o.technique = DWV_TECHNIQUE_CLASSICAL;
+    dwv_image_t *image = NULL;
+    if (dwv_bake(scene, &o, &image) != DWV_SUCCESS) {
+        fprintf(stderr, "bake: %s\n", dwv_last_error_message());
+        exit(2);
+    }
+    dwv_bake_stats_t stats = DWV_BAKE_STATS_INIT;
+    if (dwv_image_stats(image, &stats) != DWV_SUCCESS) exit(2);
+    CHECK(stats.warnings == 0u, "bake met %llu warnings", (unsigned long long)stats.warnings);
+    if (kept) *kept = image;
+    else dwv_image_release(image);
+    dwv_scene_release(scene);
+    return stats.walks;
+}
+
 /* A 1 m box of a 4.x subsurface material whose radii are `factor` x a quarter of its faces'
  * texel footprint, UV-baked at 32 x 32 with min_footprint 0.25: the walks it ran. */
 static uint64_t box_walks(double factor, uint32_t threads, dwv_image_t **kept)
@@ -152,25 +178,7 @@ static uint64_t box_walks(double factor, uint32_t threads, dwv_image_t **kept)
         fprintf(stderr, "test scene: %s\n", dwv_last_error_message());
         exit(2);
     }
-    dwv_bake_options_t o = DWV_BAKE_OPTIONS_INIT;
-    o.target = DWV_BAKE_UV;
-    o.width = o.height = size;
-    o.samples = 4u;
-    o.threads = threads;
-    o.seed = 3u;
-    o.technique = DWV_TECHNIQUE_CLASSICAL;
-    dwv_image_t *image = NULL;
-    if (dwv_bake(scene, &o, &image) != DWV_SUCCESS) {
-        fprintf(stderr, "bake: %s\n", dwv_last_error_message());
-        exit(2);
-    }
-    dwv_bake_stats_t stats = DWV_BAKE_STATS_INIT;
-    if (dwv_image_stats(image, &stats) != DWV_SUCCESS) exit(2);
-    CHECK(stats.warnings == 0u, "box bake met %llu warnings", (unsigned long long)stats.warnings);
-    if (kept) *kept = image;
-    else dwv_image_release(image);
-    dwv_scene_release(scene);
-    return stats.walks;
+    return bake_walks(scene, DWV_BAKE_UV, size, 4u, threads, kept);
 }
 
 static void test_bake_footprint_rule(void)
@@ -229,23 +237,7 @@ static uint64_t glossy_path_walks(double factor)
         fprintf(stderr, "test scene: %s\n", dwv_last_error_message());
         exit(2);
     }
-    dwv_bake_options_t o = DWV_BAKE_OPTIONS_INIT;
-    o.target = DWV_BAKE_CAMERA;
-    o.width = o.height = size;
-    o.samples = 8u;
-    o.threads = 2u;
-    o.seed = 5u;
-    o.technique = DWV_TECHNIQUE_CLASSICAL;
-    dwv_image_t *image = NULL;
-    if (dwv_bake(scene, &o, &image) != DWV_SUCCESS) {
-        fprintf(stderr, "bake: %s\n", dwv_last_error_message());
-        exit(2);
-    }
-    dwv_bake_stats_t stats = DWV_BAKE_STATS_INIT;
-    if (dwv_image_stats(image, &stats) != DWV_SUCCESS) exit(2);
-    dwv_image_release(image);
-    dwv_scene_release(scene);
-    return stats.walks;
+    return bake_walks(scene, DWV_BAKE_CAMERA, size, 8u, 2u, NULL);
 }
 
 static void test_path_footprint_rule(void)
