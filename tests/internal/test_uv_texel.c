@@ -12,7 +12,8 @@
  * - along a path the footprint is the first ray's grown as Cycles' differentials: with an
  *   orthographic camera it stays a pixel's width, so a cube whose radii are below a quarter of it,
  *   seen directly and in a rough glossy floor, never walks (it did at the floor's rays' hits before
- *   the rule applied along paths). Runs in about a second. */
+ *   the rule applied along paths); with a perspective camera it is the path's length x the pixel's
+ *   spread, so a cube seen only in the floor walks or not by that. Runs in about a second. */
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -199,15 +200,12 @@ static void test_bake_footprint_rule(void)
     dwv_image_release(two);
 }
 
-/* Along a path (Cycles' compact differentials): an orthographic camera (footprint a pixel's width at
- * every distance, dD = 0) over a rough glossy-only floor (no diffuse lobe, so the floor's rays keep
- * no diffuse ancestor) with a subsurface cube standing on it, radii `factor` x a quarter of the
- * pixel: the walks of a 16 x 16 camera bake. The cube's camera hits and the floor's glossy rays'
- * hits on it obey the rule alike. */
-static uint64_t glossy_path_walks(double factor)
+/* Along a path (Cycles' compact differentials): `camera` over a rough glossy-only floor (no diffuse
+ * lobe, so the floor's rays keep no diffuse ancestor) with a subsurface cube `cube` (x0, y0, x1,
+ * y1, height) of radii `radius` standing on it, 4.0-4.3's rule on: the walks of a 16 x 16 camera
+ * bake. */
+static uint64_t glossy_floor_walks(const dwv_camera_t *camera, const double cube[5], double radius)
 {
-    const uint32_t size = 16u;
-    const double scale = 3.0, pixel = scale / size;
     dwv_material_t floor = DWV_MATERIAL_INIT, wax = DWV_MATERIAL_INIT;
     floor.subsurface_weight = 0.0;
     floor.base_color[0] = floor.base_color[1] = floor.base_color[2] = 0.0;
@@ -220,32 +218,49 @@ static uint64_t glossy_path_walks(double factor)
     wax.subsurface_scale = 1.0;
     wax.subsurface_min_footprint = 0.25;
     wax.specular = 0.0;
-    for (int c = 0; c < 3; ++c) wax.subsurface_radius[c] = factor * 0.25 * pixel;
+    for (int c = 0; c < 3; ++c) wax.subsurface_radius[c] = radius;
     dwv_scene_t *scene;
     if (dwv_scene_create(&scene) != DWV_SUCCESS) exit(2);
-    test_mesh ground = test_box(-2.0, -2.0, -0.1, 2.0, 2.0, 0.0), cube = test_box(-0.5, -0.5, 0.0, 0.5, 0.5, 1.0);
+    test_mesh ground = test_box(-6.0, -6.0, -0.1, 6.0, 6.0, 0.0);
+    test_mesh box = test_box(cube[0], cube[1], 0.0, cube[2], cube[3], cube[4]);
     test_add(scene, &ground, &floor);
-    test_add(scene, &cube, &wax);
+    test_add(scene, &box, &wax);
     test_mesh_free(&ground);
-    test_mesh_free(&cube);
+    test_mesh_free(&box);
     dwv_light_desc_t sun = DWV_LIGHT_DESC_INIT;
     sun.strength = 3.0;
     sun.direction[0] = -0.5;
     sun.direction[2] = -0.8;
-    dwv_camera_t camera = test_ortho_camera(0.0, 0.0, 5.0, scale);
-    if (dwv_scene_add_light(scene, &sun) || dwv_scene_set_camera(scene, &camera) || dwv_scene_commit(scene)) {
+    if (dwv_scene_add_light(scene, &sun) || dwv_scene_set_camera(scene, camera) || dwv_scene_commit(scene)) {
         fprintf(stderr, "test scene: %s\n", dwv_last_error_message());
         exit(2);
     }
-    return bake_walks(scene, DWV_BAKE_CAMERA, size, 8u, 2u, NULL);
+    return bake_walks(scene, DWV_BAKE_CAMERA, 16u, 8u, 2u, NULL);
 }
 
 static void test_path_footprint_rule(void)
 {
-    uint64_t below = glossy_path_walks(0.9), above = glossy_path_walks(1.1);
-    CHECK(below == 0u, "radii 10%% below a quarter of the footprint walked %llu times (glossy paths' hits?)",
+    /* Orthographic (footprint a pixel's width 3 / 16 everywhere, dD = 0), the cube in view: its
+     * camera hits and the floor's rays' hits on it obey the rule alike. */
+    dwv_camera_t ortho = test_ortho_camera(0.0, 0.0, 5.0, 3.0);
+    const double centre[5] = {-0.5, -0.5, 0.5, 0.5, 1.0}, quarter_pixel = 0.25 * 3.0 / 16.0;
+    uint64_t below = glossy_floor_walks(&ortho, centre, 0.9 * quarter_pixel);
+    uint64_t above = glossy_floor_walks(&ortho, centre, 1.1 * quarter_pixel);
+    CHECK(below == 0u, "orthographic: radii 10%% below a quarter pixel walked %llu times", (unsigned long long)below);
+    CHECK(above > 0u, "orthographic: radii 10%% above a quarter pixel never walked");
+    /* Perspective 50 mm / 36 mm from 5 m up (the floor seen within |x|, |y| < 1.8 m, pixel spreads
+     * 0.039-0.045), the cube out of view at x 2.5-3.5 m: seen only in the floor, at a footprint of
+     * (t0 + t1) x spread > 6 x 0.041, a quarter of it > 0.06 on every path (the floor's segment
+     * alone, t1 x spread, would be a quarter of at most 0.27, above 0.05 on most). Radii 0.05: no
+     * walk; 0.2, above a quarter of any path's footprint: walks. */
+    dwv_camera_t perspective = DWV_CAMERA_INIT;
+    perspective.transform[11] = 5.0;
+    const double aside[5] = {2.5, -0.5, 3.5, 0.5, 1.0};
+    below = glossy_floor_walks(&perspective, aside, 0.05);
+    above = glossy_floor_walks(&perspective, aside, 0.2);
+    CHECK(below == 0u, "perspective: radii below a quarter of the paths' footprints walked %llu times",
           (unsigned long long)below);
-    CHECK(above > 0u, "radii 10%% above a quarter of the footprint never walked");
+    CHECK(above > 0u, "perspective: radii above a quarter of the paths' footprints never walked");
 }
 
 int main(void)
