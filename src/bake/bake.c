@@ -469,7 +469,7 @@ dwv_result_t dwvb_bake_start(dwvb_scene *scene, const dwv_bake_options_t *option
                                             options->glossy_bounces,      options->transmission_bounces,
                                             options->min_light_bounces,   (int)options->subsurface_after_diffuse};
     if (options->target == DWV_BAKE_CAMERA) {
-        /* The pixel's footprint for Cycles 4.0-4.4's quarter-pixel rule (shade.h). */
+        /* The pixel's footprint for Cycles 4.0-4.3's quarter-pixel rule (shade.h). */
         double px = 2.0 / bake->width, py = 2.0 / bake->height;
         bake->shader.footprint = scene->camera.kind == DWV_CAMERA_PERSPECTIVE ? DWVB_FOOTPRINT_PERSPECTIVE
                                                                               : DWVB_FOOTPRINT_CONSTANT;
