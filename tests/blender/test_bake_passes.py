@@ -51,7 +51,7 @@ NOISE_RATIO_LIMIT = 1.5
 FIGURES = {"blender_version": list(bpy.app.version)}
 # The glossy highlight varies within a texel and is nearly noise-free under a sun (relative
 # standard error 0.02%), so its per-texel ratio weighs how the texel's samples spread: Cycles 3.6+
-# and the library draw them alike (5.2: 1.55; against texel centres it was 10), Cycles 3.4-3.5 fold
+# and the library draw them alike (4.3: 1.07, 5.2: 1.55), Cycles 3.4-3.5 fold
 # a point that leaves its triangle back into it (bake_clamp_mirror_repeat; 3.4: 8.0), which the
 # library does not model: the per-texel bound is 2 there from 3.6 on, none before (means: 2%).
 JITTER_BOUND_CASES = ("glossy_direct_color",)
