@@ -526,10 +526,12 @@ typedef struct dwv_material_t {
     int32_t specular_multiscatter; /* 0: GGX; 1: Multiscatter GGX (4.x+: energy-compensated; refused with
                                      DWV_SPECULAR_PRINCIPLED_V1, whose multiscatter is a stochastic walk) */
     uint32_t reserved2;           /* 0 */
-    /* >= 0, finite: in camera bakes a channel whose radius x scale is below this many times the
-     * camera ray's footprint at the hit (Cycles' sd->dP: distance x the pixel's angular spread, or
-     * the pixel's width for an orthographic camera) is Lambertian there: Cycles 4.0-4.4's "fall back
-     * to diffuse if the radius is smaller than a quarter pixel" (0.25). 0: never (UV bakes: never). */
+    /* >= 0, finite: a channel whose radius x scale is below this many times the ray's footprint at
+     * a hit (Cycles' ray differentials sd->dP: for a camera ray distance x the pixel's angular
+     * spread, or the pixel's width for an orthographic camera; for a UV bake the texel's footprint
+     * on the surface, from the UV layout; along a path the first ray's, grown by the path's length
+     * x the camera ray's spread) is Lambertian there: Cycles 4.0-4.3's "fall back to diffuse if the
+     * radius is smaller than a quarter pixel" (0.25; removed in 4.4). 0: never. */
     double subsurface_min_footprint;
 } dwv_material_t;
 #define DWV_MATERIAL_INIT                                                                           \

@@ -392,9 +392,11 @@ def texture_uses(material: Any, converted: Any, warnings: List[str],
 
 
 def footprint_rule(version: Tuple[int, ...]) -> float:
-    """Cycles 4.0-4.4's bssrdf_setup turns a channel whose radius is below a quarter of the camera
-    ray's footprint into diffuse (removed in 4.5): 0.25 there, else 0."""
-    return 0.25 if (4, 0, 0) <= tuple(version) < (4, 5, 0) else 0.0
+    """Cycles 4.0-4.3's bssrdf_setup turns a channel whose radius is below a quarter of the ray's
+    footprint (a camera pixel's, a UV bake texel's) into diffuse; Cycles commit 58f78fb1e
+    ("Remove camera size optimization from SSS shader", 2025-01-21) removed it before v4.4.0:
+    0.25 there, else 0."""
+    return 0.25 if (4, 0, 0) <= tuple(version) < (4, 4, 0) else 0.0
 
 
 # ---------------------------------------------------------------------------------------------

@@ -172,8 +172,8 @@ class Material:
     (dwv_subsurface_model_t). specular_model: "none", "principled_v1" (3.x: Specular, Specular
     Tint as specular_tint[0], Roughness) or "principled_v2" (4.x+: ior, Specular IOR Level as
     `specular`, the Specular Tint colour, Roughness, specular_multiscatter for Multiscatter GGX).
-    subsurface_min_footprint: Cycles 4.0-4.4 turn a channel whose radius is below a quarter of the
-    camera ray's footprint into diffuse (0.25; 0: never). The add-on sets all of these from
+    subsurface_min_footprint: Cycles 4.0-4.3 turn a channel whose radius is below a quarter of the
+    ray's footprint (a camera pixel's, a UV bake texel's) into diffuse (0.25; 0: never). The add-on sets all of these from
     bpy.app.version and the node (blender_addon/dwivedi_bake/export.py).
     """
 

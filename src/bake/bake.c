@@ -38,6 +38,44 @@ static void camera_sample(const dwvb_bake *bake, uint32_t x, uint32_t row, const
     }
 }
 
+/* The salt of the counter-based numbers of a texel sample's further tries (texel_sample). */
+#define TEXEL_RETRY_SALT 0x9e6c63d0676a9a99ull
+
+/* A UV bake's sample of texel `index`: its triangle and the point of it the sample shades, and the
+ * shader it shades with. As Cycles (integrator_init_from_bake, 3.6+): the texel centre moved by
+ * the sampler's pair PIXEL_PAIR (unused otherwise in UV bakes: stratified over the texel's
+ * samples) over a box of the texel's differentials (dwvb_uv_jitter); where that point is not
+ * inside the triangle, up to DWVB_UV_JITTER_TRIES - 1 further tries from counter-based numbers of
+ * the sample, then the centre. (Cycles shades its sample 0 at the centre; here every sample is
+ * jittered: the box filter's mean, to 1 / samples of it.) The shader is `shader` with the texel's
+ * footprint on the surface (dwvb_uv_texel_footprint) as a constant one: Cycles' ray differential
+ * for Cycles 4.0-4.3's quarter-footprint rule (dwvb_material.min_footprint). */
+static void texel_sample(const dwvb_bake *bake, const dwvg_mesh *mesh, uint32_t index, const dwvk_sampler *sampler,
+                         uint64_t key_walk, dwvg_hit *hit, dwvb_shader *texel_shader, const dwvb_shader *shader)
+{
+    const dwvb_uv_texel *texel = &bake->raster.texels[index];
+    hit->prim = (uint32_t)texel->triangle;
+    hit->u = texel->b1;
+    hit->v = texel->b2;
+    hit->t = 0.0;
+    dwvb_uv_steps step;
+    dwvb_uv_texel_steps(mesh->uvs + 6u * (size_t)hit->prim, bake->width, bake->height, &step);
+    double r[2];
+    dwvk_sampler_pair(sampler, PIXEL_PAIR, r);
+    dwvk_sampler retry = {dwvk_mix64(key_walk ^ TEXEL_RETRY_SALT), 0u, 0};
+    for (uint32_t k = 1; !dwvb_uv_jitter(&step, texel->b1, texel->b2, r[0], r[1], &hit->u, &hit->v); ++k) {
+        if (k == DWVB_UV_JITTER_TRIES) break; /* the centre, set above */
+        dwvk_sampler_pair(&retry, k - 1u, r);
+    }
+    dwvu_vec3 p0 = dwvg_point(mesh, hit->prim, 0.0, 0.0);
+    dwvu_vec3 e1 = dwvu_sub(dwvg_point(mesh, hit->prim, 1.0, 0.0), p0);
+    dwvu_vec3 e2 = dwvu_sub(dwvg_point(mesh, hit->prim, 0.0, 1.0), p0);
+    double edge1[3] = {e1.x, e1.y, e1.z}, edge2[3] = {e2.x, e2.y, e2.z};
+    *texel_shader = *shader;
+    texel_shader->footprint = DWVB_FOOTPRINT_CONSTANT;
+    texel_shader->pixel = dwvb_uv_texel_footprint(edge1, edge2, &step);
+}
+
 void dwvb_bake_sample(const dwvb_bake *bake, const dwvb_shader *shader, uint64_t stream, uint32_t index, uint64_t s,
                       dwvb_shade_parts *parts, double rgb[3], double *alpha, uint32_t *mesh_seen, dwvb_tally *tally)
 {
@@ -50,6 +88,7 @@ void dwvb_bake_sample(const dwvb_bake *bake, const dwvb_shader *shader, uint64_t
                             .index = s / REPLICATES, .stratified = 1};
     uint64_t key_walk = dwvk_rng_key(bake->options.seed, stream | WALK_STREAM | index, s);
     *mesh_seen = UINT32_MAX;
+    dwvb_shader texel_shader;
     uint32_t x = index % bake->width, row = index / bake->width;
     dwvg_hit hit;
     dwvu_vec3 view;
@@ -67,17 +106,15 @@ void dwvb_bake_sample(const dwvb_bake *bake, const dwvb_shader *shader, uint64_t
             return;
         }
     } else {
-        /* The texel centre's surface point, seen along its normal: the radiance leaving along n,
-         * the smooth normal where the mesh has normals (Cycles' integrator_init_from_bake:
-         * ray.D = -N, N = triangle_smooth_normal for smooth-shaded triangles; the view-dependent
-         * lobes, the specular layer above all, see the texel from there). */
-        const dwvb_uv_texel *texel = &bake->raster.texels[index];
+        /* A point of the texel on its triangle (texel_sample), seen along its normal: the radiance
+         * leaving along n, the smooth normal where the mesh has normals (Cycles'
+         * integrator_init_from_bake: ray.D = -N, N = triangle_smooth_normal for smooth-shaded
+         * triangles; the view-dependent lobes, the specular layer above all, see the texel from
+         * there). */
         hit.mesh = bake->options.uv_mesh;
-        hit.prim = (uint32_t)texel->triangle;
-        hit.u = texel->b1;
-        hit.v = texel->b2;
-        hit.t = 0.0;
         const dwvg_mesh *mesh = &bake->scene->meshes[hit.mesh];
+        texel_sample(bake, mesh, index, &sampler, key_walk, &hit, &texel_shader, shader);
+        shader = &texel_shader;
         dwvu_vec3 ng = dwvg_geometric_normal(mesh, hit.prim);
         view = dwvu_scale(dwvg_shading_normal(mesh, hit.prim, hit.u, hit.v, ng), -1.0);
     }
@@ -432,9 +469,10 @@ dwv_result_t dwvb_bake_start(dwvb_scene *scene, const dwv_bake_options_t *option
                                             options->glossy_bounces,      options->transmission_bounces,
                                             options->min_light_bounces,   (int)options->subsurface_after_diffuse};
     if (options->target == DWV_BAKE_CAMERA) {
-        /* The pixel's footprint for Cycles 4.0-4.4's quarter-pixel rule (shade.h). */
+        /* The pixel's footprint for Cycles 4.0-4.3's quarter-pixel rule (shade.h). */
         double px = 2.0 / bake->width, py = 2.0 / bake->height;
-        bake->shader.footprint = scene->camera.kind == DWV_CAMERA_PERSPECTIVE ? 1 : 2;
+        bake->shader.footprint = scene->camera.kind == DWV_CAMERA_PERSPECTIVE ? DWVB_FOOTPRINT_PERSPECTIVE
+                                                                              : DWVB_FOOTPRINT_CONSTANT;
         bake->shader.eye = bake->eye;
         bake->shader.forward = bake->forward;
         bake->shader.pixel_right = dwvu_scale(bake->right, px);

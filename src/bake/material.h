@@ -78,9 +78,10 @@ typedef struct dwvb_material {
     double spec_Fms[3];        /* v2 multiscatter: Kulla-Conty's multiple-bounce Fresnel */
     const dwvb_spec_grid *spec_grid; /* v2 with a textured Roughness or Specular IOR Level: the
                                   tables textured points interpolate (owned by the scene), else NULL */
-    /* Cycles 4.0-4.4's footprint rule (dwv_material_t.subsurface_min_footprint): a walking channel
-     * c whose radius[c] (radius x scale) is below min_footprint x the camera ray's footprint turns
-     * into a Lambertian lobe of fallback_albedo[c] there. */
+    /* Cycles 4.0-4.3's footprint rule (dwv_material_t.subsurface_min_footprint): a walking channel
+     * c whose radius[c] (radius x scale) is below min_footprint x the ray's footprint (camera pixel,
+     * UV texel, grown along a path: shade.h dwvb_footprint) turns into a Lambertian lobe of
+     * fallback_albedo[c] there. */
     double min_footprint;
     double radius[3];
     double fallback_albedo[3];

@@ -284,8 +284,8 @@ static void exit_light(const dwvb_shader *shader, uint32_t mesh_id, const dwvb_m
 
 double dwvb_footprint(const dwvb_shader *shader, dwvu_vec3 view, double t)
 {
-    if (shader->footprint == 2) return shader->pixel;
-    if (shader->footprint != 1) return 0.0;
+    if (shader->footprint == DWVB_FOOTPRINT_CONSTANT) return shader->pixel;
+    if (shader->footprint != DWVB_FOOTPRINT_PERSPECTIVE) return 0.0;
     double along = dwvu_dot(view, shader->forward);
     if (!(along > 0.0)) return 0.0;
     dwvu_vec3 d = dwvu_scale(view, 1.0 / along); /* on the plane at unit distance */
@@ -296,11 +296,13 @@ double dwvb_footprint(const dwvb_shader *shader, dwvu_vec3 view, double t)
 
 #define INV_PI 0.31830988618379067154
 
-/* Where a path stands (Cycles' path state): its bounces so far by kind, and whether one of them
- * was diffuse (PATH_RAY_DIFFUSE_ANCESTOR). */
+/* Where a path stands (Cycles' path state): its bounces so far by kind, whether one of them was
+ * diffuse (PATH_RAY_DIFFUSE_ANCESTOR), and its ray's compact differentials (Cycles' ray.dP, ray.dD:
+ * the footprint at the next hit is dP + t dD; dwvb_footprint). */
 typedef struct path_state {
     uint32_t bounce, diffuse, glossy, transmission;
     int diffuse_ancestor;
+    double dP, dD;
 } path_state;
 
 /* A path's next segment, sampled at a scattering point: the ray (from the point's offset
@@ -565,13 +567,15 @@ static void shade_point(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec
     int tilted = n.x != smooth_n.x || n.y != smooth_n.y || n.z != smooth_n.z;
     int bumped = tilted ? dwvb_textured_bump_shadowing(scene, hit->mesh) : DWV_BUMP_SHADOWING_NONE;
     uint32_t light_pairs = dwvl_direct_pairs(&shader->env);
-    /* Cycles 4.0-4.4: channels whose radius is below a quarter of the camera ray's footprint are
-     * Lambertian at this hit (bssrdf_setup); their walks' results are not used. */
+    /* Cycles 4.0-4.3: channels whose radius is below a quarter of the ray's footprint are
+     * Lambertian at this hit (bssrdf_setup); their walks' results are not used. The footprint: the
+     * first ray's (camera or texel, dwvb_footprint), at a later hit the path's (path_state). */
     double diffuse_albedo[3], keep[3] = {1.0, 1.0, 1.0};
     int walks_left = material->subsurface;
     for (int c = 0; c < 3; ++c) diffuse_albedo[c] = material->diffuse_albedo[c];
-    if (camera && material->subsurface && material->min_footprint > 0.0 && shader->footprint) {
-        double limit = material->min_footprint * dwvb_footprint(shader, view, hit->t);
+    if (material->subsurface && material->min_footprint > 0.0 && shader->footprint) {
+        double footprint = camera ? dwvb_footprint(shader, view, hit->t) : state->dP + hit->t * state->dD;
+        double limit = material->min_footprint * footprint;
         walks_left = 0;
         for (int c = 0; c < 3; ++c) {
             if (material->walk_scale[c] > 0.0 && material->radius[c] < limit) {
@@ -795,6 +799,10 @@ static void follow_path(const dwvb_shader *shader, const path_ray *first, path_s
         for (int c = 0; c < 3; ++c)
             out[c] += throughput[c] * (direct[DWVB_LOBE_DIFFUSE][c] + direct[DWVB_LOBE_GLOSSY][c]);
         if (count == 0u || !choose_ray(rays, count, u[1], &ray)) return;
+        /* The next ray's differentials: dP the footprint here, dD kept, 0 after a walk
+         * (shade_surface.h, subsurface.h). */
+        state.dP += hit.t * state.dD;
+        if (ray.exit) state.dD = 0.0;
     }
 }
 
@@ -802,7 +810,7 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
                 uint32_t pair, uint64_t key_walk, dwvb_shade_parts *parts, dwvb_tally *tally)
 {
     *parts = (dwvb_shade_parts){0};
-    path_state state = {0u, 0u, 0u, 0u, 0};
+    path_state state = {0u, 0u, 0u, 0u, 0, 0.0, 0.0};
     path_ray rays[1u + 3u * DWVB_MAX_CHANNEL_WALKS];
     uint32_t count = 0u;
     /* No ray goes on where the limits leave no bounce: the one-bounce image, bit for bit. */
@@ -829,8 +837,13 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
         if (exit_count == 1u) paths[path_count++] = exits[0];
         else if (exit_count && choose_ray(exits, exit_count, u[0], &paths[path_count])) ++path_count;
     }
+    /* The paths' first rays' differentials: dP the footprint at this hit, dD the camera ray's
+     * (0 after a walk and for a constant footprint). */
+    state.dP = dwvb_footprint(shader, view, hit->t);
+    double spread = shader->footprint == DWVB_FOOTPRINT_PERSPECTIVE ? dwvb_footprint(shader, view, 1.0) : 0.0;
     for (uint32_t j = 0; j < path_count; ++j) {
         double gathered[3];
+        state.dD = paths[j].exit ? 0.0 : spread;
         follow_path(shader, &paths[j], state, dwvk_mix64(key_walk ^ (PATH_ONWARD_SALT + 1u + j)), gathered, tally);
         for (int c = 0; c < 3; ++c) parts->indirect[paths[j].lobe][c] += gathered[c];
     }

@@ -45,17 +45,23 @@ typedef struct dwvb_shader {
     const uint8_t *channel_counts;
     uint32_t max_events;
     dwvb_light_paths paths;
-    /* Camera bakes: the camera ray's footprint at a hit (Cycles' sd->dP, for
-     * dwvb_material.min_footprint): 1 perspective (eye, forward, and right / up one pixel apart on
-     * the plane at unit distance), 2 orthographic (pixel: a pixel's width); 0 none (UV bakes). */
+    /* The footprint of the ray that found the first hit (Cycles' ray differentials, sd->dP, for
+     * dwvb_material.min_footprint): DWVB_FOOTPRINT_PERSPECTIVE (eye, forward, and right / up one
+     * pixel apart on the plane at unit distance), DWVB_FOOTPRINT_CONSTANT (`pixel` at any
+     * distance: an orthographic camera's pixel width, a UV bake texel's footprint on the surface,
+     * dwvb_uv_texel_footprint), DWVB_FOOTPRINT_NONE. */
     int footprint;
     dwvu_vec3 eye, pixel_right, pixel_up, forward;
     double pixel;
 } dwvb_shader;
 
-/* The camera ray's footprint at distance t along unit `view` (Cycles 4.x differentials:
- * t x 0.5 (|normalize(D + dx) - D'| + |normalize(D + dy) - D'|), D the direction on the unit
- * plane, D' = view). */
+enum { DWVB_FOOTPRINT_NONE = 0, DWVB_FOOTPRINT_PERSPECTIVE = 1, DWVB_FOOTPRINT_CONSTANT = 2 };
+
+/* The first ray's footprint at distance t along unit `view` (Cycles 4.x compact differentials,
+ * sd->dP = dP + t dD): perspective t x 0.5 (|normalize(D + dx) - D'| + |normalize(D + dy) - D'|),
+ * D the direction on the unit plane, D' = view (dP = 0); constant: `pixel` (dD = 0). Along a path
+ * Cycles keeps the camera's dD and takes sd->dP as the next ray's dP (shade_surface.h), so that
+ * the footprint at a later hit is dP + (the path's length) dD: dwvb_shade follows that. */
 double dwvb_footprint(const dwvb_shader *shader, dwvu_vec3 view, double t);
 
 /* Cycles' light passes (Blender's bake types Diffuse, Glossy, Transmission and Combined's pass

@@ -32,6 +32,7 @@
  * type (uint32 sample counts too), and it does not depend on the order texels are visited in. */
 #include "bake/uv_raster.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -228,6 +229,50 @@ void dwvb_uv_raster_free(dwvb_uv_raster *raster)
     if (!raster) return;
     free(raster->texels);
     memset(raster, 0, sizeof *raster);
+}
+
+/* ---- a texel's frame on its triangle (uv_raster.h) ---------------------------------------- */
+
+void dwvb_uv_texel_steps(const float *uv, uint32_t width, uint32_t height, dwvb_uv_steps *step)
+{
+    /* Corners in texels; centre - P0 = b1 (P1 - P0) + b2 (P2 - P0) inverted by Cramer's rule:
+     * d b1 / dx = e2y / A, d b1 / dy = -e2x / A, d b2 / dx = -e1y / A, d b2 / dy = e1x / A. */
+    double e1x = ((double)uv[2] - uv[0]) * width, e1y = ((double)uv[3] - uv[1]) * height;
+    double e2x = ((double)uv[4] - uv[0]) * width, e2y = ((double)uv[5] - uv[1]) * height;
+    double area2 = e1x * e2y - e2x * e1y;
+    if (!(fabs(area2) > (double)FLT_EPSILON)) { /* also NaN */
+        *step = (dwvb_uv_steps){{{0.0, 0.0}, {0.0, 0.0}}};
+        return;
+    }
+    double half = 0.5 / area2;
+    step->d[0][0] = e2y * half;
+    step->d[0][1] = -e2x * half;
+    step->d[1][0] = -e1y * half;
+    step->d[1][1] = e1x * half;
+}
+
+double dwvb_uv_texel_footprint(const double e1[3], const double e2[3], const dwvb_uv_steps *step)
+{
+    double sum = 0.0;
+    for (int a = 0; a < 2; ++a) {
+        double d2 = 0.0;
+        for (int i = 0; i < 3; ++i) {
+            double d = e1[i] * step->d[0][a] + e2[i] * step->d[1][a];
+            d2 += d * d;
+        }
+        sum += sqrt(d2);
+    }
+    return 0.5 * sum;
+}
+
+int dwvb_uv_jitter(const dwvb_uv_steps *step, double b1, double b2, double r0, double r1, double *j1, double *j2)
+{
+    double u = b1 + (r0 - 0.5) * step->d[0][0] + (r1 - 0.5) * step->d[0][1];
+    double v = b2 + (r0 - 0.5) * step->d[1][0] + (r1 - 0.5) * step->d[1][1];
+    if (!(u > 0.0 && v > 0.0 && u + v < 1.0)) return 0;
+    *j1 = u;
+    *j2 = v;
+    return 1;
 }
 
 /* ---- margin ---------------------------------------------------------------------------------- */

@@ -56,6 +56,32 @@ dwv_result_t dwvb_uv_rasterize(const float *uvs, uint32_t triangle_count, uint32
                                uint32_t height, dwvb_uv_raster *raster);
 void dwvb_uv_raster_free(dwvb_uv_raster *raster);
 
+/* A texel's frame on its triangle, as Blender hands a UV bake's texels to Cycles
+ * (RE_bake_pixels_populate, bake_differentials; Cycles' integrator_init_from_bake):
+ * d[k][a] = 1/2 d b_k / d x_a, half the change of the barycentric b_k (k = 0: corner 1's, k = 1:
+ * corner 2's, as dwvb_uv_texel) per texel along image axis a (0: x, to the right; 1: y, up in UV).
+ * Blender's differentials are 0.5 / A times the edge terms, A twice the triangle's area in texels:
+ * half a texel's step, which Cycles then takes as the ray's differential. All zero where
+ * |A| <= FLT_EPSILON texels^2 (Blender's test). uv: the triangle's six UVs (as dwv_mesh_t.uvs). */
+typedef struct dwvb_uv_steps {
+    double d[2][2];
+} dwvb_uv_steps;
+void dwvb_uv_texel_steps(const float *uv, uint32_t width, uint32_t height, dwvb_uv_steps *step);
+
+/* Cycles' footprint of a UV bake's texel on the surface (the ray's compact differential sd->dP:
+ * 0.5 (|dP/dx| + |dP/dy|) with dP/dx_a = e1 d[0][a] + e2 d[1][a]), e1, e2 the triangle's
+ * edges from corner 0 to corners 1 and 2: a quarter of the sum of the lengths of one texel's
+ * steps along x and y on the surface. */
+double dwvb_uv_texel_footprint(const double e1[3], const double e2[3], const dwvb_uv_steps *step);
+
+/* The texel's sample at uniforms (r0, r1) in [0, 1)^2: the centre's barycentrics (b1, b2) moved by
+ * (r0 - 1/2, r1 - 1/2) differentials, Cycles' box filter of half a texel's width about the centre
+ * (bake_jitter_barycentric, Cycles 3.6+). Returns 1 and the moved point where it lies strictly
+ * inside the triangle, else 0 (Cycles then tries new numbers, and after 10 tries the centre). */
+int dwvb_uv_jitter(const dwvb_uv_steps *step, double b1, double b2, double r0, double r1, double *j1, double *j2);
+/* Cycles' tries before it keeps the centre. */
+#define DWVB_UV_JITTER_TRIES 10u
+
 /* The margin: for every texel, the covered texel whose values it takes. A covered texel takes its
  * own; an uncovered texel at Chebyshev distance d in 1..margin from the covered ones takes those of
  * a covered texel at that distance (found by d passes over 8-neighbours, see uv_raster.c); the

@@ -6,7 +6,7 @@ the tests and tools/cycles_report.py run Blender in a chroot (make_chroot, blend
     python3 tests/blender/run_package_tests.py --blender host|trixie|sid --build-dir build
             [--script test_package.py|test_fidelity.py|test_farm.py|...] [--ui] [--work DIR]
 
---script (default test_package.py): the script, run with harness.py and scenes.py beside it; it
+--script (default test_package.py): the script, run with harness.py, scenes.py and uv_bakes.py beside it; it
 installs the package the build made for that Blender (3.x: the legacy zip, 4.2+: the extension)
 itself. test_fidelity.py compares the bakes with that Blender's Cycles; its figures
 (fidelity_figures.json) are copied to WORK, pass or fail. --ui runs test_ui.py instead, in
@@ -57,7 +57,7 @@ TIMES = {}
 SCRIPTS = tuple(sorted(p.name for p in Path(__file__).resolve().parent.glob("test_*.py") if p.name != "test_ui.py"))
 # Passed on to test_fidelity.py (its settings, for a diagnosis run; CI uses its defaults).
 FIDELITY_SETTINGS = ("DWIVEDI_FIDELITY_EVENT_CAP", "DWIVEDI_FIDELITY_ONLY", "DWIVEDI_FIDELITY_RESOLUTION",
-                     "DWIVEDI_FIDELITY_CYCLES_SPP", "DWIVEDI_FIDELITY_DWIVEDI_SPP")
+                     "DWIVEDI_FIDELITY_CYCLES_SPP", "DWIVEDI_FIDELITY_DWIVEDI_SPP", "DWIVEDI_FOOTPRINT_PLANTED")
 
 
 def fail(message):
@@ -194,7 +194,7 @@ def main(argv=None):
 
     def stage_files():
         (stage / "scripts").mkdir(parents=True)
-        for name in sorted({test_script, "harness.py", "scenes.py"}):
+        for name in sorted({test_script, "harness.py", "scenes.py", "uv_bakes.py"}):
             shutil.copy2(HERE / name, stage / "scripts" / name)
         shutil.copy2(legacy, stage / legacy.name)
         shutil.copy2(extension, stage / extension.name)
