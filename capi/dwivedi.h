@@ -1124,10 +1124,15 @@ typedef struct dwv_bake_stats_t {
     uint64_t warnings;           /* degenerate geometry met (zero-area triangles, NaN hits...) */
     uint32_t error_vs_time_count;/* points in dwv_image_error_vs_time */
     uint32_t reserved;
+    /* Added after 0.3 (issue 18; a caller whose struct_size ends before it gets the fields before
+     * it). Rays the paths after the first scattering traced (indirect light and mirrors'
+     * reflections; the walks' own rays are not counted). Merged partial files: 0 (their format
+     * does not carry it). */
+    uint64_t path_rays;
 } dwv_bake_stats_t;
 #define DWV_BAKE_STATS_INIT                                                                         \
     {sizeof(dwv_bake_stats_t), 0, 0u, 0u, 0u, 0u, 0.0, 0.0, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, 0u,    \
-     0u, 0u, 0u, 0u}
+     0u, 0u, 0u, 0u, 0u}
 DWV_API dwv_result_t dwv_image_stats(const dwv_image_t *image, dwv_bake_stats_t *stats);
 /* One point of the error-against-time series (one per completed pass). */
 typedef struct dwv_error_point_t {
