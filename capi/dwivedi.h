@@ -999,7 +999,9 @@ typedef struct dwv_bake_options_t {
      * until its bounces of that kind or in total would exceed their limit, each 0 to 1024; after
      * min_light_bounces + 1 bounces, Russian roulette as Cycles (continuation probability
      * min(1, sqrt(max channel of the path's throughput))). max_bounces = 0: the one-bounce
-     * image, bit for bit. dwivedi's materials have no transmission lobe (a walk's entry is no
+     * image, bit for bit, but for mirror-sharp specular layers (Roughness 0, or nearly: Cycles'
+     * singular reflection), whose reflected ray is traced for the lights and world it meets
+     * whatever the limits, as Cycles' (its limits are the scene's + 1). dwivedi's materials have no transmission lobe (a walk's entry is no
      * transmission bounce in Cycles either): transmission_bounces never limits a path today. */
     uint32_t max_bounces, diffuse_bounces, glossy_bounces, transmission_bounces;
     uint32_t min_light_bounces;

@@ -496,6 +496,7 @@ static int surface_path_ray(const dwvb_shader *shader, const surface_lobes *s, d
         double f[2][3];
         surface_factor(s, w, f);
         double cos_n = fmax(dwvu_dot(s->lobe.n, w), 0.0), cos_s = fmax(dwvu_dot(s->specular_n, w), 0.0);
+        if (!(cos_n > 0.0) && !(cos_s > 0.0)) return 0; /* below both lobes' horizons: nothing */
         for (int c = 0; c < 3; ++c) ray->weight[c] = (f[0][c] * cos_s + f[1][c] * cos_n) * INV_PI / pdf;
     }
     path_ray_from(shader, x, ng, top, w, ray);
