@@ -497,7 +497,11 @@ static int surface_path_ray(const dwvb_shader *shader, const surface_lobes *s, d
         surface_factor(s, w, f);
         double cos_n = fmax(dwvu_dot(s->lobe.n, w), 0.0), cos_s = fmax(dwvu_dot(s->specular_n, w), 0.0);
         if (!(cos_n > 0.0) && !(cos_s > 0.0)) return 0; /* below both lobes' horizons: nothing */
-        for (int c = 0; c < 3; ++c) ray->weight[c] = (f[0][c] * cos_s + f[1][c] * cos_n) * INV_PI / pdf;
+        /* One normal for both (no normal map, or one that needed no correction): the BRDF's sum
+         * times its cosine, as before the lobes had normals of their own (the same bits). */
+        for (int c = 0; c < 3; ++c)
+            ray->weight[c] = cos_s == cos_n ? (f[0][c] + f[1][c]) * INV_PI * cos_n / pdf
+                                            : (f[0][c] * cos_s + f[1][c] * cos_n) * INV_PI / pdf;
     }
     path_ray_from(shader, x, ng, top, w, ray);
     ray->exit = 0;
