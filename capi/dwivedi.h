@@ -1001,7 +1001,9 @@ typedef struct dwv_bake_options_t {
      * until its bounces of that kind or in total would exceed their limit, each 0 to 1024; after
      * min_light_bounces + 1 bounces, Russian roulette as Cycles (continuation probability
      * min(1, sqrt(max channel of the path's throughput))). max_bounces = 0: the one-bounce
-     * image, bit for bit. dwivedi's materials have no transmission lobe (a walk's entry is no
+     * image, bit for bit, but for mirror-sharp specular layers (Roughness 0, or nearly: Cycles'
+     * singular reflection), whose reflected ray is traced for the lights and world it meets
+     * whatever the limits, as Cycles' (its limits are the scene's + 1). dwivedi's materials have no transmission lobe (a walk's entry is no
      * transmission bounce in Cycles either): transmission_bounces never limits a path today. */
     uint32_t max_bounces, diffuse_bounces, glossy_bounces, transmission_bounces;
     uint32_t min_light_bounces;
@@ -1126,10 +1128,15 @@ typedef struct dwv_bake_stats_t {
     uint64_t warnings;           /* degenerate geometry met (zero-area triangles, NaN hits...) */
     uint32_t error_vs_time_count;/* points in dwv_image_error_vs_time */
     uint32_t reserved;
+    /* Added after 0.3 (issue 18; a caller whose struct_size ends before it gets the fields before
+     * it). Rays the paths after the first scattering traced (indirect light and mirrors'
+     * reflections; the walks' own rays are not counted). Merged partial files: 0 (their format
+     * does not carry it). */
+    uint64_t path_rays;
 } dwv_bake_stats_t;
 #define DWV_BAKE_STATS_INIT                                                                         \
     {sizeof(dwv_bake_stats_t), 0, 0u, 0u, 0u, 0u, 0.0, 0.0, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, 0u,    \
-     0u, 0u, 0u, 0u}
+     0u, 0u, 0u, 0u, 0u}
 DWV_API dwv_result_t dwv_image_stats(const dwv_image_t *image, dwv_bake_stats_t *stats);
 /* One point of the error-against-time series (one per completed pass). */
 typedef struct dwv_error_point_t {

@@ -607,6 +607,9 @@ class _Job:
         # The technique asked for and whether the walks carried the colour channels apart (the
         # Channel Walks setting, or auto's choice per mesh), which the setting alone does not say.
         walks = stats.technique + (" with channel walks" if "channel_walks" in stats.features else "")
+        # Indirect light's work (getattr: an older shim's stats have no path rays).
+        path_rays = getattr(stats, "path_rays", 0)
+        walks += f", {path_rays / max(stats.samples, 1):.2f} path rays a sample" if path_rays else ""
         notes = "".join(f" ({note})" for note in self.notes if note)
         return (f"Dwivedi bake: {self.exported.width} x {self.exported.height}, {stats.samples_per_pixel} spp, "
                 f"{stats.seconds:.2f} s, est. error {stats.estimated_relative_error:.2%}, {walks}{degenerate} -> "

@@ -355,6 +355,7 @@ class BakeStats(_SizedStructure):
         ("warnings", ctypes.c_uint64),
         ("error_vs_time_count", ctypes.c_uint32),
         ("reserved", ctypes.c_uint32),
+        ("path_rays", ctypes.c_uint64),
     ]
 
 

@@ -581,6 +581,8 @@ class BakeStats:
     features: Tuple[str, ...]
     threads: int
     warnings: int
+    #: rays the paths after the first scattering traced (indirect light, mirrors' reflections)
+    path_rays: int = 0
 
 
 # ---------------------------------------------------------------------------------------------
@@ -1228,7 +1230,7 @@ class Image:
                          samples=s.samples, events=s.events, walks=s.walks, seconds=s.seconds,
                          estimated_relative_error=s.estimated_relative_error, mean_rgb=tuple(s.mean_rgb),
                          truncated_weight=tuple(s.truncated_weight), features=feature_names(s.features),
-                         threads=s.threads, warnings=s.warnings)
+                         threads=s.threads, warnings=s.warnings, path_rays=s.path_rays)
 
     @property
     def error_vs_time(self) -> List[ErrorPoint]:

@@ -1,5 +1,6 @@
 /* capi entry points of images: handles, pixels and what their bake measured. Writing them out
  * (EXR, display images) lives in image_io_api.c. */
+#include <stddef.h>
 #include <string.h>
 
 #include "bake/image.h"
@@ -52,9 +53,11 @@ dwv_result_t dwv_image_stats(const dwv_image_t *image, dwv_bake_stats_t *stats)
 {
     static const char fn[] = "dwv_image_stats";
     DWV_TRY(dwv_check_pointer(fn, "image", image));
-    DWV_TRY(dwv_check_struct(fn, "stats", stats, (uint32_t)sizeof(dwv_bake_stats_t)));
+    /* A caller's struct that ends before path_rays (an older header) gets the fields it has. */
+    DWV_TRY(dwv_check_struct(fn, "stats", stats, (uint32_t)offsetof(dwv_bake_stats_t, path_rays)));
     uint32_t size = stats->struct_size;
-    *stats = dwv_image_object(image)->stats;
+    dwv_bake_stats_t whole = dwv_image_object(image)->stats;
+    memcpy(stats, &whole, size < sizeof whole ? size : sizeof whole);
     stats->struct_size = size;
     return DWV_SUCCESS;
 }

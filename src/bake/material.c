@@ -258,7 +258,7 @@ void dwvb_specular_factor(const dwvb_material *m, dwvu_vec3 n, dwvu_vec3 L, dwvu
     f[0] = f[1] = f[2] = 0.0;
     double a2 = m->spec_alpha * m->spec_alpha;
     double cos_l = dwvu_dot(n, L), cos_v = dwvu_dot(n, V);
-    if (!m->specular || !(a2 > DWVB_GGX_MIN_ALPHA2) || !(cos_l > 0.0) || !(cos_v > 0.0)) return;
+    if (!m->specular || dwvb_specular_singular(m) || !(cos_l > 0.0) || !(cos_v > 0.0)) return;
     dwvu_vec3 h = dwvu_add(L, V);
     double len = dwvu_length(h);
     if (!(len > 0.0)) return;
@@ -284,6 +284,29 @@ void dwvb_specular_factor(const dwvb_material *m, dwvu_vec3 n, dwvu_vec3 L, dwvu
         for (int c = 0; c < 3; ++c) scale[c] = 1.0 + m->spec_Fms[c] * (1.0 - E) / E;
     }
     for (int c = 0; c < 3; ++c) f[c] = common * (m->spec_f0[c] + (1.0 - m->spec_f0[c]) * s) * scale[c];
+}
+
+int dwvb_specular_singular(const dwvb_material *m)
+{
+    double a2 = m->spec_alpha * m->spec_alpha;
+    return m->specular && !(a2 > (m->specular == DWV_SPECULAR_PRINCIPLED_V2 ? DWVB_GGX_MIN_ALPHA2_V2 : DWVB_GGX_MIN_ALPHA2));
+}
+
+void dwvb_specular_singular_weight(const dwvb_material *m, double mu, double f[3])
+{
+    f[0] = f[1] = f[2] = 0.0;
+    if (!dwvb_specular_singular(m) || !(mu > 0.0)) return;
+    if (m->specular == DWV_SPECULAR_PRINCIPLED_V1) {
+        double fh = (dwvb_fresnel_dielectric(mu, m->spec_eta) - m->spec_F0) / (1.0 - m->spec_F0);
+        for (int c = 0; c < 3; ++c) f[c] = m->spec_f0[c] * (1.0 - fh) + fh;
+        return;
+    }
+    double s = v2_share(mu, m->spec_eta, m->spec_F0);
+    double E = m->spec_multiscatter ? spec_table(m->spec_E, mu) : 1.0;
+    for (int c = 0; c < 3; ++c) {
+        double scale = m->spec_multiscatter ? 1.0 + m->spec_Fms[c] * (1.0 - E) / E : 1.0;
+        f[c] = (m->spec_f0[c] + (1.0 - m->spec_f0[c]) * s) * scale;
+    }
 }
 
 void dwvb_specular_color(const dwvb_material *m, double mu, double albedo[3])

@@ -90,9 +90,13 @@ typedef struct dwvb_material {
 /* Entries into the medium. */
 enum { DWVB_ENTRY_DIFFUSE = 0, DWVB_ENTRY_REFRACT = 1, DWVB_ENTRY_SKIN = 2 };
 
-/* GGX evaluation is skipped (a mirror: no light from sampled lights)
- * where alpha^2 is at most this, as Cycles' BSDF_ROUGHNESS_SQ_THRESH. */
+/* GGX evaluation is skipped (a mirror: no light from sampled lights; its reflection is the
+ * singular one, dwvb_specular_singular_weight) where alpha^2 is at most this: Cycles 3.x's
+ * alpha_x alpha_y <= 1e-7 (bsdf_microfacet.h), for DWV_SPECULAR_PRINCIPLED_V1; 4.0+'s
+ * BSDF_ROUGHNESS_SQ_THRESH = 2e-10 (svm/types.h; 5.x's roughness_is_almost_specular) for
+ * DWV_SPECULAR_PRINCIPLED_V2. */
 #define DWVB_GGX_MIN_ALPHA2 1e-7
+#define DWVB_GGX_MIN_ALPHA2_V2 2e-10
 
 /* Exact unpolarised Fresnel reflectance of a dielectric of relative IOR eta for the cosine c
  * (Cycles' fresnel_dielectric_cos form: g = sqrt(eta^2 - 1 + c^2), 1 past total reflection). */
@@ -127,6 +131,13 @@ double dwvb_albedo_van_de_hulst(double A, double g);
 /* The specular layer's BRDF times pi for light L and viewer V (unit, world), shading normal n,
  * into f[3]; 0 below either horizon. */
 void dwvb_specular_factor(const dwvb_material *m, dwvu_vec3 n, dwvu_vec3 L, dwvu_vec3 V, double f[3]);
+/* Whether the specular layer is a mirror (alpha^2 at most its model's DWVB_GGX_MIN_ALPHA2*). */
+int dwvb_specular_singular(const dwvb_material *m);
+/* A mirror layer's reflection toward a viewer at cosine mu (> 0) to its normal: the weight eval /
+ * pdf of Cycles' singular microfacet sample (H = N, so the Fresnel at L.H = mu) per channel:
+ * v1 (3.x reflection_color) cspec0 (1 - FH) + FH, FH = (F_d(mu, eta) - F0) / (1 - F0); v2 (4.x+
+ * generalized Schlick) f0 + (1 - f0) s(mu), times Multiscatter GGX's 1 + Fms (1 - E) / E. */
+void dwvb_specular_singular_weight(const dwvb_material *m, double mu, double f[3]);
 /* The weight of the layers below the specular toward a viewer at cosine mu to n: 1 for v1 and no
  * layer; v2: 1 - max_c (albedo of the layer, with its multiscatter darkening). */
 double dwvb_specular_layer_weight(const dwvb_material *m, double mu);

@@ -168,6 +168,7 @@ dwv_result_t dwvb_bake_make_image(dwvb_bake *bake, double seconds)
         total.point_queries += bake->tile_tallies[t].point_queries;
         total.ray_free_steps += bake->tile_tallies[t].ray_free_steps;
         total.ray_free_misses += bake->tile_tallies[t].ray_free_misses;
+        total.path_rays += bake->tile_tallies[t].path_rays;
         for (int c = 0; c < 3; ++c) total.truncated[c] += bake->tile_tallies[t].truncated[c];
     }
     st->technique = bake->options.technique;
@@ -178,6 +179,7 @@ dwv_result_t dwvb_bake_make_image(dwvb_bake *bake, double seconds)
     image->ray_free_misses = total.ray_free_misses;
     image->mixture_terms = total.mixture_terms;
     st->walks = total.walks;
+    st->path_rays = total.path_rays;
     st->seconds = seconds;
     st->estimated_relative_error = bake->error;
     for (int c = 0; c < 3; ++c) st->truncated_weight[c] = samples ? total.truncated[c] / (double)samples : 0.0;

@@ -315,6 +315,11 @@ typedef struct path_ray {
     int lobe;
     int clear;
     int exit; /* sent on from a walk's exit: 1 + the channel of a channel walk, 4 the one walk; 0 the lobes */
+    /* A mirror's reflection (Cycles' LABEL_SINGULAR): no light sample can find its direction, so
+     * the ray takes the whole emission it meets (lights and world, dwvl_emission_along), and it
+     * is traced for that even where its bounce exceeds a limit (Cycles' kernel limits are the
+     * scene's + 1: that bounce's ray is traced and only its emission is taken). */
+    int singular;
 } path_ray;
 
 /* Cycles' path_state_next for a bounce off `lobe`: counts it, or returns 0 where it would exceed
@@ -385,6 +390,7 @@ static int exit_path_ray(const dwvb_shader *shader, const exit_point *e, const d
     path_ray_from(shader, e->x, e->ng, e->top, w, ray);
     for (int c = 0; c < 3; ++c) ray->weight[c] = weight[c] * f;
     ray->lobe = DWVB_LOBE_DIFFUSE;
+    ray->singular = 0;
     ray->exit = 4;
     for (int c = 0; c < 3; ++c)
         if (weight[c] > 0.0 && weight[(c + 1) % 3] == 0.0 && weight[(c + 2) % 3] == 0.0) ray->exit = 1 + c;
@@ -395,7 +401,12 @@ double dwvb_surface_specular_probability(const dwvb_material *m, const double di
 {
     double weight = 0.0, specular = 0.0;
     for (int c = 0; c < 3; ++c) weight += (diffuse[c] + m->retro_albedo[c]) / 3.0;
-    if (m->specular && m->spec_alpha * m->spec_alpha > DWVB_GGX_MIN_ALPHA2 && cos_view > 0.0) {
+    if (m->specular && dwvb_specular_singular(m) && cos_view > 0.0) {
+        /* The mirror's own reflectance (its whole albedo): its weight is then F / p_s. */
+        double f[3];
+        dwvb_specular_singular_weight(m, cos_view, f);
+        specular = (f[0] + f[1] + f[2]) / 3.0;
+    } else if (m->specular && cos_view > 0.0) {
         if (m->specular == DWV_SPECULAR_PRINCIPLED_V2) {
             specular = 1.0 - dwvb_specular_layer_weight(m, cos_view);
         } else {
@@ -413,17 +424,24 @@ static dwvu_vec3 local_of(dwvu_frame frame, dwvu_vec3 d)
     return dwvu_v(dwvu_dot(frame.t, d), dwvu_dot(frame.s, d), dwvu_dot(frame.n, d));
 }
 
-int dwvb_surface_sample(const dwvb_material *m, double p_specular, dwvu_vec3 n, dwvu_vec3 to_view, double u0, double u1,
-                        double choice, dwvu_vec3 *w, int *lobe)
+int dwvb_surface_sample(const dwvb_material *m, double p_specular, dwvu_vec3 n, dwvu_vec3 specular_n, dwvu_vec3 to_view,
+                        double u0, double u1, double choice, dwvu_vec3 *w, int *lobe, int *singular)
 {
+    *singular = 0;
     if (choice < p_specular) {
-        dwvu_frame frame = dwvu_frame_about(n);
+        dwvu_frame frame = dwvu_frame_about(specular_n);
         dwvu_vec3 wi = local_of(frame, to_view);
         if (!(wi.z > 0.0)) return 0;
+        *lobe = DWVB_LOBE_GLOSSY;
+        if (dwvb_specular_singular(m)) {
+            /* Cycles' singular microfacet: H = N, the mirror direction 2 (N.V) N - V. */
+            *w = dwvu_sub(dwvu_scale(specular_n, 2.0 * wi.z), to_view);
+            *singular = 1;
+            return 1;
+        }
         dwvu_vec3 h = dwvb_ggx_sample_vndf(wi, m->spec_alpha, u0, u1);
         dwvu_vec3 wo = dwvu_sub(dwvu_scale(h, 2.0 * dwvu_dot(wi, h)), wi);
         *w = dwvu_add(dwvu_add(dwvu_scale(frame.t, wo.x), dwvu_scale(frame.s, wo.y)), dwvu_scale(frame.n, wo.z));
-        *lobe = DWVB_LOBE_GLOSSY;
     } else {
         double mu = sqrt(u0);
         *w = dwvk_direction_about(n, mu, 1.0 - mu, 1.0 + mu, u1);
@@ -432,13 +450,13 @@ int dwvb_surface_sample(const dwvb_material *m, double p_specular, dwvu_vec3 n, 
     return 1;
 }
 
-double dwvb_surface_pdf(const dwvb_material *m, double p_specular, dwvu_vec3 n, dwvu_vec3 to_view, dwvu_vec3 w)
+double dwvb_surface_pdf(const dwvb_material *m, double p_specular, dwvu_vec3 n, dwvu_vec3 specular_n, dwvu_vec3 to_view,
+                        dwvu_vec3 w)
 {
     double cos_n = dwvu_dot(n, w);
-    if (!(cos_n > 0.0)) return 0.0;
-    double pdf = (1.0 - p_specular) * cos_n * INV_PI;
-    if (p_specular > 0.0) {
-        dwvu_frame frame = dwvu_frame_about(n);
+    double pdf = cos_n > 0.0 ? (1.0 - p_specular) * cos_n * INV_PI : 0.0;
+    if (p_specular > 0.0 && !dwvb_specular_singular(m)) {
+        dwvu_frame frame = dwvu_frame_about(specular_n);
         dwvu_vec3 wi = local_of(frame, to_view), wo = local_of(frame, w);
         dwvu_vec3 h = dwvu_normalize(dwvu_add(wi, wo));
         double wi_h = dwvu_dot(wi, h);
@@ -447,29 +465,49 @@ double dwvb_surface_pdf(const dwvb_material *m, double p_specular, dwvu_vec3 n, 
     return pdf;
 }
 
-/* A surface point's path ray from the mixture of its lobes (dwvb_surface_sample); the weight is
- * the whole BRDF f (surface_factor) times cos over the mixture's pdf; the lobe drawn names the
- * bounce (glossy or diffuse). */
+/* A surface point's path ray from the mixture of its lobes (dwvb_surface_sample), each lobe about
+ * its own normal (the specular layer's specular_n, the diffuse ones' lobe.n). A continuous
+ * direction weighs the whole BRDF times each lobe's own cosine (f_s cos_s + f_d cos_n) / pi
+ * (surface_factor) over the mixture's pdf; the mirror direction of a singular layer weighs its
+ * reflectance over its probability (eval / pdf of Cycles' singular sample; the diffuse lobes
+ * have no share in a delta). The lobe drawn names the bounce (glossy or diffuse); directions
+ * below the geometric surface end the path (Cycles: LABEL_NONE). */
 static int surface_path_ray(const dwvb_shader *shader, const surface_lobes *s, dwvu_vec3 x, dwvu_vec3 ng, double top,
                             const dwvk_sampler *sampler, uint32_t pair, path_ray *ray)
 {
     const dwvb_material *m = s->material;
-    double p_specular = dwvb_surface_specular_probability(m, s->diffuse, s->lobe.cos_view);
+    double cos_specular = dwvu_dot(s->specular_n, s->lobe.to_view);
+    double p_specular = dwvb_surface_specular_probability(m, s->diffuse, cos_specular);
     if (p_specular < 0.0) return 0;
     double u[2], v[2];
     dwvk_sampler_pair(sampler, pair, u);
     dwvk_sampler_pair(sampler, pair + 1u, v);
     dwvu_vec3 w;
-    if (!dwvb_surface_sample(m, p_specular, s->lobe.n, s->lobe.to_view, u[0], u[1], v[0], &w, &ray->lobe)) return 0;
-    double cos_n = dwvu_dot(s->lobe.n, w);
-    if (!(cos_n > 0.0) || !(dwvu_dot(w, ng) > 0.0)) return 0;
-    double pdf = dwvb_surface_pdf(m, p_specular, s->lobe.n, s->lobe.to_view, w);
-    if (!(pdf > 0.0) || !isfinite(pdf)) return 0;
-    double f[2][3];
-    surface_factor(s, w, f);
-    for (int c = 0; c < 3; ++c) ray->weight[c] = (f[0][c] + f[1][c]) * INV_PI * cos_n / pdf;
+    int singular;
+    if (!dwvb_surface_sample(m, p_specular, s->lobe.n, s->specular_n, s->lobe.to_view, u[0], u[1], v[0], &w, &ray->lobe,
+                             &singular))
+        return 0;
+    if (!(dwvu_dot(w, ng) > 0.0)) return 0;
+    if (singular) {
+        double f[3];
+        dwvb_specular_singular_weight(m, cos_specular, f);
+        for (int c = 0; c < 3; ++c) ray->weight[c] = f[c] / p_specular;
+    } else {
+        double pdf = dwvb_surface_pdf(m, p_specular, s->lobe.n, s->specular_n, s->lobe.to_view, w);
+        if (!(pdf > 0.0) || !isfinite(pdf)) return 0;
+        double f[2][3];
+        surface_factor(s, w, f);
+        double cos_n = fmax(dwvu_dot(s->lobe.n, w), 0.0), cos_s = fmax(dwvu_dot(s->specular_n, w), 0.0);
+        if (!(cos_n > 0.0) && !(cos_s > 0.0)) return 0; /* below both lobes' horizons: nothing */
+        /* One normal for both (no normal map, or one that needed no correction): the BRDF's sum
+         * times its cosine, as before the lobes had normals of their own (the same bits). */
+        for (int c = 0; c < 3; ++c)
+            ray->weight[c] = cos_s == cos_n ? (f[0][c] + f[1][c]) * INV_PI * cos_n / pdf
+                                            : (f[0][c] * cos_s + f[1][c] * cos_n) * INV_PI / pdf;
+    }
     path_ray_from(shader, x, ng, top, w, ray);
     ray->exit = 0;
+    ray->singular = singular;
     return 1;
 }
 
@@ -505,13 +543,14 @@ static void lambert_after_diffuse(const dwvb_material *material, dwvb_material *
 /* Shades hit point `hit` seen along `view` by a path in `state` (camera: the camera ray's or the
  * texel's hit, whose walks may be channel walks and obey the footprint rule): its direct light
  * into `light` by lobe (the specular layer's GLOSSY, the rest DIFFUSE), the lobes' colours into
- * `color` where it is not NULL (Cycles' colour passes), and, where `rays` is not NULL, the rays its lobes and walks' exits send on (at most
+ * `color` where it is not NULL (Cycles' colour passes), and into `rays` the rays its lobes and walks' exits send on (at most
  * 1 + 3 DWVB_MAX_CHANNEL_WALKS; 2 away from the camera), drawn from `onward` from pair
- * `onward_pair` on. */
+ * `onward_pair` on: all of them where `go_on` (some bounce is left), else only a mirror's
+ * reflection (traced for the emission it meets, path_ray.singular). */
 static void shade_point(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, const dwvk_sampler *sampler,
                         uint32_t pair, uint64_t key_walk, const path_state *state, int camera,
                         double light[DWVB_LOBE_COUNT][3], double color[DWVB_LOBE_COUNT][3],
-                        path_ray *rays, const dwvk_sampler *onward, uint32_t onward_pair, uint32_t *ray_count,
+                        path_ray *rays, int go_on, const dwvk_sampler *onward, uint32_t onward_pair, uint32_t *ray_count,
                         dwvb_tally *tally)
 {
     const dwvb_scene *scene = shader->scene;
@@ -639,8 +678,13 @@ static void shade_point(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec
         dwvl_direct(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, direct);
         for (int c = 0; c < 3; ++c) rgb[c] += layer * diffuse_albedo[c] * direct[c];
     }
-    /* The surface's lobes send a path on (the same BRDF as their direct light above). */
-    if (rays && surface_path_ray(shader, &lobes, x, ng, top, onward, onward_pair, &rays[*ray_count])) ++*ray_count;
+    /* The surface's lobes send a path on (the same BRDF as their direct light above); past the
+     * limits only a mirror's reflection is kept (its other draws end there, which keeps the
+     * estimate of the emission it finds unbiased). */
+    if ((go_on || dwvb_specular_singular(material)) &&
+        surface_path_ray(shader, &lobes, x, ng, top, onward, onward_pair, &rays[*ray_count]) &&
+        (go_on || rays[*ray_count].singular))
+        ++*ray_count;
     if (!walks_left) return;
     /* Entry: cosine-weighted about minus the BSSRDF's normal (specular_n), rejected (no
      * contribution, as Cycles) where it would not go below the geometric surface. The pdf cos/pi
@@ -699,7 +743,7 @@ static void shade_point(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec
                 double weight[3] = {0.0, 0.0, 0.0};
                 weight[c] = walk.weight[0] * share;
                 uint32_t exit_pairs = onward_pair + ONWARD_PAIRS * (1u + (uint32_t)c + 3u * j);
-                if (rays && exit_path_ray(shader, &point, weight, onward, exit_pairs, &rays[*ray_count])) ++*ray_count;
+                if (go_on && exit_path_ray(shader, &point, weight, onward, exit_pairs, &rays[*ray_count])) ++*ray_count;
             }
             tally->channel_walks[c] += tally->walks - walks;
             tally->channel_events[c] += tally->events - events;
@@ -719,7 +763,7 @@ static void shade_point(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec
         weight[c] = keep[c] * layer * walk.weight[grey ? 0 : c] * material->walk_scale[c];
         rgb[c] += weight[c] * direct[c];
     }
-    if (rays && exit_path_ray(shader, &point, weight, onward, onward_pair + ONWARD_PAIRS, &rays[*ray_count])) ++*ray_count;
+    if (go_on && exit_path_ray(shader, &point, weight, onward, onward_pair + ONWARD_PAIRS, &rays[*ray_count])) ++*ray_count;
 }
 
 /* Salts of the counter-based keys of the paths after the camera vertex: the vertex's sampler,
@@ -763,24 +807,36 @@ static int choose_ray(const path_ray *rays, uint32_t count, double u, path_ray *
  * direct light (next-event estimation for lights and world, which covers them wholly: no light is
  * geometry, and a ray that leaves the world adds nothing), then one of the rays its lobes and its
  * walk's exit send on, chosen in proportion to their mean weights (the chosen one divided by its
- * probability). `key`: the path's counter-based numbers. */
-static void follow_path(const dwvb_shader *shader, const path_ray *first, path_state state, uint64_t key, double out[3],
-                        dwvb_tally *tally)
+ * probability). A mirror's ray (path_ray.singular) adds the emission it meets before its hit
+ * (before RR, which Cycles applies at surfaces only), and goes no further where its bounce
+ * exceeds a limit. `key`: the path's counter-based numbers. Light the first ray's emission brings
+ * goes to `first_light` (Cycles' direct light of the vertex that sent it), the rest to `out`. */
+static void follow_path(const dwvb_shader *shader, const path_ray *first, path_state state, uint64_t key,
+                        double first_light[3], double out[3], dwvb_tally *tally)
 {
     double throughput[3] = {1.0, 1.0, 1.0};
     out[0] = out[1] = out[2] = 0.0;
+    first_light[0] = first_light[1] = first_light[2] = 0.0;
     path_ray ray = *first;
     for (uint64_t vertex = 1;; ++vertex) {
-        if (!path_state_next(&state, ray.lobe, &shader->paths)) return;
+        int shaded = path_state_next(&state, ray.lobe, &shader->paths);
+        if (!shaded && !ray.singular) return;
         int alive = 0;
         for (int c = 0; c < 3; ++c) {
             throughput[c] *= ray.weight[c];
             alive |= throughput[c] > 0.0;
         }
+        if (!alive) return;
         dwvg_hit hit;
-        if (!alive || ray.clear ||
-            !dwvg_intersect(&shader->scene->geometry, ray.origin, ray.direction, 0.0, INFINITY, &hit))
-            return;
+        tally->path_rays += (uint64_t)!ray.clear;
+        int found = !ray.clear && dwvg_intersect(&shader->scene->geometry, ray.origin, ray.direction, 0.0, INFINITY, &hit);
+        if (ray.singular) {
+            double emission[3];
+            dwvl_emission_along(&shader->env, ray.origin, ray.direction, found ? hit.t : INFINITY, emission);
+            double *to = vertex == 1u ? first_light : out;
+            for (int c = 0; c < 3; ++c) to[c] += throughput[c] * emission[c];
+        }
+        if (!found || !shaded) return;
         uint64_t vertex_key = dwvk_mix64(key ^ (PATH_VERTEX_SALT + vertex));
         dwvk_sampler sampler = {vertex_key, 0u, 0};
         double u[2];
@@ -795,7 +851,7 @@ static void follow_path(const dwvb_shader *shader, const path_ray *first, path_s
         uint32_t count = 0u;
         int onward = path_can_go_on(&state, &shader->paths);
         shade_point(shader, &hit, ray.direction, &sampler, 1u, dwvk_mix64(vertex_key ^ PATH_WALK_SALT), &state, 0, direct, NULL,
-                    onward ? rays : NULL, &sampler, ONWARD_PAIR, &count, tally);
+                    rays, onward, &sampler, ONWARD_PAIR, &count, tally);
         for (int c = 0; c < 3; ++c)
             out[c] += throughput[c] * (direct[DWVB_LOBE_DIFFUSE][c] + direct[DWVB_LOBE_GLOSSY][c]);
         if (count == 0u || !choose_ray(rays, count, u[1], &ray)) return;
@@ -817,7 +873,7 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
     int onward = path_can_go_on(&state, &shader->paths);
     dwvk_sampler onward_sampler = {dwvk_mix64(key_walk ^ PATH_ONWARD_SALT), 0u, 0};
     shade_point(shader, hit, view, sampler, pair, key_walk, &state, 1, parts->direct, parts->color,
-                onward ? rays : NULL, &onward_sampler, 0u, &count, tally);
+                rays, onward, &onward_sampler, 0u, &count, tally);
     /* The surface lobes' ray is a path of its own, and so is, per channel of channel walks (or
      * for the one walk), one of its walks' exits' rays, chosen by their weights where the pilot
      * gave a channel several walks: tracing all of those cost the report's bowl twice its time
@@ -842,9 +898,13 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
     state.dP = dwvb_footprint(shader, view, hit->t);
     double spread = shader->footprint == DWVB_FOOTPRINT_PERSPECTIVE ? dwvb_footprint(shader, view, 1.0) : 0.0;
     for (uint32_t j = 0; j < path_count; ++j) {
-        double gathered[3];
+        double reflected[3], gathered[3];
         state.dD = paths[j].exit ? 0.0 : spread;
-        follow_path(shader, &paths[j], state, dwvk_mix64(key_walk ^ (PATH_ONWARD_SALT + 1u + j)), gathered, tally);
-        for (int c = 0; c < 3; ++c) parts->indirect[paths[j].lobe][c] += gathered[c];
+        follow_path(shader, &paths[j], state, dwvk_mix64(key_walk ^ (PATH_ONWARD_SALT + 1u + j)), reflected, gathered,
+                    tally);
+        for (int c = 0; c < 3; ++c) {
+            parts->direct[paths[j].lobe][c] += reflected[c];
+            parts->indirect[paths[j].lobe][c] += gathered[c];
+        }
     }
 }

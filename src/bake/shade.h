@@ -102,6 +102,8 @@ typedef struct dwvb_tally {
      * the surface. */
     uint64_t rays, point_queries, ray_free_steps, ray_free_misses;
     double truncated[3];
+    /* Rays the paths after the first scattering traced (indirect light; mirrors' reflections). */
+    uint64_t path_rays;
     /* Of the walks above, those of channel walks by channel: walks, events and mixture terms. */
     uint64_t channel_walks[3], channel_events[3], channel_terms[3];
 } dwvb_tally;
@@ -120,18 +122,25 @@ typedef struct dwvb_tally {
 #define DWVB_MAX_CHANNEL_WALKS 3u
 
 /* The mixture a surface point's path rays are drawn from (Cycles picks a closure by its sample
- * weight and weighs the direction by MIS over all closures): the specular layer's GGX visible
- * normals reflected (Heitz 2018), pdf D_wi(h) / (4 wi.h) (Eq. 2 there and the reflection's
- * Jacobian), with probability p_s; the cosine about n, pdf cos / pi, with 1 - p_s. p_s is the
- * layer's albedo toward the viewer (4.x+: 1 - dwvb_specular_layer_weight; 3.x: Schlick's Fresnel
- * of the mean F0) against the diffuse lobes' mean weight `diffuse` (+ the retro-reflection's);
- * 0 where the layer is absent or a mirror (alpha^2 <= DWVB_GGX_MIN_ALPHA2); -1 where nothing
- * scatters. dwvb_surface_sample draws a direction (uniforms u0, u1 and `choice`) and its lobe
- * (DWVB_LOBE_*), 0 where none is drawn; dwvb_surface_pdf is the mixture's pdf of any direction. */
+ * weight and weighs the direction by MIS over all closures), each lobe about its own normal: the
+ * specular layer's about specular_n (4.x+: the shading normal kept valid for reflection), its GGX
+ * visible normals reflected (Heitz 2018), pdf D_wi(h) / (4 wi.h) (Eq. 2 there and the
+ * reflection's Jacobian), with probability p_s; the cosine about n, pdf cos / pi, with 1 - p_s. A
+ * mirror layer (dwvb_specular_singular) is a delta instead: the mirror direction about
+ * specular_n (Cycles' singular microfacet, H = N), drawn with probability p_s and in no pdf.
+ * p_s is the layer's albedo toward the viewer at cos_view (its cosine to specular_n; 4.x+:
+ * 1 - dwvb_specular_layer_weight; 3.x: Schlick's Fresnel of the mean F0; a mirror: its mean
+ * reflectance dwvb_specular_singular_weight) against the diffuse lobes' mean weight `diffuse` (+
+ * the retro-reflection's); 0 where the layer is absent; -1 where nothing scatters.
+ * dwvb_surface_sample draws a direction (uniforms u0, u1 and `choice`), its lobe (DWVB_LOBE_*)
+ * and whether it is the mirror's (*singular), 0 where none is drawn; dwvb_surface_pdf is the
+ * density of the mixture's continuous part at any direction (its integral is 1 - p_s for a
+ * mirror, 1 otherwise, less what falls below the horizons). */
 double dwvb_surface_specular_probability(const dwvb_material *m, const double diffuse[3], double cos_view);
-int dwvb_surface_sample(const dwvb_material *m, double p_specular, dwvu_vec3 n, dwvu_vec3 to_view, double u0, double u1,
-                        double choice, dwvu_vec3 *w, int *lobe);
-double dwvb_surface_pdf(const dwvb_material *m, double p_specular, dwvu_vec3 n, dwvu_vec3 to_view, dwvu_vec3 w);
+int dwvb_surface_sample(const dwvb_material *m, double p_specular, dwvu_vec3 n, dwvu_vec3 specular_n, dwvu_vec3 to_view,
+                        double u0, double u1, double choice, dwvu_vec3 *w, int *lobe, int *singular);
+double dwvb_surface_pdf(const dwvb_material *m, double p_specular, dwvu_vec3 n, dwvu_vec3 specular_n, dwvu_vec3 to_view,
+                        dwvu_vec3 w);
 
 /* The radiance leaving hit point `hit` along -view (view: unit direction of the ray that found
  * it, from the viewer), split into `parts` (zeroed first): the specular layer's direct light is

@@ -287,9 +287,11 @@ static int write_stats_json(const char *path, const dwv_image_t *image, const dw
     fprintf(out, ",\n  \"library_version\": \"%s\",\n  \"technique\": \"%s\",\n  \"width\": %u,\n  \"height\": %u,\n",
             dwv_version_string(), dwv_technique_name(s.technique) ? dwv_technique_name(s.technique) : "?", o->width,
             o->height);
-    fprintf(out, "  \"spp\": %llu,\n  \"samples\": %llu,\n  \"walks\": %llu,\n  \"events\": %llu,\n  \"seconds\": ",
+    fprintf(out,
+            "  \"spp\": %llu,\n  \"samples\": %llu,\n  \"walks\": %llu,\n  \"events\": %llu,\n  \"path_rays\": %llu,\n"
+            "  \"seconds\": ",
             (unsigned long long)s.samples_per_pixel, (unsigned long long)s.samples, (unsigned long long)s.walks,
-            (unsigned long long)s.events);
+            (unsigned long long)s.events, (unsigned long long)s.path_rays);
     cli_json_number(out, s.seconds);
     fprintf(out, ",\n  \"estimated_relative_error\": ");
     cli_json_number(out, s.estimated_relative_error);

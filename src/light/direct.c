@@ -227,3 +227,17 @@ void dwvl_direct(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, dwvu_vec
 {
     dwvl_direct_lobe(env, x, n, ng, terminator, top, sampler, pair, NULL, NULL, out, NULL);
 }
+
+void dwvl_emission_along(const dwvl_environment *env, dwvu_vec3 origin, dwvu_vec3 d, double t_max, double rgb[3])
+{
+    rgb[0] = rgb[1] = rgb[2] = 0.0;
+    for (uint32_t i = 0; i < env->light_count; ++i) {
+        double met[3];
+        if (dwvl_light_along(&env->lights[i], origin, d, t_max, met))
+            for (int c = 0; c < 3; ++c) rgb[c] += met[c];
+    }
+    if (!env->world_lit || t_max < INFINITY) return;
+    double world[3] = {env->world[0], env->world[1], env->world[2]};
+    if (env->envmap) dwvl_envmap_radiance(env->envmap, d, world);
+    for (int c = 0; c < 3; ++c) rgb[c] += world[c];
+}

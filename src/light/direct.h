@@ -66,4 +66,10 @@ void dwvl_direct_split(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, dw
                        const dwvl_terminator *terminator, double top, const dwvk_sampler *sampler, uint32_t pair,
                        dwvl_split_factor factor, const void *context, double out[2][3]);
 
+/* The emission a path ray from `origin` along unit d finds before its first surface at distance
+ * t_max (+inf: it leaves the world): every light it passes (dwvl_light_along; Cycles' rays go on
+ * through lights) and, where it leaves, the world's radiance along d. Without MIS: for rays that
+ * no light sample could have found (singular reflections), which take the whole of it. */
+void dwvl_emission_along(const dwvl_environment *env, dwvu_vec3 origin, dwvu_vec3 d, double t_max, double rgb[3]);
+
 #endif

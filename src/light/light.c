@@ -213,3 +213,66 @@ void dwvl_light_sample(const dwvl_light *light, dwvu_vec3 x, double u1, double u
     }
     for (int c = 0; c < 3; ++c) sample->value[c] = light->emission[c] * factor;
 }
+
+int dwvl_light_along(const dwvl_light *light, dwvu_vec3 origin, dwvu_vec3 d, double t_max, double rgb[3])
+{
+    rgb[0] = rgb[1] = rgb[2] = 0.0;
+    double scale = 0.0;
+    switch (light->kind) {
+    case DWV_LIGHT_SUN: {
+        /* In the cone: 1 - cos(theta) <= 1 - cos(half); sin^2(half) = (1 - cos)(1 + cos). */
+        double omc = light->one_minus_cos_half;
+        if (!(omc > 0.0) || t_max < INFINITY || !(1.0 - dwvu_dot(d, light->direction) <= omc)) return 0;
+        scale = 1.0 / (PI * omc * (2.0 - omc));
+        break;
+    }
+    case DWV_LIGHT_SPOT:
+    case DWV_LIGHT_POINT: {
+        double r = light->radius;
+        if (!(r > 0.0)) return 0;
+        dwvu_vec3 to_centre = dwvu_sub(light->position, origin);
+        double dist2 = dwvu_dot(to_centre, to_centre), along = dwvu_dot(to_centre, d), t;
+        if (light->sphere) {
+            /* |origin + t d - centre| = r: t = along -+ sqrt(r^2 - (dist^2 - along^2)). */
+            double disc = r * r - (dist2 - along * along);
+            if (!(disc >= 0.0)) return 0;
+            double root = sqrt(disc);
+            t = along - root > 0.0 ? along - root : along + root;
+        } else {
+            /* The disc's plane through the centre, normal to to_centre: t = dist^2 / along, at
+             * t^2 - dist^2 from the centre squared. */
+            if (!(along > 0.0)) return 0;
+            t = dist2 / along;
+            if (!(t * t - dist2 <= r * r)) return 0;
+        }
+        if (!(t > 0.0) || !(t < t_max)) return 0;
+        scale = 1.0 / (PI * r * r);
+        /* (From inside a sphere spot: its radiance without the attenuation, as its samples.) */
+        if (light->kind == DWV_LIGHT_SPOT && !(light->sphere && dist2 <= r * r))
+            scale *= dwvl_spot_attenuation(light, -dwvu_dot(light->spot_axis, d));
+        break;
+    }
+    default: {
+        /* Its plane: (origin + t d - centre) . direction = 0, from the front (d . direction < 0);
+         * the point's coordinates along the axes (a, b) in [-1/2, 1/2]^2, or a^2 + b^2 <= 1/4. */
+        double facing = dwvu_dot(d, light->direction);
+        if (!(facing < 0.0)) return 0;
+        double t = dwvu_dot(dwvu_sub(light->position, origin), light->direction) / facing;
+        if (!(t > 0.0) || !(t < t_max)) return 0;
+        dwvu_vec3 q = dwvu_sub(dwvu_madd(origin, d, t), light->position);
+        /* q = a axis_x + b axis_y: the normal equations (the axes may be sheared by a transform). */
+        double xx = dwvu_dot(light->axis_x, light->axis_x), yy = dwvu_dot(light->axis_y, light->axis_y);
+        double xy = dwvu_dot(light->axis_x, light->axis_y), det = xx * yy - xy * xy;
+        if (!(det > 0.0)) return 0;
+        double qx = dwvu_dot(q, light->axis_x), qy = dwvu_dot(q, light->axis_y);
+        double a = (qx * yy - qy * xy) / det, b = (qy * xx - qx * xy) / det;
+        int inside = light->kind == DWV_LIGHT_AREA_RECTANGLE ? fabs(a) <= 0.5 && fabs(b) <= 0.5 : a * a + b * b <= 0.25;
+        if (!inside) return 0;
+        scale = 1.0;
+        break;
+    }
+    }
+    if (!(scale > 0.0) || !isfinite(scale)) return 0;
+    for (int c = 0; c < 3; ++c) rgb[c] = light->emission[c] * scale;
+    return 1;
+}

@@ -73,4 +73,14 @@ void dwvl_light_sample(const dwvl_light *light, dwvu_vec3 x, double u1, double u
  * A sample's value is the light's radiance along its direction divided by this. */
 double dwvl_light_pdf(const dwvl_light *light, dwvu_vec3 x, dwvu_vec3 direction);
 
+/* The radiance a ray from `origin` along unit d meets on the light before distance t_max (a path
+ * ray that found it: Cycles' lights_intersect, which singular reflections use with no MIS), into
+ * rgb (0 where it meets none): a point or spot light of radius r > 0 as Cycles 3.x's disc of
+ * radius r through the centre facing the ray's origin (DWV_POINT_SHAPE_SPHERE: 4.0+'s sphere, its
+ * nearer intersection ahead), radiance I / (pi r^2), a spot's times its attenuation of -d; an area
+ * light from its front (against `direction`), its radiance; a sun of angle > 0 where d lies in
+ * its cone and t_max is infinite, S c / (pi sin^2(angle / 2)). Deltas (radius or angle 0) are
+ * never met. Returns 1 where the light was met. */
+int dwvl_light_along(const dwvl_light *light, dwvu_vec3 origin, dwvu_vec3 d, double t_max, double rgb[3]);
+
 #endif

@@ -85,7 +85,7 @@ class StructLayoutTest(unittest.TestCase):
             self.skipTest("the sizes below are those of an LP64 ABI")
         sizes = {"dwv_material_t": 192, "dwv_mesh_t": 184, "dwv_light_desc_t": 248, "dwv_camera_t": 128,
                  "dwv_bake_progress_t": 48, "dwv_bake_options_t": 152, "dwv_image_info_t": 40,
-                 "dwv_bake_stats_t": 128, "dwv_error_point_t": 24, "dwv_display_options_t": 56,
+                 "dwv_bake_stats_t": 136, "dwv_error_point_t": 24, "dwv_display_options_t": 56,
                  "dwv_environment_t": 104, "dwv_texture_desc_t": 40, "dwv_texture_binding_t": 56}
         for name, size in sizes.items():
             self.assertEqual(ctypes.sizeof(self.STRUCTS[name]), size, name)

@@ -14,7 +14,7 @@ import unittest
 from cli_helpers import USAGE, assert_bad_usage, run_cli
 
 SMALL = ["--width", "48", "--height", "27", "--spp", "4", "--quiet"]
-JSON_KEYS = {"spp", "seconds", "estimated_relative_error", "mean_rgb", "events", "features", "error_vs_time"}
+JSON_KEYS = {"spp", "seconds", "estimated_relative_error", "mean_rgb", "events", "path_rays", "features", "error_vs_time"}
 
 
 def outputs(prefix):
