@@ -389,7 +389,10 @@ static double sheet_sample(dwvw_walk *walk, int channel, const double *choice, f
                                   ? walk->sheet_norm[c - 1]
                                   : dwvk_sheet_flight_norm(walk->sheet_a[c], walk->sheet_mu);
     if (classical) walk->step_distance = dwvw_flight(m->sigma_t[channel], u_flight);
-    else walk->step_distance = dwvk_sheet_flight_sample(walk->sheet_a[channel], walk->sheet_mu, (double)u_flight) / m->sigma_t[channel];
+    else
+        walk->step_distance = dwvk_sheet_flight_sample_normed(walk->sheet_a[channel], walk->sheet_mu, walk->sheet_norm[channel],
+                                                              (double)u_flight) /
+                              m->sigma_t[channel];
     return walk->step_distance;
 }
 
