@@ -117,6 +117,7 @@ typedef struct dwvw_guide {
     dwvu_vec3 sheet_normal; /* the sheet technique's lit normal: the strongest patch's */
     int patch_count;
     dwvw_light_patch patches[DWVW_MAX_PATCHES];
+    int patches_distinct; /* no two patch normals as close as a component's merge (dwvw_guide_init) */
 } dwvw_guide;
 
 typedef enum dwvw_status {
