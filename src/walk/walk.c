@@ -66,6 +66,7 @@ void dwvw_guide_init(dwvw_guide *guide, dwvw_technique technique, const dwvw_med
     for (int i = 0; i < guide->patch_count; ++i) {
         guide->patches[i] = patches[i];
         guide->patches[i].log_power = log(patches[i].power);
+        guide->patch_frames[i] = dwvu_frame_about(guide->patches[i].normal);
     }
     guide->patches_distinct = 1;
     for (int i = 0; i < guide->patch_count; ++i)
@@ -179,6 +180,7 @@ static void add_component(dwvw_walk *walk, double q, dwvu_vec3 axis)
     if (walk->component_count >= DWVW_MAX_COMPONENTS) return;
     walk->component_q[walk->component_count] = q;
     walk->component_axis[walk->component_count] = axis;
+    walk->component_patch[walk->component_count] = -1;
     ++walk->component_count;
 }
 
@@ -224,12 +226,14 @@ static void add_incident_components(dwvw_walk *walk, double q)
     if (guide->patches_distinct && walk->component_count == 1) {
         /* Only the classical component before them, and no two patches merge: add_component's
          * search for a component of the same axis (all patches against all, per event) would find
-         * none, so each patch of weight > 0 takes the next component, as there. */
+         * none, so each patch of weight > 0 takes the next component, as there, and its frame is
+         * the guide's. */
         for (int j = 0; j < guide->patch_count; ++j) {
             double share = q * w[j] / sum;
             if (!(share > 0.0)) continue;
             walk->component_q[walk->component_count] = share;
             walk->component_axis[walk->component_count] = guide->patches[j].normal;
+            walk->component_patch[walk->component_count] = j;
             ++walk->component_count;
         }
         return;
@@ -476,7 +480,11 @@ double dwvw_walk_sample(dwvw_walk *walk)
         if (chosen == 0) {
             walk->direction = dwvw_classical_direction(previous, g, u);
         } else {
-            walk->direction = dwvw_guided_direction(frame_about_axis(walk, walk->component_axis[chosen]), &m->dwivedi_event, u);
+            /* a patch's frame is the guide's (the same bits: a frame is a function of its axis) */
+            int patch = walk->component_patch[chosen];
+            const dwvu_frame *frame = patch >= 0 ? &walk->guide->patch_frames[patch]
+                                                 : frame_about_axis(walk, walk->component_axis[chosen]);
+            walk->direction = dwvw_guided_direction(frame, &m->dwivedi_event, u);
         }
         walk->phase = dwvw_phase_value(g, previous, walk->direction);
     } else {
