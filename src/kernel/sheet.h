@@ -134,7 +134,8 @@ static inline double dwvk_sheet_flight_norm(double a, double mu)
 static inline void dwvk_sheet_slopes(double a, double *up, double *down)
 {
     double n0 = dwvk_sheet_flight_norm(a, 0.0);
-    *up = fmin(dwvk_sheet_flight_norm(a, 1.0) / n0 - 1.0, 1.0 / DWVK_SHEET_EXTRAPOLATION);
+    double chord = dwvk_sheet_flight_norm(a, 1.0) / n0 - 1.0; /* not NaN: a ternary, not libm's fmin call */
+    *up = chord < 1.0 / DWVK_SHEET_EXTRAPOLATION ? chord : 1.0 / DWVK_SHEET_EXTRAPOLATION;
     *down = 1.0 - dwvk_sheet_flight_norm(a, -1.0) / n0;
 }
 
@@ -167,10 +168,12 @@ static inline double dwvk_sheet_flight_tail(double a, double mu, double tau)
  * convex wherever psi > mu (g'' = exp(-tau) (psi - mu)). Halley's method inside the bracket, which
  * every iterate narrows (Newton's step where Halley's correction is large, bisection where a step
  * would leave the bracket), from tau_0 = log(c / y), the root at mu = 0 (left of the root for
- * mu >= 0, right of it for mu < 0; lo where it is out of the bracket or y <= 0): 3.6 exponentials
- * per flight for either sign (a random a in [z_e, 4.7], mu in [-1, 1]), where Newton on log g took
- * 5.0 logarithms and, from 0, Newton on g 5.4 exponentials. It stops when a step moves tau by less
- * than 1e-12 (1 + tau), past the float precision of the walk's distances. */
+ * mu >= 0, right of it for mu < 0; lo where it is out of the bracket or y <= 0): 2.8 exponentials
+ * per flight for either sign (a random a in [z_e, 4.7], mu in [-1, 1]; 3.5 when it stopped only
+ * after a step below 1e-12 (1 + tau)), where Newton on log g took 5.0 logarithms and, from 0, Newton
+ * on g 5.4 exponentials. It stops where tau is within about 1e-12 (1 + tau) of the root, past the
+ * float precision of the walk's distances: after a step of less than that, or after a Halley step
+ * of less than 1e-5 (below: its error is cubic in the step; the roots move by at most 5.6e-15). */
 static inline double dwvk_sheet_flight_solve(double c, double mu, double y, double lo, double hi)
 {
     double tau = lo;
@@ -186,13 +189,20 @@ static inline double dwvk_sheet_flight_solve(double c, double mu, double y, doub
         else break;
         if (!(slope < 0.0)) break;
         double square = slope * slope, denominator = 2.0 * square - g * e * (psi - mu);
-        double next = tau - (denominator > square ? 2.0 * g * slope / denominator : g / slope);
+        int halley = denominator > square;
+        double next = tau - (halley ? 2.0 * g * slope / denominator : g / slope);
         double step = fabs(next - tau);
-        if (step <= 1e-12 * (1.0 + tau)) { /* converged (a step that rounds onto the bracket too) */
-            tau = next > lo && next < hi ? next : tau;
+        int inside = next > lo && next < hi;
+        /* Converged: a step below 1e-12 (1 + tau) (one that rounds onto the bracket too), or a
+         * Halley step below 1e-5 inside the bracket. Near the root Halley's error after a step s is
+         * about C s^3, C = |g''' / (6 g') - (g'' / (2 g'))^2| <= 13.1 where psi >= f (g' = -e psi,
+         * g'' = e (psi - mu), g''' = -e (psi - 2 mu), |mu| <= 1): below 1.4e-14 after such a step,
+         * which then needs no step after it (one exponential less per flight). */
+        if (step <= 1e-12 * (1.0 + tau) || (halley && inside && step <= 1e-5)) {
+            tau = inside ? next : tau;
             break;
         }
-        if (!(next > lo && next < hi)) {
+        if (!inside) {
             if (!(hi < INFINITY)) break; /* not met: from the left a step always rises */
             next = 0.5 * (lo + hi);
         }
@@ -208,11 +218,11 @@ static inline double dwvk_sheet_flight_solve(double c, double mu, double y, doub
  * (I = f exp(-tau)), tau = log(f / ((1 - u) N)); on the flat piece before a line (mu > 0 from
  * below the floor, I = f exp(-tau) + mu exp(-t0)), tau = -log(1 - u N / f); on the line after it,
  * exp(-tau) (c + mu tau) = (1 - u) N from t0 on. A flat importance all the way is the exponential
- * flight -log(1 - u). */
-static inline double dwvk_sheet_flight_sample(double a, double mu, double u)
+ * flight -log(1 - u). n is N(a, mu). */
+static inline double dwvk_sheet_flight_sample_normed(double a, double mu, double n, double u)
 {
     const double f = DWVK_SHEET_FLOOR;
-    double c = a + mu, n = dwvk_sheet_flight_norm(a, mu);
+    double c = a + mu;
     double t0 = dwvk_sheet_switch(a, mu);
     if (t0 > 0.0) {
         double e0 = dwvk_exp_fast(-t0);
@@ -230,6 +240,13 @@ static inline double dwvk_sheet_flight_sample(double a, double mu, double u)
     }
     if (mu >= 0.0 && a >= f) return dwvk_sheet_flight_solve(c, mu, c - u * n, 0.0, INFINITY);
     return -log1p(-u);
+}
+
+/* dwvk_sheet_flight_sample_normed with its normalisation n = N(a, mu) (dwvk_sheet_flight_norm),
+ * which the walk has already formed for the flight's pdf. */
+static inline double dwvk_sheet_flight_sample(double a, double mu, double u)
+{
+    return dwvk_sheet_flight_sample_normed(a, mu, dwvk_sheet_flight_norm(a, mu), u);
 }
 
 #endif

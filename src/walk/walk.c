@@ -6,6 +6,11 @@
 #include "kernel/sheet.h"
 #include "step.h"
 
+/* Two axes whose cosine is at least this are one component's (add_component). */
+#define DWVW_SAME_AXIS_COSINE (1.0 - 1e-12)
+_Static_assert(DWVW_MAX_COMPONENTS >= 1 + DWVW_MAX_PATCHES,
+               "the classical component and every patch fit (add_incident_components)");
+
 void dwvw_medium_init(dwvw_medium *medium, int channels, const double *sigma_t, const double *albedo, double g)
 {
     medium->channels = channels;
@@ -61,7 +66,13 @@ void dwvw_guide_init(dwvw_guide *guide, dwvw_technique technique, const dwvw_med
     for (int i = 0; i < guide->patch_count; ++i) {
         guide->patches[i] = patches[i];
         guide->patches[i].log_power = log(patches[i].power);
+        guide->patch_frames[i] = dwvu_frame_about(guide->patches[i].normal);
     }
+    guide->patches_distinct = 1;
+    for (int i = 0; i < guide->patch_count; ++i)
+        for (int j = i + 1; j < guide->patch_count; ++j)
+            if (dwvu_dot(guide->patches[i].normal, guide->patches[j].normal) >= DWVW_SAME_AXIS_COSINE)
+                guide->patches_distinct = 0;
     switch (technique) {
     case DWVW_CLASSICAL: guide->q_classical = 1.0; break;
     case DWVW_POE: guide->q_poe = 1.0; break;
@@ -161,7 +172,7 @@ static void add_component(dwvw_walk *walk, double q, dwvu_vec3 axis)
 {
     if (!(q > 0.0)) return;
     for (int k = 1; k < walk->component_count; ++k) {
-        if (dwvu_dot(walk->component_axis[k], axis) >= 1.0 - 1e-12) {
+        if (dwvu_dot(walk->component_axis[k], axis) >= DWVW_SAME_AXIS_COSINE) {
             walk->component_q[k] += q;
             return;
         }
@@ -169,6 +180,7 @@ static void add_component(dwvw_walk *walk, double q, dwvu_vec3 axis)
     if (walk->component_count >= DWVW_MAX_COMPONENTS) return;
     walk->component_q[walk->component_count] = q;
     walk->component_axis[walk->component_count] = axis;
+    walk->component_patch[walk->component_count] = -1;
     ++walk->component_count;
 }
 
@@ -204,12 +216,27 @@ static void add_incident_components(dwvw_walk *walk, double q)
         dwvu_vec3 offset = dwvu_sub(walk->position, patch->point);
         double distance = patch->is_plane ? fabs(dwvu_dot(offset, patch->normal)) : dwvu_length(offset);
         log_w[j] = patch->log_power - decay * distance;
-        largest = fmax(largest, log_w[j]);
+        largest = log_w[j] > largest ? log_w[j] : largest; /* not NaN: no call to libm's fmax */
     }
     double sum = 0.0, w[DWVW_MAX_PATCHES];
     for (int j = 0; j < guide->patch_count; ++j) {
         double relative = log_w[j] - largest;
         sum += (w[j] = relative < DWVW_PATCH_PRUNE_LOG ? 0.0 : dwvk_exp_fast(relative));
+    }
+    if (guide->patches_distinct && walk->component_count == 1) {
+        /* Only the classical component before them, and no two patches merge: add_component's
+         * search for a component of the same axis (all patches against all, per event) would find
+         * none, so each patch of weight > 0 takes the next component, as there, and its frame is
+         * the guide's. */
+        for (int j = 0; j < guide->patch_count; ++j) {
+            double share = q * w[j] / sum;
+            if (!(share > 0.0)) continue;
+            walk->component_q[walk->component_count] = share;
+            walk->component_axis[walk->component_count] = guide->patches[j].normal;
+            walk->component_patch[walk->component_count] = j;
+            ++walk->component_count;
+        }
+        return;
     }
     for (int j = 0; j < guide->patch_count; ++j) add_component(walk, q * w[j] / sum, guide->patches[j].normal);
 }
@@ -389,7 +416,10 @@ static double sheet_sample(dwvw_walk *walk, int channel, const double *choice, f
                                   ? walk->sheet_norm[c - 1]
                                   : dwvk_sheet_flight_norm(walk->sheet_a[c], walk->sheet_mu);
     if (classical) walk->step_distance = dwvw_flight(m->sigma_t[channel], u_flight);
-    else walk->step_distance = dwvk_sheet_flight_sample(walk->sheet_a[channel], walk->sheet_mu, (double)u_flight) / m->sigma_t[channel];
+    else
+        walk->step_distance = dwvk_sheet_flight_sample_normed(walk->sheet_a[channel], walk->sheet_mu, walk->sheet_norm[channel],
+                                                              (double)u_flight) /
+                              m->sigma_t[channel];
     return walk->step_distance;
 }
 
@@ -450,7 +480,11 @@ double dwvw_walk_sample(dwvw_walk *walk)
         if (chosen == 0) {
             walk->direction = dwvw_classical_direction(previous, g, u);
         } else {
-            walk->direction = dwvw_guided_direction(frame_about_axis(walk, walk->component_axis[chosen]), &m->dwivedi_event, u);
+            /* a patch's frame is the guide's (the same bits: a frame is a function of its axis) */
+            int patch = walk->component_patch[chosen];
+            const dwvu_frame *frame = patch >= 0 ? &walk->guide->patch_frames[patch]
+                                                 : frame_about_axis(walk, walk->component_axis[chosen]);
+            walk->direction = dwvw_guided_direction(frame, &m->dwivedi_event, u);
         }
         walk->phase = dwvw_phase_value(g, previous, walk->direction);
     } else {
@@ -461,16 +495,22 @@ double dwvw_walk_sample(dwvw_walk *walk)
     walk->component_pdf[0] = walk->phase;
     walk->component_stretch[0] = 1.0;
     const double kappa = m->dwivedi.kappa, one_minus_kappa = m->dwivedi.one_minus_kappa;
-    for (int k = 1; k < walk->component_count; ++k) {
+    const double pdf_scale = m->guided_pdf_scale;
+    const int count = walk->component_count;
+    for (int k = 1; k < count; ++k) {
         /* dwvk_dwivedi_stretch_d, both sides formed and one taken by a bit mask (the same bits):
          * across a mixture's axes the cosine's sign is a coin toss, and as a branch (which GCC
          * makes of a select of doubles) it was mispredicted, the hottest spot of
-         * dwvw_walk_sample on the benchmark's torus (perf). */
+         * dwvw_walk_sample on the benchmark's torus (perf). The pdf's division in a loop of its
+         * own, without the first step's case in it: a division under a condition is control flow
+         * the vectoriser leaves alone (it may not compute it where the condition is false). */
         double mu = dwvw_cosine(walk->direction, walk->component_axis[k]);
-        double stretch = select_nonnegative(mu, one_minus_kappa + kappa * (1.0 - mu), 1.0 - kappa * mu);
-        walk->component_stretch[k] = stretch;
-        walk->component_pdf[k] = walk->events > 0 ? m->guided_pdf_scale / stretch : 1.0;
+        walk->component_stretch[k] = select_nonnegative(mu, one_minus_kappa + kappa * (1.0 - mu), 1.0 - kappa * mu);
     }
+    if (walk->events > 0)
+        for (int k = 1; k < count; ++k) walk->component_pdf[k] = pdf_scale / walk->component_stretch[k];
+    else
+        for (int k = 1; k < count; ++k) walk->component_pdf[k] = 1.0;
     float u_distance = stratified ? flight_distance : dwvk_rng_uniform_f(walk->key, dim + DWVW_DIM_DISTANCE);
     walk->step_distance = dwvw_flight(m->sigma_t[channel] * walk->component_stretch[chosen], u_distance);
     return walk->step_distance;

@@ -117,6 +117,8 @@ typedef struct dwvw_guide {
     dwvu_vec3 sheet_normal; /* the sheet technique's lit normal: the strongest patch's */
     int patch_count;
     dwvw_light_patch patches[DWVW_MAX_PATCHES];
+    int patches_distinct; /* no two patch normals as close as a component's merge (dwvw_guide_init) */
+    dwvu_frame patch_frames[DWVW_MAX_PATCHES]; /* dwvu_frame_about of each patch's normal, made once */
 } dwvw_guide;
 
 typedef enum dwvw_status {
@@ -169,6 +171,7 @@ typedef struct dwvw_walk {
     int single_component;                           /* the only component with q > 0, else -1 */
     double component_q[DWVW_MAX_COMPONENTS];
     dwvu_vec3 component_axis[DWVW_MAX_COMPONENTS]; /* unused for component 0 (classical) */
+    int component_patch[DWVW_MAX_COMPONENTS];      /* the patch whose frame it takes (the guide's), or -1 */
     double component_pdf[DWVW_MAX_COMPONENTS];     /* direction pdf per steradian */
     double component_stretch[DWVW_MAX_COMPONENTS];
     double channel_p[DWVW_MAX_CHANNELS];
