@@ -1,11 +1,12 @@
 /* Split bakes (capi: dwv_image_write_partial, dwv_merge_partials; docs/farm.md).
  *
- * A partial file ("DWVPART", format 1), native little-endian, written atomically:
+ * A partial file ("DWVPART", format 2), native little-endian, written atomically:
  *   magic[8] format u32, endian u32 (0x01020304), library_version[32]
  *   u64 scene_hash, options_hash, seed, first, count, total
  *   u32 width, height, technique, features, threads, point_count
  *   u64 events, walks, warnings, rays, point_queries, ray_free_steps, ray_free_misses, mixture_terms
  *   f64 seconds, truncated_weight[3]
+ *   u64 path_rays                                         (format 2 on; format 1 files are refused)
  *   point_count x {f64 seconds, f64 estimated_relative_error, u64 spp}   the chunk's own passes
  *   width x height u32 counts, then width x height x 10 i128 exact sums (dwvb_pixel_sums)
  *   u64 FNV-1a 64 of every byte before it, end[8]
@@ -28,7 +29,7 @@ _Static_assert(sizeof(dwvb_pixel_sums) == DWVB_PIXEL_SUM_FIELDS * 16u, "pixel su
 
 static const char MAGIC[8] = {'D', 'W', 'V', 'P', 'A', 'R', 'T', '\0'};
 static const char END[8] = {'D', 'W', 'V', 'E', 'N', 'D', '\0', '\0'};
-#define FORMAT 1u
+#define FORMAT 2u
 #define ENDIAN 0x01020304u
 #define VERSION_BYTES 32u
 #define MAX_POINTS 4096u
@@ -231,8 +232,9 @@ typedef struct header {
     uint32_t width, height, technique, features, threads, point_count;
     uint64_t events, walks, warnings, rays, point_queries, ray_free_steps, ray_free_misses, mixture_terms;
     double seconds, truncated_weight[3];
+    uint64_t path_rays;
 } header;
-_Static_assert(sizeof(header) == 8 + 8 + VERSION_BYTES + 6 * 8 + 6 * 4 + 8 * 8 + 4 * 8, "no padding in the header");
+_Static_assert(sizeof(header) == 8 + 8 + VERSION_BYTES + 6 * 8 + 6 * 4 + 8 * 8 + 4 * 8 + 8, "no padding in the header");
 _Static_assert(sizeof(dwv_error_point_t) == 24, "no padding in an error point");
 
 static int write_all(dwvo_atomic_file *file, fnv *f, const void *data, size_t size)
@@ -281,6 +283,7 @@ dwv_result_t dwv_image_write_partial(const dwv_image_t *image, const char *path)
     h.mixture_terms = img->mixture_terms;
     h.seconds = img->stats.seconds;
     for (int c = 0; c < 3; ++c) h.truncated_weight[c] = img->stats.truncated_weight[c];
+    h.path_rays = img->stats.path_rays;
     size_t pixels = (size_t)img->width * img->height;
     dwvo_atomic_file file;
     r = dwvo_atomic_open(&file, path, message, sizeof message);
@@ -518,6 +521,7 @@ dwv_result_t dwv_merge_partials(const char *const *paths, uint32_t count, dwv_im
         for (int j = 0; j < 3; ++j) truncated[j] += c->h.truncated_weight[j] * (double)c->h.count * (double)pixels;
         st->events += c->h.events;
         st->walks += c->h.walks;
+        st->path_rays += c->h.path_rays;
         img->rays += c->h.rays;
         img->point_queries += c->h.point_queries;
         img->ray_free_steps += c->h.ray_free_steps;

@@ -14,6 +14,7 @@
  * Public API only. */
 #include <float.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -583,7 +584,13 @@ static void test_images(void)
     info.struct_size = 0u;
     REFUSED(dwv_image_info, dwv_image_info(image, &info), SIZE);
     REFUSED(dwv_image_stats, dwv_image_stats(NULL, &stats), NULLP);
-    stats.struct_size = (uint32_t)sizeof stats - 8u;
+    /* A struct of an older header (ending before path_rays) is filled as far as it goes; a
+     * shorter one is refused. */
+    stats.struct_size = (uint32_t)offsetof(dwv_bake_stats_t, path_rays);
+    stats.path_rays = 12345u;
+    CHECK(dwv_image_stats(image, &stats) == DWV_SUCCESS && stats.path_rays == 12345u,
+          "stats of an older header's size: %s", dwv_last_error_message());
+    stats.struct_size = (uint32_t)offsetof(dwv_bake_stats_t, path_rays) - 8u;
     REFUSED(dwv_image_stats, dwv_image_stats(image, &stats), SIZE);
     REFUSED(dwv_image_error_vs_time, dwv_image_error_vs_time(NULL, points, 2, &count), NULLP);
     REFUSED(dwv_image_error_vs_time, dwv_image_error_vs_time(image, points, 2, NULL), NULLP);
