@@ -416,17 +416,24 @@ def hdri_texels(width: int, height: int, sun: Vec, spot: float) -> List[float]:
 
 def head_uvs(points: List[Vec], tris: List[Tri]) -> List[Tuple[float, float]]:
     """Per triangle corner: a spherical map of head()'s points, u the longitude about z from the
-    face (-y), v the latitude, its seam at the back (+y); a triangle across the seam takes u + 1 on
-    its corners below 0.5 (the image repeats), so no triangle spans the whole image."""
+    face (-y), v the latitude, its seam at the back (+y). A triangle's corners take u within 0.5
+    of its first (u + 1 across the seam: the image repeats), so no triangle spans the whole image;
+    a corner at a pole, whose longitude is any, takes its triangle's other corners' mean."""
     per_vertex = []
     for p in points:
         d = _normalise((p[0] / 0.82, p[1] / 0.95, p[2] / 1.1))
-        per_vertex.append((0.5 + math.atan2(d[0], -d[1]) / (2 * math.pi), 0.5 + math.asin(max(-1.0, min(1.0, d[2]))) / math.pi))
+        pole = abs(d[2]) > 1.0 - 1e-9
+        per_vertex.append((None if pole else 0.5 + math.atan2(d[0], -d[1]) / (2 * math.pi),
+                           0.5 + math.asin(max(-1.0, min(1.0, d[2]))) / math.pi))
     out = []
     for t in tris:
         us = [per_vertex[i][0] for i in t]
-        wrap = max(us) - min(us) > 0.5
-        out += [((u + 1.0) if wrap and u < 0.5 else u, per_vertex[i][1]) for u, i in zip(us, t)]
+        first = next(u for u in us if u is not None)
+        us = [None if u is None else u + round(first - u) for u in us]
+        known = [u for u in us if u is not None]
+        shift = 1.0 if min(known) < 0.0 else 0.0
+        mean = sum(known) / len(known)
+        out += [((mean if u is None else u) + shift, per_vertex[i][1]) for u, i in zip(us, t)]
     return out
 
 
