@@ -107,6 +107,12 @@ class BenchmarkScenesTest(unittest.TestCase):
                                   "nosuch", "--out", tmp], capture_output=True, text=True, env=env, timeout=120)
             self.assertEqual(bad.returncode, 1)
             self.assertIn("unknown section, scene or Blender 'nosuch'", bad.stderr)
+            for budget in ("0", "-3", "nan"):
+                bad = subprocess.run([sys.executable, str(report), "--sections", "cycles", "--no-cycles",
+                                      "--budget-minutes", budget, "--out", tmp], capture_output=True, text=True,
+                                     env=env, timeout=120)
+                self.assertEqual(bad.returncode, 1, budget)
+                self.assertIn("is not a positive number of minutes", bad.stderr)
 
 
 if __name__ == "__main__":
