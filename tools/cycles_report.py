@@ -44,6 +44,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
@@ -197,7 +198,7 @@ def technique_section(quick: bool, size: int) -> Dict[str, Any]:
 
 
 BLENDER_SCRIPT = r'''
-import json, sys, time, math
+import json, os, sys, time, math
 args = json.loads(sys.argv[sys.argv.index("--") + 1])
 sys.path[:0] = [args["shim"], args["addon"], args["scenes"], args["tools"]]
 import bpy, dwivedi, scenes, benchmark_scenes
@@ -262,7 +263,20 @@ def cycles(scene, spp, seed, path):
     t = time.monotonic(); bpy.ops.render.render(write_still=True); return time.monotonic() - t
 
 out = {}
-for name in args["scenes_list"]:
+not_run = []
+
+def write_result():
+    # After every scene, so that a run cut short (the machine's load, --budget-minutes) keeps the
+    # scenes it finished: written beside and renamed, never half-written.
+    with open(args["result"] + ".part", "w") as f:
+        json.dump({"blender": bpy.app.version_string, "scenes": out, "not_run": not_run}, f)
+    os.replace(args["result"] + ".part", args["result"])
+
+for index, name in enumerate(args["scenes_list"]):
+    if args["deadline"] is not None and time.time() > args["deadline"]:
+        not_run[:] = args["scenes_list"][index:]
+        print("time budget spent: not run", ", ".join(not_run), file=sys.stderr, flush=True)
+        break
     builders = {"slab": scenes.slab_scene,
                 # A leaf-like sheet: 2 cm thick, the same radius in every channel (mean free path
                 # 0.1 / (4 pi) = 8 mm, 2.5 of them across), a high green albedo, lit from behind.
@@ -337,18 +351,21 @@ for name in args["scenes_list"]:
     entry["cycles_reference_mean_rgb"] = [sum(ref[c::4]) / n for c in range(3)]
     out[name] = entry
     print("scene", name, "done", file=sys.stderr, flush=True)
-with open(args["result"], "w") as f:
-    json.dump({"blender": bpy.app.version_string, "scenes": out}, f)
+    write_result()
+write_result()
 '''
 
 
 def cycles_section(quick: bool, blender: str, size: int, scenes: Sequence[str], repeats: int,
-                   where: str = "host", library: Optional[str] = None) -> Dict[str, Any]:
+                   where: str = "host", library: Optional[str] = None,
+                   deadline: Optional[float] = None) -> Dict[str, Any]:
     """The Cycles comparison in one Blender: `blender` on the host (where = "host"), or the Blender
     of the trixie / sid chroot (scripts/blender-chroots.sh, run the way the tests run it:
     tests/blender/run_package_tests.py's make_chroot and blender_command; root). `library`: the
     dwivedi library the bakes use (default the shim's; a chroot needs the self-contained one,
-    build/portable/libdwivedi.so.1). Returns {"blender": version, "scenes": {name: entry}}."""
+    build/portable/libdwivedi.so.1). `deadline` (time.time() seconds): scenes not begun by then
+    are left out and listed. Returns {"blender": version, "scenes": {name: entry}, "not_run":
+    [names]}."""
     scenes_dir = SOURCE_DIR / "tests" / "blender"
     addon_dir = SOURCE_DIR / "blender_addon"
     shim_dir = Path(dwivedi.__file__).resolve().parent.parent
@@ -391,6 +408,7 @@ def cycles_section(quick: bool, blender: str, size: int, scenes: Sequence[str], 
         result_path = stage / "result.json"
         args = {**{key: inside(value) for key, value in paths.items()}, "work": inside(stage),
                 "result": inside(result_path), "size": size, "scenes_list": list(scenes), "repeats": repeats,
+                "deadline": deadline,
                 # Counts large enough that Cycles' render time, not its per-render overhead, is
                 # what is measured.
                 "cycles_counts": [32, 128, 512] if quick else [64, 256, 1024],
@@ -615,6 +633,8 @@ def markdown(data: Dict[str, Any], made: List[str]) -> str:
                                      f"{(theirs['rmse'] / mine['rmse']) ** 2:.3g} | {theirs['seconds']:.3g}"
                                      f"{own(theirs)} | {mine['seconds']:.3g}{own(mine)} | "
                                      f"{mine.get('export_seconds', math.nan):.3g} |")
+            if run.get("not_run"):
+                lines += ["", "Not run (--budget-minutes spent before they began): " + ", ".join(run["not_run"]) + "."]
             for name in run["scenes"]:
                 if f"cycles_{where}_{name}.png" in made:
                     lines += ["", f"![{name} against Blender {run['blender']}'s Cycles](cycles_{where}_{name}.png)"]
@@ -643,6 +663,9 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     parser.add_argument("--cycles-blenders", default="host",
                         help="the Blenders whose Cycles is compared, comma-separated, in this order: host (--blender), "
                              "trixie (4.3), sid (5.2) (the chroots of scripts/blender-chroots.sh; root). Default host")
+    parser.add_argument("--budget-minutes", type=float, default=None,
+                        help="against Cycles: scenes not begun this many minutes after the start are left out "
+                             "(listed as not run in the report); the scenes finished are kept. Default: no limit")
     parser.add_argument("--library", default=None,
                         help="the dwivedi library the Cycles part bakes with (default the shim's; the chroots need "
                              "the self-contained build/portable/libdwivedi.so.1)")
@@ -656,9 +679,11 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     unknown = ([part for part in sections if part not in SECTIONS]
                + [n for n in cycles_scenes if n not in CYCLES_SCENES + BENCHMARK_SCENES]
                + [n for n in blenders if n not in BLENDERS])
-    if unknown or not sections or not cycles_scenes or not blenders or not 1 <= repeats <= 100:
+    budget_bad = args.budget_minutes is not None and not (math.isfinite(args.budget_minutes) and args.budget_minutes > 0)
+    if unknown or not sections or not cycles_scenes or not blenders or not 1 <= repeats <= 100 or budget_bad:
         problem = (f"unknown section, scene or Blender {unknown[0]!r}" if unknown else "no section, scene or Blender "
                    "given" if not sections or not cycles_scenes or not blenders else
+                   f"--budget-minutes {args.budget_minutes} is not a positive number of minutes" if budget_bad else
                    f"--repeats {repeats} is outside 1 to 100")
         print(f"cycles_report: {problem} (sections: {', '.join(SECTIONS)}; scenes: {', '.join(CYCLES_SCENES)}; "
               f"Blenders: {', '.join(BLENDERS)})", file=sys.stderr)
@@ -684,11 +709,12 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             data["cycles"] = {}
             data["cycles_library"] = args.library or dwivedi.library_path()
             cycles_size = args.size or (32 if args.quick else 48)
+            deadline = None if args.budget_minutes is None else time.time() + 60.0 * args.budget_minutes
             for where in blenders:
                 print(f"Cycles ({where})", file=sys.stderr, flush=True)
                 try:
                     data["cycles"][where] = cycles_section(args.quick, args.blender, cycles_size, cycles_scenes,
-                                                           repeats, where, args.library)
+                                                           repeats, where, args.library, deadline)
                 except RuntimeError as error:  # the other Blenders' figures are still written
                     data.setdefault("cycles_failed", {})[where] = str(error)
                     print(f"cycles_report: {error}", file=sys.stderr, flush=True)
