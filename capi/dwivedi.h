@@ -1130,8 +1130,8 @@ typedef struct dwv_bake_stats_t {
     uint32_t reserved;
     /* Added after 0.3 (issue 18; a caller whose struct_size ends before it gets the fields before
      * it). Rays the paths after the first scattering traced (indirect light and mirrors'
-     * reflections; the walks' own rays are not counted). Merged partial files: 0 (their format
-     * does not carry it). */
+     * reflections; the walks' own rays are not counted). A merge of partial files: the sum of
+     * its chunks' (partial format 2). */
     uint64_t path_rays;
 } dwv_bake_stats_t;
 #define DWV_BAKE_STATS_INIT                                                                         \
