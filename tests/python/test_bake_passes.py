@@ -5,7 +5,6 @@ PREFIX.layers.exr, and a split bake's chunk refusing passes. Standard library on
 Run by ctest, which sets DWIVEDI_LIBRARY, DWIVEDI_CLI, DWIVEDI_SOURCE_DIR and PYTHONPATH."""
 import json
 import os
-import subprocess
 import sys
 import tempfile
 import unittest
@@ -15,6 +14,7 @@ SOURCE_DIR = Path(os.environ.get("DWIVEDI_SOURCE_DIR", Path(__file__).resolve().
 sys.path.append(str(SOURCE_DIR / "python_shim"))
 
 import dwivedi  # noqa: E402
+from cli_helpers import run_cli  # noqa: E402
 
 SMALL = dict(width=12, height=10, samples=4, threads=2, seed=3)
 
@@ -85,18 +85,15 @@ class SceneFilePasses(unittest.TestCase):
                 dwivedi.Scene.from_json(json.dumps(document), base_dir=scene_path.parent)
 
     def test_cli_layers(self):
-        cli = os.environ.get("DWIVEDI_CLI")
-        if not cli:
-            self.skipTest("DWIVEDI_CLI is not set (ctest sets it)")
+        # run_cli fails (never skips) where ctest did not set DWIVEDI_CLI.
         with tempfile.TemporaryDirectory() as folder:
             prefix = Path(folder) / "out"
-            run = subprocess.run([cli, "bake", "--out", str(prefix), "--spp", "2", "--width", "8", "--height", "8",
-                                  "--passes", "DiffDir,Env", "--quiet"], capture_output=True, text=True)
+            run = run_cli("bake", "--out", str(prefix), "--spp", "2", "--width", "8", "--height", "8",
+                          "--passes", "DiffDir,Env", "--quiet")
             self.assertEqual(run.returncode, 0, run.stderr)
             self.assertIn("out.layers.exr", run.stdout)
             self.assertIn(b"DiffCol.R", (Path(folder) / "out.layers.exr").read_bytes())
-            bad = subprocess.run([cli, "bake", "--out", str(prefix), "--passes", "DiffDir,,Env"],
-                                 capture_output=True, text=True)
+            bad = run_cli("bake", "--out", str(prefix), "--passes", "DiffDir,,Env")
             self.assertNotEqual(bad.returncode, 0)
             self.assertIn("--passes", bad.stderr)
 
