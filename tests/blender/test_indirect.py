@@ -23,7 +23,8 @@ least 5% of the brightest channel's mean, with the standard error of that differ
 
 Planted error (to show the comparison catches what indirect light changes):
 DWIVEDI_INDIRECT_PLANTED=one_bounce makes the add-on pass max_bounces 0 (the one-bounce image)
-while Cycles keeps its Light Paths; the test must then fail.
+while Cycles keeps its Light Paths; the test must then fail. DWIVEDI_INDIRECT_PLANTED=no_blur makes
+it pass blur_glossy 0 while Cycles blurs: test_mirror_at_default_filter_glossy must then fail.
 """
 import json
 import math
@@ -57,6 +58,14 @@ if os.environ.get("DWIVEDI_INDIRECT_PLANTED") == "one_bounce":
         return {**real_light_paths(scene, version), "max_bounces": 0}
 
     export.light_paths = one_bounce
+elif os.environ.get("DWIVEDI_INDIRECT_PLANTED") == "no_blur":
+    export = harness.addon_module("export")
+    real_light_paths = export.light_paths
+
+    def no_blur(scene, version=None):
+        return {**real_light_paths(scene, version), "blur_glossy": 0.0}
+
+    export.light_paths = no_blur
 
 
 def empty_scene(resolution, samples):
