@@ -1242,7 +1242,8 @@ DWV_API dwv_result_t dwv_merge_partials(const char *const *paths, uint32_t count
  * ------------------------------------------------------------------------------------------- */
 /* Reads a scene file and the meshes it references (OBJ, PLY) into a new committed scene; bake
  * settings in the file (resolution, samples, technique...) go into *options, which should
- * come in as DWV_BAKE_OPTIONS_INIT (it may be NULL). */
+ * come in as DWV_BAKE_OPTIONS_INIT (it may be NULL; a struct of an older header, ending at
+ * sample_first or later, gets the settings it has fields for, as dwv_bake_start reads it). */
 DWV_API dwv_result_t dwv_scene_load(const char *path, dwv_scene_t **scene, dwv_bake_options_t *options);
 /* The same from JSON text in memory; relative mesh paths resolve against base_dir (NULL: "."). */
 DWV_API dwv_result_t dwv_scene_load_json(const char *json, uint64_t size, const char *base_dir,

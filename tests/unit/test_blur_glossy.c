@@ -20,7 +20,7 @@
  * - an options struct that ends before blur_glossy (an older header) bakes as blur_glossy 0,
  *   bit for bit; 1 and 2 threads give the same bits with blur_glossy 1; NaN, infinity and -0.5
  *   are refused (DWV_ERROR_OUT_OF_RANGE, naming blur_glossy), and so is a scene file's negative
- *   "blur_glossy". */
+ *   "blur_glossy"; a scene file loads into an older struct without writing past its end. */
 #include <math.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -182,6 +182,15 @@ static void test_scene_file(void)
     dwv_result_t r = dwv_scene_load_json(good, sizeof good - 1u, NULL, &scene, &o);
     CHECK(r == DWV_SUCCESS && o.blur_glossy == 2.5, "scene file blur_glossy 2.5: %d, %g, '%s'", (int)r, o.blur_glossy,
           dwv_last_error_message());
+    dwv_scene_release(scene);
+    scene = NULL;
+    /* An older header's struct, ending before blur_glossy: loaded, nothing written past its end. */
+    o = (dwv_bake_options_t)DWV_BAKE_OPTIONS_INIT;
+    o.struct_size = (uint32_t)offsetof(dwv_bake_options_t, blur_glossy);
+    o.blur_glossy = -7.0; /* stands for the bytes beyond the caller's struct */
+    r = dwv_scene_load_json(good, sizeof good - 1u, NULL, &scene, &o);
+    CHECK(r == DWV_SUCCESS && o.blur_glossy == -7.0 && o.struct_size == offsetof(dwv_bake_options_t, blur_glossy),
+          "older struct: %d, %g, '%s'", (int)r, o.blur_glossy, dwv_last_error_message());
     dwv_scene_release(scene);
     scene = NULL;
     o = (dwv_bake_options_t)DWV_BAKE_OPTIONS_INIT;
