@@ -1008,12 +1008,21 @@ typedef struct dwv_bake_options_t {
     uint32_t max_bounces, diffuse_bounces, glossy_bounces, transmission_bounces;
     uint32_t min_light_bounces;
     dwv_subsurface_after_diffuse_t subsurface_after_diffuse; /* DWV_SUBSURFACE_AFTER_DIFFUSE_* */
+    /* Added after 0.3 (issue 18; a caller whose struct_size ends before it gets 0: no blur, the
+     * image it always got). Cycles' Filter Glossy (Blender's scene.cycles.blur_glossy, default
+     * 1.0), finite and >= 0: at a path's vertex after the camera's, with p the smallest pdf of
+     * the path's non-singular bounces so far (its sampled direction's density under the surface
+     * mixture that drew it; cos / pi for a walk's exit), every specular layer's GGX alpha becomes
+     * max(alpha, 0.5 sqrt(1 - p / blur_glossy)) where p / blur_glossy < 1 (a mirror-sharp layer
+     * turns GGX), for its direct light and its path ray alike. 0: none. */
+    double blur_glossy;
 } dwv_bake_options_t;
-/* Blender's default Light Paths (12 total, 4 diffuse, 4 glossy, 12 transmission, min 0). */
+/* Blender's default Light Paths (12 total, 4 diffuse, 4 glossy, 12 transmission, min 0; Filter
+ * Glossy 1). */
 #define DWV_BAKE_OPTIONS_INIT                                                                       \
     {sizeof(dwv_bake_options_t), DWV_BAKE_CAMERA, 256u, 256u, 0u, 16u, DWV_TECHNIQUE_AUTO, 64u, 0.0,  \
      0.0, 0u, 0u, 0u, 0u, 0u, NULL, NULL, 0u, 0u, 0, 0u, 0u, 0u, 12u, 4u, 4u, 12u, 0u,                \
-     DWV_SUBSURFACE_AFTER_DIFFUSE_BY_MODEL}
+     DWV_SUBSURFACE_AFTER_DIFFUSE_BY_MODEL, 1.0}
 
 /* Bake passes as Cycles' (Blender's render passes and its bake types' pass filter). Direct:
  * light from the lights and the world at the first scattering, the one at the camera ray's hit
@@ -1233,7 +1242,8 @@ DWV_API dwv_result_t dwv_merge_partials(const char *const *paths, uint32_t count
  * ------------------------------------------------------------------------------------------- */
 /* Reads a scene file and the meshes it references (OBJ, PLY) into a new committed scene; bake
  * settings in the file (resolution, samples, technique...) go into *options, which should
- * come in as DWV_BAKE_OPTIONS_INIT (it may be NULL). */
+ * come in as DWV_BAKE_OPTIONS_INIT (it may be NULL; a struct of an older header, ending at
+ * sample_first or later, gets the settings it has fields for, as dwv_bake_start reads it). */
 DWV_API dwv_result_t dwv_scene_load(const char *path, dwv_scene_t **scene, dwv_bake_options_t *options);
 /* The same from JSON text in memory; relative mesh paths resolve against base_dir (NULL: "."). */
 DWV_API dwv_result_t dwv_scene_load_json(const char *json, uint64_t size, const char *base_dir,

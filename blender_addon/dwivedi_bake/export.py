@@ -860,7 +860,7 @@ _LIGHT_PATH_DEFAULTS = {"max_bounces": 12, "diffuse_bounces": 4, "glossy_bounces
 
 def light_paths(scene: Any, version: Optional[Tuple[int, ...]] = None) -> Dict[str, Any]:
     """Cycles' Light Paths of the scene (scene.cycles: Max Bounces Total, Diffuse, Glossy,
-    Transmission, Min Light Bounces) as dwivedi.BakeSettings keys, and what a subsurface surface
+    Transmission, Min Light Bounces, Filter Glossy) as dwivedi.BakeSettings keys, and what a subsurface surface
     met after a diffuse bounce does in that Blender's Cycles: Lambertian up to 4.x (bssrdf_setup's
     fallback after a diffuse ancestor), a walk from 5.0 on (multi-bounce random walk)."""
     if version is None:
@@ -871,6 +871,9 @@ def light_paths(scene: Any, version: Optional[Tuple[int, ...]] = None) -> Dict[s
         value = getattr(cycles, key, default) if cycles is not None else default
         out[key] = max(0, min(1024, int(value)))
     out["subsurface_after_diffuse"] = "walk" if tuple(version) >= (5, 0, 0) else "lambert"
+    # Filter Glossy (Light Paths > Caustics; Blender's default 1.0, soft range 0 to 10).
+    blur = float(getattr(cycles, "blur_glossy", 1.0)) if cycles is not None else 1.0
+    out["blur_glossy"] = blur if math.isfinite(blur) and blur > 0.0 else 0.0
     return out
 
 

@@ -308,6 +308,7 @@ class BakeOptions(_SizedStructure):
         ("transmission_bounces", ctypes.c_uint32),
         ("min_light_bounces", ctypes.c_uint32),
         ("subsurface_after_diffuse", ctypes.c_int32),
+        ("blur_glossy", ctypes.c_double),
     ]
 
     def __init__(self) -> None:
@@ -320,6 +321,7 @@ class BakeOptions(_SizedStructure):
         self.diffuse_bounces = 4
         self.glossy_bounces = 4
         self.transmission_bounces = 12
+        self.blur_glossy = 1.0
 
 
 class ImageInfo(_SizedStructure):

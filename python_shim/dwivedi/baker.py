@@ -495,6 +495,9 @@ class BakeSettings:
     transmission_bounces: int = 12
     min_light_bounces: int = 0
     subsurface_after_diffuse: str = "by_model"
+    # Cycles' Filter Glossy (scene.cycles.blur_glossy; Blender's default 1.0, 0: no blur): specular
+    # layers met after a path's bounces roughened as Cycles roughens them (capi's blur_glossy).
+    blur_glossy: float = 1.0
 
     def _to_c(self) -> _library.BakeOptions:
         out = _library.BakeOptions()
@@ -525,6 +528,7 @@ class BakeSettings:
         out.min_light_bounces = _uint("min_light_bounces", self.min_light_bounces)
         out.subsurface_after_diffuse = _name_code("subsurface_after_diffuse", self.subsurface_after_diffuse,
                                                   _AFTER_DIFFUSE)
+        out.blur_glossy = _real("blur_glossy", self.blur_glossy)
         return out
 
     @classmethod
@@ -539,6 +543,7 @@ class BakeSettings:
                    transmission_bounces=c.transmission_bounces, min_light_bounces=c.min_light_bounces,
                    subsurface_after_diffuse={v: k for k, v in _AFTER_DIFFUSE.items()}.get(
                        c.subsurface_after_diffuse, str(c.subsurface_after_diffuse)),
+                   blur_glossy=c.blur_glossy,
                    channel_walks={v: k for k, v in _CHANNEL_WALKS.items()}.get(c.channel_walks, str(c.channel_walks)))
 
 

@@ -75,7 +75,7 @@ def degrees_for(radians: float) -> float:
 
 
 LIGHT_PATH_KEYS = ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces", "min_light_bounces",
-                   "subsurface_after_diffuse")
+                   "subsurface_after_diffuse", "blur_glossy")
 
 
 def light_path_keys(settings: BakeSettings) -> Dict[str, Any]:

@@ -108,6 +108,10 @@ static dwv_result_t check_options(const char *fn, const dwvb_scene *s, const dwv
         return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
                         "%s: subsurface_after_diffuse %u is not known (0 by model, 1 Lambert, 2 walk)", fn,
                         (unsigned)o->subsurface_after_diffuse);
+    if (!isfinite(o->blur_glossy) || o->blur_glossy < 0.0)
+        return dwv_fail(DWV_ERROR_OUT_OF_RANGE,
+                        "%s: blur_glossy = %.17g must be finite and >= 0 (Cycles' Filter Glossy; 0: no blur)", fn,
+                        o->blur_glossy);
     DWV_TRY(dwv_check_range(fn, "time_limit", o->time_limit, 0.0, HUGE_VAL));
     DWV_TRY(dwv_check_range(fn, "target_error", o->target_error, 0.0, HUGE_VAL));
     if (o->threads > MAX_THREADS)

@@ -219,6 +219,7 @@ uint64_t dwv_options_hash(const dwv_bake_options_t *o)
         ADD(&f, o->transmission_bounces);
         ADD(&f, o->min_light_bounces);
         ADD(&f, o->subsurface_after_diffuse);
+        if (o->blur_glossy != 0.0) ADD(&f, o->blur_glossy); /* bakes without it hash as before it */
     }
     return f.h;
 }

@@ -467,7 +467,8 @@ dwv_result_t dwvb_bake_start(dwvb_scene *scene, const dwv_bake_options_t *option
     bake->shader.max_events = options->max_events;
     bake->shader.paths = (dwvb_light_paths){options->max_bounces,         options->diffuse_bounces,
                                             options->glossy_bounces,      options->transmission_bounces,
-                                            options->min_light_bounces,   (int)options->subsurface_after_diffuse};
+                                            options->min_light_bounces,   (int)options->subsurface_after_diffuse,
+                                            options->blur_glossy};
     if (options->target == DWV_BAKE_CAMERA) {
         /* The pixel's footprint for Cycles 4.0-4.3's quarter-pixel rule (shade.h). */
         double px = 2.0 / bake->width, py = 2.0 / bake->height;

@@ -297,13 +297,25 @@ double dwvb_footprint(const dwvb_shader *shader, dwvu_vec3 view, double t)
 #define INV_PI 0.31830988618379067154
 
 /* Where a path stands (Cycles' path state): its bounces so far by kind, whether one of them was
- * diffuse (PATH_RAY_DIFFUSE_ANCESTOR), and its ray's compact differentials (Cycles' ray.dP, ray.dD:
- * the footprint at the next hit is dP + t dD; dwvb_footprint). */
+ * diffuse (PATH_RAY_DIFFUSE_ANCESTOR), its ray's compact differentials (Cycles' ray.dP, ray.dD:
+ * the footprint at the next hit is dP + t dD; dwvb_footprint), and the smallest pdf of its
+ * non-singular bounces (Cycles' min_ray_pdf: FLT_MAX at the camera, path_state_init; the min
+ * with each BSDF bounce's pdf, shade_surface.h; a walk's entry leaves it, its exit's bounce is a
+ * diffuse BSDF's; for Filter Glossy, dwvb_blur_alpha). */
 typedef struct path_state {
     uint32_t bounce, diffuse, glossy, transmission;
     int diffuse_ancestor;
     double dP, dD;
+    double min_ray_pdf;
 } path_state;
+
+double dwvb_blur_alpha(double alpha, double min_ray_pdf, double blur_glossy)
+{
+    if (!(blur_glossy > 0.0)) return alpha;
+    double b = min_ray_pdf / blur_glossy;
+    if (!(b < 1.0)) return alpha;
+    return fmax(alpha, 0.5 * sqrt(1.0 - b));
+}
 
 /* A path's next segment, sampled at a scattering point: the ray (from the point's offset
  * origin), the factor f cos / pdf it multiplies the path's throughput by (times what the point
@@ -320,6 +332,9 @@ typedef struct path_ray {
      * is traced for that even where its bounce exceeds a limit (Cycles' kernel limits are the
      * scene's + 1: that bounce's ray is traced and only its emission is taken). */
     int singular;
+    /* The density the direction was drawn with (the mixture's, dwvb_surface_pdf; a walk's exit
+     * cos / pi); +inf for a mirror's (Cycles' singular pdf is a stand-in 1e6: no blur follows it). */
+    double pdf;
 } path_ray;
 
 /* Cycles' path_state_next for a bounce off `lobe`: counts it, or returns 0 where it would exceed
@@ -391,6 +406,7 @@ static int exit_path_ray(const dwvb_shader *shader, const exit_point *e, const d
     for (int c = 0; c < 3; ++c) ray->weight[c] = weight[c] * f;
     ray->lobe = DWVB_LOBE_DIFFUSE;
     ray->singular = 0;
+    ray->pdf = mu * INV_PI;
     ray->exit = 4;
     for (int c = 0; c < 3; ++c)
         if (weight[c] > 0.0 && weight[(c + 1) % 3] == 0.0 && weight[(c + 2) % 3] == 0.0) ray->exit = 1 + c;
@@ -488,12 +504,13 @@ static int surface_path_ray(const dwvb_shader *shader, const surface_lobes *s, d
                              &singular))
         return 0;
     if (!(dwvu_dot(w, ng) > 0.0)) return 0;
+    double pdf = INFINITY;
     if (singular) {
         double f[3];
         dwvb_specular_singular_weight(m, cos_specular, f);
         for (int c = 0; c < 3; ++c) ray->weight[c] = f[c] / p_specular;
     } else {
-        double pdf = dwvb_surface_pdf(m, p_specular, s->lobe.n, s->specular_n, s->lobe.to_view, w);
+        pdf = dwvb_surface_pdf(m, p_specular, s->lobe.n, s->specular_n, s->lobe.to_view, w);
         if (!(pdf > 0.0) || !isfinite(pdf)) return 0;
         double f[2][3];
         surface_factor(s, w, f);
@@ -508,6 +525,7 @@ static int surface_path_ray(const dwvb_shader *shader, const surface_lobes *s, d
     path_ray_from(shader, x, ng, top, w, ray);
     ray->exit = 0;
     ray->singular = singular;
+    ray->pdf = pdf;
     return 1;
 }
 
@@ -567,6 +585,15 @@ static void shade_point(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec
     if (material->subsurface && state->diffuse_ancestor && !walks_after_diffuse(shader, material)) {
         lambert_after_diffuse(material, &lambert);
         material = &lambert;
+    }
+    /* Filter Glossy: the specular layer roughened after the path's bounces (none at the camera's
+     * hit, whose min_ray_pdf is +inf), for its direct light and its path ray alike. */
+    dwvb_material blurred;
+    double blurred_alpha = dwvb_blur_alpha(material->spec_alpha, state->min_ray_pdf, shader->paths.blur_glossy);
+    if (material->specular && blurred_alpha != material->spec_alpha) {
+        blurred = *material;
+        blurred.spec_alpha = blurred_alpha;
+        material = &blurred;
     }
     *ray_count = 0u;
     for (int l = 0; l < DWVB_LOBE_COUNT; ++l) light[l][0] = light[l][1] = light[l][2] = 0.0;
@@ -821,6 +848,7 @@ static void follow_path(const dwvb_shader *shader, const path_ray *first, path_s
     for (uint64_t vertex = 1;; ++vertex) {
         int shaded = path_state_next(&state, ray.lobe, &shader->paths);
         if (!shaded && !ray.singular) return;
+        if (!ray.singular) state.min_ray_pdf = fmin(state.min_ray_pdf, ray.pdf);
         int alive = 0;
         for (int c = 0; c < 3; ++c) {
             throughput[c] *= ray.weight[c];
@@ -866,7 +894,7 @@ void dwvb_shade(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec3 view, 
                 uint32_t pair, uint64_t key_walk, dwvb_shade_parts *parts, dwvb_tally *tally)
 {
     *parts = (dwvb_shade_parts){0};
-    path_state state = {0u, 0u, 0u, 0u, 0, 0.0, 0.0};
+    path_state state = {0u, 0u, 0u, 0u, 0, 0.0, 0.0, INFINITY};
     path_ray rays[1u + 3u * DWVB_MAX_CHANNEL_WALKS];
     uint32_t count = 0u;
     /* No ray goes on where the limits leave no bounce: the one-bounce image, bit for bit. */

@@ -27,7 +27,19 @@
 typedef struct dwvb_light_paths {
     uint32_t max_bounces, diffuse, glossy, transmission, min_bounces;
     int after_diffuse;
+    /* Cycles' Filter Glossy (scene.cycles.blur_glossy; 0: none): dwvb_blur_alpha. */
+    double blur_glossy;
 } dwvb_light_paths;
+
+/* Cycles' Filter Glossy (surface_shader_prepare_closures, the same in 3.4, 4.3 and 5.x): at a
+ * shading point of a path whose non-singular bounces so far had pdfs of at least min_ray_pdf
+ * (+inf at the camera's hit), where b = min_ray_pdf / blur_glossy < 1, every microfacet closure's
+ * alpha becomes max(alpha, 0.5 sqrt(1 - b)) (bsdf_blur). Returns that alpha (`alpha` itself
+ * where no blur applies, and always for blur_glossy 0). Only alpha changes: 4.x+ compute the
+ * multiscatter energy scale, the darkening and the layering weight at the closure's setup from
+ * its own roughness and keep them after the blur (bsdf.h: "TODO: Recompute energy preservation
+ * after blur?"), so v2's albedo tables stay the material's. */
+double dwvb_blur_alpha(double alpha, double min_ray_pdf, double blur_glossy);
 
 typedef struct dwvb_shader {
     const dwvb_scene *scene;

@@ -24,7 +24,8 @@ static void help(FILE *out)
             "usage: dwivedi bake [SCENE.json] --out PREFIX [--spp N] [--time SECONDS] [--error REL]\n"
             "           [--technique T] [--channel-walks C] [--threads N] [--seed S] [--width W] [--height H]\n"
             "           [--ocio CONFIG] [--display NAME] [--view NAME] [--look NAME]\n"
-            "           [--exposure E] [--gamma G] [--samples FIRST:COUNT] [--passes NAMES] [--quiet]\n"
+            "           [--exposure E] [--gamma G] [--samples FIRST:COUNT] [--passes NAMES] [--blur-glossy B]\n"
+            "           [--quiet]\n"
             "           [--mpi [--mpi-chunk N] [--mpi-timeout SECONDS]]\n\n"
             "Bakes SCENE.json (docs/scene-format.md), or without it the built-in default scene: a thin\n"
             "back-lit leaf-like shell beside a thick front-lit wax-like shape. Writes\n"
@@ -54,6 +55,8 @@ static void help(FILE *out)
             "  --passes NAMES bake passes beside the combined image, Blender's names comma-separated:\n"
             "                 DiffDir, DiffInd, DiffCol, GlossDir, GlossInd, GlossCol, TransDir, TransInd,\n"
             "                 TransCol, Emit, Env (docs/output.md; a direct or indirect pass brings its colour)\n"
+            "  --blur-glossy B  Cycles' Filter Glossy (default: the scene's bake.blur_glossy, else Blender's\n"
+            "                 1.0; 0: none): specular layers met after a bounce roughened as Cycles does\n"
             "  --quiet        no progress bar (it is shown only on a terminal anyway)\n"
             "  --mpi          under mpirun (docs/farm.md): the ranks bake ranges of N samples each, handed\n"
             "                 out by rank 0, which merges them exactly and writes the outputs (bit for bit\n"
@@ -94,7 +97,8 @@ static int parse_overrides(int argc, char **argv, cli_bake_flags *f, dwv_bake_op
         static const char *const flags[] = {"--out",     "--spp",   "--time",    "--error",   "--technique",
                                             "--threads", "--seed",  "--width",   "--height",  "--ocio",
                                             "--display", "--view",  "--look",    "--exposure", "--gamma",
-                                            "--channel-walks", "--samples", "--mpi-chunk", "--mpi-timeout", "--passes"};
+                                            "--channel-walks", "--samples", "--mpi-chunk", "--mpi-timeout", "--passes",
+                                            "--blur-glossy"};
         int known = 0;
         for (size_t k = 0; k < sizeof flags / sizeof flags[0]; ++k) known |= strcmp(flag, flags[k]) == 0;
         if (!known) return cli_usage_error(verb, "unknown argument '%.64s'", flag);
@@ -165,6 +169,11 @@ static int parse_overrides(int argc, char **argv, cli_bake_flags *f, dwv_bake_op
             if (dwv_channel_walks_from_name(value, &channel_walks) != DWV_SUCCESS)
                 return cli_usage_error(verb, "--channel-walks: %s", dwv_last_error_message());
             if (apply) o->channel_walks = channel_walks;
+        } else if (strcmp(flag, "--blur-glossy") == 0) {
+            if (cli_parse_double(verb, flag, value, &number)) return CLI_USAGE;
+            if (!isfinite(number) || number < 0.0)
+                return cli_usage_error(verb, "--blur-glossy: '%.64s' must be finite and >= 0 (0: no blur)", value);
+            if (apply) o->blur_glossy = number;
         } else if (strcmp(flag, "--time") == 0 || strcmp(flag, "--error") == 0) {
             if (cli_parse_double(verb, flag, value, &number)) return CLI_USAGE;
             f->budget = 1;

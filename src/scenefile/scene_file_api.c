@@ -3,6 +3,7 @@
  * arguments and the reading of the file. */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -23,10 +24,28 @@ static dwv_result_t prefixed(dwv_result_t code, const char *what)
     return dwv_fail(code, "%s: %s", what, message);
 }
 
-static dwv_result_t check_options(const char *fn, dwv_bake_options_t *options)
+/* The caller's options as a whole struct in *full (NULL where the caller passed none): a struct
+ * of an older header (ending at sample_first or later, as dwv_bake_start takes) gets 0 in the
+ * fields it has not, and gets back only its own bytes (options_done). */
+static dwv_result_t check_options(const char *fn, dwv_bake_options_t *options, dwv_bake_options_t *full,
+                                  dwv_bake_options_t **use)
 {
+    *use = NULL;
     if (!options) return DWV_SUCCESS;
-    return dwv_check_struct(fn, "options", options, (uint32_t)sizeof(dwv_bake_options_t));
+    DWV_TRY(dwv_check_struct(fn, "options", options, (uint32_t)offsetof(dwv_bake_options_t, sample_first)));
+    memset(full, 0, sizeof *full);
+    memcpy(full, options, options->struct_size < sizeof *full ? options->struct_size : sizeof *full);
+    *use = full;
+    return DWV_SUCCESS;
+}
+
+static dwv_result_t options_done(dwv_result_t r, dwv_bake_options_t *options, const dwv_bake_options_t *full)
+{
+    if (r != DWV_SUCCESS || !options) return r;
+    uint32_t size = options->struct_size;
+    memcpy(options, full, size < sizeof *full ? size : sizeof *full);
+    options->struct_size = size;
+    return r;
 }
 
 dwv_result_t dwv_scene_load_json(const char *json, uint64_t size, const char *base_dir, dwv_scene_t **scene,
@@ -36,11 +55,12 @@ dwv_result_t dwv_scene_load_json(const char *json, uint64_t size, const char *ba
     DWV_TRY(dwv_check_pointer(fn, "scene", scene));
     *scene = NULL;
     DWV_TRY(dwv_check_pointer(fn, "json", json));
-    DWV_TRY(check_options(fn, options));
+    dwv_bake_options_t full, *use;
+    DWV_TRY(check_options(fn, options, &full, &use));
     if (size > DWVS_SCENE_MAX_BYTES)
         return dwv_fail(DWV_ERROR_FORMAT, "%s: the scene text is %llu bytes, more than %u", fn,
                         (unsigned long long)size, DWVS_SCENE_MAX_BYTES);
-    return dwvs_scene_from_json(json, (size_t)size, base_dir ? base_dir : ".", scene, options);
+    return options_done(dwvs_scene_from_json(json, (size_t)size, base_dir ? base_dir : ".", scene, use), options, &full);
 }
 
 /* The folder of `path` ("." if it names none), for relative mesh paths. */
@@ -110,7 +130,8 @@ dwv_result_t dwv_scene_load(const char *path, dwv_scene_t **scene, dwv_bake_opti
     DWV_TRY(dwv_check_pointer(fn, "scene", scene));
     *scene = NULL;
     DWV_TRY(dwv_check_pointer(fn, "path", path));
-    DWV_TRY(check_options(fn, options));
+    dwv_bake_options_t full, *use;
+    DWV_TRY(check_options(fn, options, &full, &use));
     if (!path[0]) return dwv_fail(DWV_ERROR_IO, "%s: the path is empty", fn);
     char *text;
     size_t size;
@@ -121,10 +142,10 @@ dwv_result_t dwv_scene_load(const char *path, dwv_scene_t **scene, dwv_bake_opti
         free(text);
         return dwv_fail(DWV_ERROR_OUT_OF_MEMORY, "%s: out of memory", fn);
     }
-    r = dwvs_scene_from_json(text, size, folder, scene, options);
+    r = dwvs_scene_from_json(text, size, folder, scene, use);
     free(folder);
     free(text);
-    return r == DWV_SUCCESS ? r : prefixed(r, path);
+    return r == DWV_SUCCESS ? options_done(r, options, &full) : prefixed(r, path);
 }
 
 dwv_result_t dwv_scene_create_default(dwv_scene_t **scene, dwv_bake_options_t *options)
@@ -132,7 +153,8 @@ dwv_result_t dwv_scene_create_default(dwv_scene_t **scene, dwv_bake_options_t *o
     static const char fn[] = "dwv_scene_create_default";
     DWV_TRY(dwv_check_pointer(fn, "scene", scene));
     *scene = NULL;
-    DWV_TRY(check_options(fn, options));
-    dwv_result_t r = dwvs_default_scene(scene, options);
-    return r == DWV_SUCCESS ? r : prefixed(r, fn);
+    dwv_bake_options_t full, *use;
+    DWV_TRY(check_options(fn, options, &full, &use));
+    dwv_result_t r = dwvs_default_scene(scene, use);
+    return r == DWV_SUCCESS ? options_done(r, options, &full) : prefixed(r, fn);
 }

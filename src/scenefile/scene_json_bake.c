@@ -46,7 +46,7 @@ dwv_result_t dwvs_read_bake(dwvs_parser *ps, const cJSON *item)
                                        "max_events", "tile_size", "uv_mesh",     "uv_margin",
                                        "transparent_background", "passes", "max_bounces", "diffuse_bounces",
                                        "glossy_bounces", "transmission_bounces", "min_light_bounces",
-                                       "subsurface_after_diffuse"};
+                                       "subsurface_after_diffuse", "blur_glossy"};
     static const char *const after_diffuse[] = {"by_model", "lambert", "walk"};
     static const char *const targets[] = {"camera", "uv"};
     DWV_TRY(dwvs_check_keys(item, "bake", keys, sizeof keys / sizeof keys[0]));
@@ -130,6 +130,11 @@ dwv_result_t dwvs_read_bake(dwvs_parser *ps, const cJSON *item)
         DWV_TRY(dwvs_read_choice(after, "bake.subsurface_after_diffuse", after_diffuse, 3, &a));
         o->subsurface_after_diffuse = (dwv_subsurface_after_diffuse_t)a;
     }
+    /* Cycles' Filter Glossy (scene.cycles.blur_glossy): finite, >= 0. */
+    DWV_TRY(dwvs_opt_number(item, "bake", "blur_glossy", &o->blur_glossy));
+    if (!(o->blur_glossy >= 0.0))
+        return dwvs_fail_at(DWV_ERROR_OUT_OF_RANGE, "bake.blur_glossy", "%.17g is negative (0 means no blur)",
+                            o->blur_glossy);
 
     const cJSON *uv_mesh = dwvs_member(item, "uv_mesh"), *uv_margin = dwvs_member(item, "uv_margin");
     if (o->target != DWV_BAKE_UV) {

@@ -9,7 +9,10 @@
  * binomial(n, p_s) within 5 sigma, the rest chi-square against the continuous part. Planted
  * pdfs must fail: the specular part not weighted by p_s; and, tilted, the specular part about n
  * (the pdf before the lobes took their own normals). Bound: p > 1e-5 per case (the planted ones
- * give p < 1e-12). */
+ * give p < 1e-12). Filter Glossy: two mirrors roughened as after a bounce of pdf 0.6 / pi at
+ * blur_glossy 1 (dwvb_blur_alpha: alpha 0.5 sqrt(1 - 0.6 / pi) = 0.45, v2 keeping its alpha-0
+ * tables as Cycles keeps its energy terms), one of them tilted: GGX lobes now, no singular draw;
+ * and dwvb_blur_alpha's values where it applies and where not. */
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -123,20 +126,30 @@ int main(void)
 {
     /* tilt: the specular layer's normal turned that many radians from n toward the viewer's side
      * (+x), as ensure_valid_reflection turns a mapped normal. */
-    static const struct { int model; double roughness, mu, tilt; } cases[] = {
-        {DWV_SPECULAR_PRINCIPLED_V2, 0.3, 0.9, 0.0}, {DWV_SPECULAR_PRINCIPLED_V2, 0.3, 0.3, 0.0},
-        {DWV_SPECULAR_PRINCIPLED_V2, 0.7, 0.6, 0.0}, {DWV_SPECULAR_PRINCIPLED_V1, 0.4, 0.8, 0.0},
-        {DWV_SPECULAR_PRINCIPLED_V1, 0.5, 0.2, 0.0}, {DWV_SPECULAR_PRINCIPLED_V2, 0.3, 0.3, 0.35},
-        {DWV_SPECULAR_PRINCIPLED_V2, 0.6, 0.5, 0.5}, {DWV_SPECULAR_PRINCIPLED_V2, 0.0, 0.5, 0.0},
-        {DWV_SPECULAR_PRINCIPLED_V1, 0.0, 0.3, 0.0}, {DWV_SPECULAR_PRINCIPLED_V2, 0.0, 0.4, 0.3}};
+    /* blur: the specular alpha roughened as after a bounce of pdf 0.6 / pi (Filter Glossy 1). */
+    static const struct { int model; double roughness, mu, tilt; int blur; } cases[] = {
+        {DWV_SPECULAR_PRINCIPLED_V2, 0.3, 0.9, 0.0, 0}, {DWV_SPECULAR_PRINCIPLED_V2, 0.3, 0.3, 0.0, 0},
+        {DWV_SPECULAR_PRINCIPLED_V2, 0.7, 0.6, 0.0, 0}, {DWV_SPECULAR_PRINCIPLED_V1, 0.4, 0.8, 0.0, 0},
+        {DWV_SPECULAR_PRINCIPLED_V1, 0.5, 0.2, 0.0, 0}, {DWV_SPECULAR_PRINCIPLED_V2, 0.3, 0.3, 0.35, 0},
+        {DWV_SPECULAR_PRINCIPLED_V2, 0.6, 0.5, 0.5, 0}, {DWV_SPECULAR_PRINCIPLED_V2, 0.0, 0.5, 0.0, 0},
+        {DWV_SPECULAR_PRINCIPLED_V1, 0.0, 0.3, 0.0, 0}, {DWV_SPECULAR_PRINCIPLED_V2, 0.0, 0.4, 0.3, 0},
+        {DWV_SPECULAR_PRINCIPLED_V2, 0.0, 0.5, 0.0, 1}, {DWV_SPECULAR_PRINCIPLED_V1, 0.0, 0.4, 0.3, 1}};
+    const double bounce_pdf = 0.6 / 3.14159265358979323846, blurred = 0.5 * sqrt(1.0 - bounce_pdf);
+    CHECK(dwvb_blur_alpha(0.0, bounce_pdf, 1.0) == blurred && dwvb_blur_alpha(0.7, bounce_pdf, 1.0) == 0.7,
+          "blur of a bounce of pdf 0.6 / pi: %g, %g", dwvb_blur_alpha(0.0, bounce_pdf, 1.0),
+          dwvb_blur_alpha(0.7, bounce_pdf, 1.0));
+    CHECK(dwvb_blur_alpha(0.0, 2.0, 1.0) == 0.0 && dwvb_blur_alpha(0.0, INFINITY, 1.0) == 0.0 &&
+              dwvb_blur_alpha(0.0, bounce_pdf, 0.0) == 0.0 && dwvb_blur_alpha(0.0, 2.0, 4.0) == 0.5 * sqrt(0.5),
+          "blur where p / blur_glossy >= 1, at the camera, with blur_glossy 0, and at p 2 / blur_glossy 4");
     const double diffuse[3] = {0.5, 0.4, 0.3};
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
         dwvb_material m;
         material_of(&m, cases[k].model, cases[k].roughness);
+        if (cases[k].blur) m.spec_alpha = dwvb_blur_alpha(m.spec_alpha, bounce_pdf, 1.0);
         dwvu_vec3 to_view = dwvu_v(sqrt(1.0 - cases[k].mu * cases[k].mu), 0.0, cases[k].mu);
         dwvu_vec3 specular_n = dwvu_v(sin(cases[k].tilt), 0.0, cos(cases[k].tilt));
         int mirror = dwvb_specular_singular(&m);
-        CHECK(mirror == (cases[k].roughness == 0.0), "case %zu: singular %d", k, mirror);
+        CHECK(mirror == (cases[k].roughness == 0.0 && !cases[k].blur), "case %zu: singular %d", k, mirror);
         double p_specular = dwvb_surface_specular_probability(&m, diffuse, dwvu_dot(specular_n, to_view));
         CHECK(p_specular > 0.0 && p_specular < 1.0, "case %zu: p_s = %g", k, p_specular);
         double total, planted_total, draws, planted_draws;
@@ -147,9 +160,9 @@ int main(void)
                                     ? chi_square(&m, p_specular, specular_n, to_view, planted_normal_pdf, &planted_total,
                                                  &planted_draws)
                                     : 0.0;
-        printf("case %zu (model %d, roughness %.1f, mu %.1f, tilt %.2f): p_s %.4f, pdf above the horizon %.5f, "
+        printf("case %zu (model %d, roughness %.1f, mu %.1f, tilt %.2f, alpha %.3f): p_s %.4f, pdf above the horizon %.5f, "
                "chi-square p %.3g; mirror draws %.0f; planted p %.3g, planted normal p %.3g\n",
-               k, cases[k].model, cases[k].roughness, cases[k].mu, cases[k].tilt, p_specular, total, p, draws, planted,
+               k, cases[k].model, cases[k].roughness, cases[k].mu, cases[k].tilt, m.spec_alpha, p_specular, total, p, draws, planted,
                planted_normal);
         CHECK(p > 1e-5, "case %zu: chi-square p = %g", k, p);
         CHECK(total <= 1.0 + 1e-3, "case %zu: the pdf integrates to %g above the horizon", k, total);

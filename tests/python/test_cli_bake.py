@@ -90,6 +90,9 @@ class BakeCli(unittest.TestCase):
         assert_bad_usage(self, ["bake", "--out", self.prefix, "--spp", "many"], "dwivedi bake:", ["--spp"])
         assert_bad_usage(self, ["bake", "--out", self.prefix, "--technique", "magic"], "dwivedi bake:", ["magic"])
         assert_bad_usage(self, ["bake", "--out", self.prefix, "--frobnicate"], "dwivedi bake:", ["--frobnicate"])
+        for blur in ("-1", "inf", "nan", "soft"):
+            assert_bad_usage(self, ["bake", "--out", self.prefix, "--blur-glossy", blur], "dwivedi bake:",
+                             ["--blur-glossy", blur])
         done = run_cli("bake", "--out", self.prefix, "--spp", "0", "--quiet")
         self.assertEqual(done.returncode, USAGE, done.stderr)
         self.assertIn("samples", done.stderr)
