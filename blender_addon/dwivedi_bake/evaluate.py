@@ -116,10 +116,22 @@ def reads_only_mesh(socket: Any) -> bool:
 # gradient is the texels' differences), and Cycles' render takes the height's differences over
 # each pixel's footprint (ray differentials). Measured on tests/blender/test_evaluate.py's sphere
 # (a Wave Texture bump of Distance 0.3, tilts up to 70 degrees, 24 x 24 pixels, two seeds; the
-# three channels' means differ alike): +0.51% (3.4), -0.14% (4.3), +0.48% (5.2) at 256 x 256; the
-# Distance / 16 normal bake this replaced gave +1.1% / +1.7% / +2.9% there.
-BUMP_FIGURES = ("; a strong bump's height evaluated at 256 x 256 (a Wave bump of Distance 0.3, tilts up to 70 "
-                "degrees) gave means within +0.5% (Blender 3.4), -0.1% (4.3), +0.5% (5.2) of Cycles'")
+# three channels' means differ alike): +0.60% (3.4), -0.08% (4.3), +0.35% (5.2) with the height at
+# 512 x 512 (the default's, HEIGHT_SIZE_FACTOR), +0.51% / -0.14% / +0.48% at 256 x 256; the
+# Distance / 16 normal bake this replaced gave +1.1% / +1.7% / +2.9% at 256 x 256. A Wave twice as
+# fine, 64 x 64 pixels: +0.12% / +0.37% / +0.06% at 512 x 512, +0.15% / +0.99% / +1.30% at 256.
+BUMP_FIGURES = ("; a strong bump's height evaluated at 512 x 512 (a Wave bump of Distance 0.3, tilts up to 70 "
+                "degrees) gave means +0.6% (Blender 3.4), -0.1% (4.3), +0.4% (5.2) off Cycles', at 256 x 256 "
+                "+0.5% / -0.1% / +0.5%, and a Wave twice as fine (tilts up to 80 degrees) +0.1% / +0.4% / +0.1% "
+                "at 512 x 512, +0.2% / +1.0% / +1.3% at 256 x 256")
+# A Bump's height is evaluated at HEIGHT_SIZE_FACTOR x the Texture Bake Size per axis (at most
+# MAX_SIZE, the setting's own maximum): the bump's normal is the image's gradient, the texels'
+# differences, which fall short of the height's slopes by sinc(pi texel / period) and hold them
+# constant across a texel; a Wave bump of 7 texels a period at 256 x 256 (the test's finer one)
+# came out +1.3% above Cycles 5.2, at 512 x 512 -0.1%. The cost: about 1 to 2 s more per
+# evaluated height on this machine (4 x the texels of 256 x 256).
+HEIGHT_SIZE_FACTOR = 2
+MAX_SIZE = 8192
 # The z (cosine to the smooth normal) at or below which a baked normal is taken as clamped.
 CLAMPED_Z = 0.72
 
@@ -289,6 +301,11 @@ def _owner(obj: Any, sockets: List[Any]) -> str:
     return f"object {obj.name_full}"
 
 
+def _evaluated_size(socket: Any, size: int) -> int:
+    """The evaluated image's width and height for `socket` at Texture Bake Size `size`."""
+    return min(HEIGHT_SIZE_FACTOR * size, MAX_SIZE) if socket.node.type == 'BUMP' else size
+
+
 def _input_name(socket: Any) -> str:
     """How the warnings name an evaluated input: a Bump's Height by its node."""
     return f"the Height of Bump node '{socket.node.name}'" if socket.node.type == 'BUMP' else repr(socket.name)
@@ -334,7 +351,7 @@ def evaluate_objects(objects: List[Any], shader_of: Any, blender4: bool, size: i
                     continue
                 uv_map = mesh.uv_layers.active.name
                 for socket in sockets:
-                    image = _bake_socket(original, material, socket, size, warnings)
+                    image = _bake_socket(original, material, socket, _evaluated_size(socket, size), warnings)
                     images.append(image)
                     textures.EVALUATED[textures.evaluated_key(evaluation, socket)] = (textures.EvaluatedImage(image),
                                                                                     uv_map)
@@ -354,9 +371,11 @@ def evaluate_objects(objects: List[Any], shader_of: Any, blender4: bool, size: i
         uv_maps = f"UV map{'s' if len(maps) > 1 else ''} {', '.join(repr(m) for m in maps)}"
         normal = any(s.name == "Normal" for s in sockets)
         height = any(s.node.type == 'BUMP' for s in sockets)
+        sizes = " and ".join(f"{n} x {n}" for n in sorted({_evaluated_size(s, size) for s in sockets}))
         warnings.append(f"material '{material.name}': {', '.join(_input_name(s) for s in sockets)} driven by node "
-                        f"trees, evaluated by Blender into {size} x {size} images on {uv_maps}{each} (detail finer "
-                        "than that is lost; set Texture Bake Size)"
+                        f"trees, evaluated by Blender into {sizes} images on {uv_maps}{each} (detail finer "
+                        "than that is lost; set Texture Bake Size"
+                        + (f"; a Bump's height at {HEIGHT_SIZE_FACTOR} x that" if height else "") + ")"
                         + ("; the Normal as a tangent-space normal map" if normal else "")
                         + (BUMP_FIGURES if height else ""))
     return images
