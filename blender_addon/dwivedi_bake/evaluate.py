@@ -106,8 +106,8 @@ def reads_only_mesh(socket: Any) -> bool:
 # the surface, so N within about 45 degrees of it): a bump tilted further comes out at 45 degrees
 # (measured in 3.4: a Wave bump of Distance 0.3 has tangents of its tilt up to 3.0, the bake gave
 # 1.08 and a third of its texels at the limit). So a Bump node of constant settings over a
-# procedural Height is not normal-baked: its Height is (textures.evaluable_bump_height, an emission
-# bake of a scalar, which nothing clamps), and the library's bump computes the normal from that
+# procedural Height is not normal-baked: its Height is evaluated instead (textures.
+# evaluable_bump_height: an emission bake of a scalar, which nothing clamps), and the library's bump computes the normal from that
 # height's surface gradient as svm_node_set_bump does (dwv_texture_binding_t, DWV_INPUT_BUMP).
 # Other Normal trees (a bump of a bump, linked Strength...) are normal-baked and warned about where
 # they reach the limit.

@@ -9,8 +9,8 @@ Anything else linked to an input (a Mapping node, a procedural texture, a Mix no
 Normal input fed by anything but those nodes) is evaluated by Blender into an image first
 (evaluate.py: an emission bake; for a Normal fed by a Bump node of constant settings over a
 procedural Height, an emission bake of that height bound as the bump's height texture; for any
-other Normal tree a tangent-space normal bake bound as a normal map), per material of each object, or once for the objects of one mesh where the result cannot
-differ; each object's material then reads its own evaluation's images (OWNERS, evaluation_of).
+other Normal tree a tangent-space normal bake bound as a normal map), per material of each
+object, or once for the objects of one mesh where the result cannot differ; each object's material then reads its own evaluation's images (OWNERS, evaluation_of).
 """
 from __future__ import annotations
 
@@ -155,8 +155,8 @@ def _normal_uses(socket: Any, evaluation: Optional[Evaluation] = None) -> Option
 
 
 def _plain_bump(node: Any) -> bool:
-    """Whether a Bump node's settings are constants (Strength, Distance and, 4.4+, Filter Width
-    unlinked): what the library's bump takes (dwv_texture_binding_t)."""
+    """Whether a Bump node's settings are constants (Strength, Distance and, where the node has
+    one (5.2), Filter Width unlinked): what the library's bump takes (dwv_texture_binding_t)."""
     return not any(s is not None and s.is_linked for s in (node.inputs.get(name) for name in
                                                            ("Strength", "Distance", "Filter Width")))
 
