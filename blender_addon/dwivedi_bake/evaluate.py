@@ -105,63 +105,49 @@ def reads_only_mesh(socket: Any) -> bool:
 # valid for reflection of that direction (Cycles' ensure_valid_reflection: R = 2 (N.I) N - I above
 # the surface, so N within about 45 degrees of it): a bump tilted further comes out at 45 degrees
 # (measured in 3.4: a Wave bump of Distance 0.3 has tangents of its tilt up to 3.0, the bake gave
-# 1.08 and a third of its texels at the limit; the bake was 3-5% brighter than Cycles). A Bump
-# node's tilt is linear in its Distance in the tangent frame (svm_node_set_bump: the normal is
-# normalize(|det| N - Distance sign(det) surfgrad), surfgrad orthogonal to N), so the bump is
-# baked with Distance x BUMP_SCALE, within the limit up to tangents of 1 / BUMP_SCALE, and its
-# tangent-space x and y divided by BUMP_SCALE after; its Strength mix is applied after too.
-BUMP_SCALE = 1.0 / 16.0
-# What evaluating a bump into an image leaves (said with every evaluated Normal): the image's
-# texels hold the bump's normal at their centres, interpolated linearly between them, and Cycles'
-# render takes the bump's finite differences over each pixel's footprint (ray differentials).
-# Measured (tests/blender/test_evaluate.py's sphere, a Wave Texture bump of Distance 0.3, tilts
-# up to 70 degrees, 24 x 24 pixels, one seed of 64 samples each, 512: the test's two seeds; the
-# three channels' means differ alike). Evaluated without BUMP_SCALE, 3.4 gave +4.8% / +3.8% / +3.3%
-# at 128 / 256 / 1024.
-BUMP_FIGURES = ("; a strong bump comes out smoother than Cycles renders it: a Wave bump of Distance 0.3 gave "
-                "means +1.7% (Blender 3.4), +5.1% (4.3), +8.1% (5.2) above Cycles' at 128 x 128, "
-                "+1.1% / +1.7% / +2.9% at 256 x 256, +0.7% / +0.3% / +1.0% at 512 x 512 and +0.7% / +0.2% / +0.7% at "
-                "1024 x 1024")
+# 1.08 and a third of its texels at the limit). So a Bump node of constant settings over a
+# procedural Height is not normal-baked: its Height is evaluated instead (textures.
+# evaluable_bump_height: an emission bake of a scalar, which nothing clamps), and the library's bump computes the normal from that
+# height's surface gradient as svm_node_set_bump does (dwv_texture_binding_t, DWV_INPUT_BUMP).
+# Other Normal trees (a bump of a bump, linked Strength...) are normal-baked and warned about where
+# they reach the limit.
+# What evaluating the height into an image leaves (said with every evaluated Bump height): the
+# image's texels hold the height at their centres, interpolated linearly between them (so the
+# gradient is the texels' differences), and Cycles' render takes the height's differences over
+# each pixel's footprint (ray differentials). Measured on tests/blender/test_evaluate.py's sphere
+# (a Wave Texture bump of Distance 0.3, tilts up to 70 degrees, 24 x 24 pixels, two seeds; the
+# three channels' means differ alike): +0.60% (3.4), -0.08% (4.3), +0.35% (5.2) with the height at
+# 512 x 512 (the default's, HEIGHT_SIZE_FACTOR), +0.51% / -0.14% / +0.48% at 256 x 256; the
+# Distance / 16 normal bake this replaced gave +1.1% / +1.7% / +2.9% at 256 x 256. A Wave twice as
+# fine, 64 x 64 pixels: +0.12% / +0.37% / +0.06% at 512 x 512, +0.15% / +0.99% / +1.30% at 256.
+BUMP_FIGURES = ("; a strong bump's height evaluated at 512 x 512 (a Wave bump of Distance 0.3, tilts up to 70 "
+                "degrees) gave means +0.6% (Blender 3.4), -0.1% (4.3), +0.4% (5.2) off Cycles', at 256 x 256 "
+                "+0.5% / -0.1% / +0.5%, and a Wave twice as fine (tilts up to 80 degrees) +0.1% / +0.4% / +0.1% "
+                "at 512 x 512, +0.2% / +1.0% / +1.3% at 256 x 256")
+# A Bump's height is evaluated at HEIGHT_SIZE_FACTOR x the Texture Bake Size per axis (at most
+# MAX_SIZE, the setting's own maximum): the bump's normal is the image's gradient, the texels'
+# differences, which fall short of the height's slopes by sinc(pi texel / period) and hold them
+# constant across a texel; a Wave bump of 7 texels a period at 256 x 256 (the test's finer one)
+# came out +1.3% above Cycles 5.2, at 512 x 512 -0.1%. The cost: about 1 to 2 s more per
+# evaluated height on this machine (4 x the texels of 256 x 256).
+HEIGHT_SIZE_FACTOR = 2
+MAX_SIZE = 8192
 # The z (cosine to the smooth normal) at or below which a baked normal is taken as clamped.
 CLAMPED_Z = 0.72
 
 
-def _scalable_bump(socket: Any) -> Optional[Any]:
-    """The Bump node feeding the Normal input `socket` straight, if its tilt can be scaled (its
-    Strength and Distance unlinked, its own Normal input unlinked: the smooth normal)."""
-    node = socket.links[0].from_node if socket.is_linked else None
-    if node is None or node.type != 'BUMP':
-        return None
-    if node.inputs["Strength"].is_linked or node.inputs["Distance"].is_linked or node.inputs["Normal"].is_linked:
-        return None
-    return node
-
-
-def _baked_normals(image: Any, strength: Optional[float]) -> float:
+def _clamped_share(image: Any) -> float:
     """The fraction of a normal bake's covered texels (the others hold the cleared black, not of
-    unit length) at the bake's limit (CLAMPED_Z). With a `strength`, the image was baked with
-    BUMP_SCALE and is rewritten: (x, y) / BUMP_SCALE, renormalised, then mixed with the smooth
-    normal (0, 0, 1) by the Bump's strength (svm_node_set_bump: normalize(strength N_bump +
-    (1 - strength) N))."""
+    unit length) at the bake's limit (CLAMPED_Z)."""
     pixels = array.array("f", [0.0]) * len(image.pixels)
     image.pixels.foreach_get(pixels)
     covered = clamped = 0
-    scale = 1.0 / BUMP_SCALE
     for k in range(0, len(pixels), 4):
         x, y, z = 2.0 * pixels[k] - 1.0, 2.0 * pixels[k + 1] - 1.0, 2.0 * pixels[k + 2] - 1.0
         if abs(x * x + y * y + z * z - 1.0) >= 0.05:
             continue
         covered += 1
         clamped += z <= CLAMPED_Z
-        if strength is None:
-            continue
-        x, y = x * scale, y * scale
-        length = (x * x + y * y + z * z) ** 0.5
-        x, y, z = strength * x / length, strength * y / length, strength * z / length + (1.0 - strength)
-        half = 0.5 / (x * x + y * y + z * z) ** 0.5
-        pixels[k], pixels[k + 1], pixels[k + 2] = 0.5 + half * x, 0.5 + half * y, 0.5 + half * z
-    if strength is not None:
-        image.pixels.foreach_set(pixels)
     return clamped / max(covered, 1)
 
 
@@ -199,7 +185,7 @@ class _SceneState:
 
 def _bake_socket(obj: Any, material: Any, socket: Any, size: int, warnings: Optional[List[str]] = None) -> Any:
     """A float image of `socket`'s value (the Normal input: the tangent-space normal map of the
-    shading normal, a Bump's scaled: BUMP_SCALE) over the object's active UV map, on the faces of
+    shading normal) over the object's active UV map, on the faces of
     `material`; baked on a copy of the object (the module's comment). EvaluationError if
     Blender's bake fails. A normal still at the bake's limit is said in `warnings`."""
     normal = socket.name == "Normal"
@@ -221,11 +207,6 @@ def _bake_socket(obj: Any, material: Any, socket: Any, size: int, warnings: Opti
             raise EvaluationError(f"material '{material.name}' has no material output or no linked "
                                   f"'{socket.name}' to evaluate")
         surface = output.inputs["Surface"]
-        bump = _scalable_bump(target_socket) if normal else None
-        if bump is not None:
-            strength = min(max(float(bump.inputs["Strength"].default_value), 0.0), 1.0)
-            bump.inputs["Strength"].default_value = 1.0
-            bump.inputs["Distance"].default_value *= BUMP_SCALE
         if not normal:
             emission = tree.nodes.new("ShaderNodeEmission")
             source = target_socket.links[0].from_socket
@@ -274,13 +255,14 @@ def _bake_socket(obj: Any, material: Any, socket: Any, size: int, warnings: Opti
             raise EvaluationError(f"Blender could not evaluate '{socket.name}' of material '{material.name}' on "
                                   f"object '{obj.name}' (its bake returned {sorted(result)})")
         if normal:
-            clamped = _baked_normals(image, strength if bump is not None else None)
+            clamped = _clamped_share(image)
             if clamped > 0.001 and warnings is not None:
                 warnings.append(f"material '{material.name}': {100.0 * clamped:.1f}% of the texels of its Normal "
                                 f"on object '{obj.name}' are at Blender's normal bake's limit (about 45 degrees "
-                                "from the smooth normal): the bump is baked flatter than Cycles renders it"
-                                + ("" if bump is not None else " (only a Bump node of unlinked Strength, Distance "
-                                   "and Normal feeding the Normal straight is baked past that limit)"))
+                                "from the smooth normal): the bump is baked flatter than Cycles renders it (only "
+                                "a Bump node of unlinked Strength and Distance feeding the Normal straight, over "
+                                "a smooth normal or an image normal map, is evaluated past that limit: by its "
+                                "height)")
     except BaseException:
         bpy.data.images.remove(image)
         raise
@@ -317,6 +299,16 @@ def _owner(obj: Any, sockets: List[Any]) -> str:
     if not obj.modifiers and all(reads_only_mesh(s) for s in sockets):
         return f"mesh {obj.data.name_full}"
     return f"object {obj.name_full}"
+
+
+def _evaluated_size(socket: Any, size: int) -> int:
+    """The evaluated image's width and height for `socket` at Texture Bake Size `size`."""
+    return min(HEIGHT_SIZE_FACTOR * size, MAX_SIZE) if socket.node.type == 'BUMP' else size
+
+
+def _input_name(socket: Any) -> str:
+    """How the warnings name an evaluated input: a Bump's Height by its node."""
+    return f"the Height of Bump node '{socket.node.name}'" if socket.node.type == 'BUMP' else repr(socket.name)
 
 
 def evaluate_objects(objects: List[Any], shader_of: Any, blender4: bool, size: int,
@@ -359,7 +351,7 @@ def evaluate_objects(objects: List[Any], shader_of: Any, blender4: bool, size: i
                     continue
                 uv_map = mesh.uv_layers.active.name
                 for socket in sockets:
-                    image = _bake_socket(original, material, socket, size, warnings)
+                    image = _bake_socket(original, material, socket, _evaluated_size(socket, size), warnings)
                     images.append(image)
                     textures.EVALUATED[textures.evaluated_key(evaluation, socket)] = (textures.EvaluatedImage(image),
                                                                                     uv_map)
@@ -378,8 +370,12 @@ def evaluate_objects(objects: List[Any], shader_of: Any, blender4: bool, size: i
             each = f" once for its {users} objects (one mesh)" if users > 1 else ""
         uv_maps = f"UV map{'s' if len(maps) > 1 else ''} {', '.join(repr(m) for m in maps)}"
         normal = any(s.name == "Normal" for s in sockets)
-        warnings.append(f"material '{material.name}': {', '.join(repr(s.name) for s in sockets)} driven by node "
-                        f"trees, evaluated by Blender into {size} x {size} images on {uv_maps}{each} (detail finer "
-                        "than that is lost; set Texture Bake Size)"
-                        + ("; the Normal as a tangent-space normal map" + BUMP_FIGURES if normal else ""))
+        height = any(s.node.type == 'BUMP' for s in sockets)
+        sizes = " and ".join(f"{n} x {n}" for n in sorted({_evaluated_size(s, size) for s in sockets}))
+        warnings.append(f"material '{material.name}': {', '.join(_input_name(s) for s in sockets)} driven by node "
+                        f"trees, evaluated by Blender into {sizes} images on {uv_maps}{each} (detail finer "
+                        "than that is lost; set Texture Bake Size"
+                        + (f"; a Bump's height at {HEIGHT_SIZE_FACTOR} x that" if height else "") + ")"
+                        + ("; the Normal as a tangent-space normal map" if normal else "")
+                        + (BUMP_FIGURES if height else ""))
     return images

@@ -7,9 +7,10 @@ interpolation, and the UV map it reads (the UV Map node's, else the mesh's activ
 
 Anything else linked to an input (a Mapping node, a procedural texture, a Mix node..., and a
 Normal input fed by anything but those nodes) is evaluated by Blender into an image first
-(evaluate.py: an emission bake, or for the Normal a tangent-space normal bake bound as a normal
-map), per material of each object, or once for the objects of one mesh where the result cannot
-differ; each object's material then reads its own evaluation's images (OWNERS, evaluation_of).
+(evaluate.py: an emission bake; for a Normal fed by a Bump node of constant settings over a
+procedural Height, an emission bake of that height bound as the bump's height texture; for any
+other Normal tree a tangent-space normal bake bound as a normal map), per material of each
+object, or once for the objects of one mesh where the result cannot differ; each object's material then reads its own evaluation's images (OWNERS, evaluation_of).
 """
 from __future__ import annotations
 
@@ -130,8 +131,8 @@ def _normal_uses(socket: Any, evaluation: Optional[Evaluation] = None) -> Option
     node = socket.links[0].from_node
     uses: List[Use] = []
     if node.type == 'BUMP':
-        height = _image_source(node.inputs.get("Height"))
-        if height is None or node.inputs.get("Strength").is_linked or node.inputs.get("Distance").is_linked:
+        height = _image_source(node.inputs.get("Height"), evaluation)
+        if height is None or not _plain_bump(node):
             return None
         inner = node.inputs.get("Normal")
         if inner is not None and inner.is_linked:
@@ -151,6 +152,32 @@ def _normal_uses(socket: Any, evaluation: Optional[Evaluation] = None) -> Option
         uv_map = node.uv_map or colour[2]
         return [Use("normal_map", colour[0], "Color", uv_map, strength=max(_plain(node.inputs["Strength"], 1.0), 0.0))]
     return None
+
+
+def _plain_bump(node: Any) -> bool:
+    """Whether a Bump node's settings are constants (Strength, Distance and, where the node has
+    one (5.2), Filter Width unlinked): what the library's bump takes (dwv_texture_binding_t)."""
+    return not any(s is not None and s.is_linked for s in (node.inputs.get(name) for name in
+                                                           ("Strength", "Distance", "Filter Width")))
+
+
+def evaluable_bump_height(normal: Any) -> Optional[Any]:
+    """The Height input of a plain Bump node (_plain_bump; its own Normal unlinked or an image
+    normal map passed as it is) feeding the Normal input `normal` straight, when that Height is
+    linked to a node tree that no Image Texture feeds as it is: evaluated by Blender into a
+    height image (an emission bake of a scalar, evaluate.py) which the library's bump then
+    differentiates, instead of Blender's normal bake of the whole Normal."""
+    node = normal.links[0].from_node if normal is not None and normal.is_linked else None
+    if node is None or node.type != 'BUMP' or not _plain_bump(node):
+        return None
+    height, inner = node.inputs.get("Height"), node.inputs.get("Normal")
+    if height is None or not height.is_linked or _image_source(height) is not None:
+        return None
+    if inner is not None and inner.is_linked:
+        mapped = _normal_uses(inner)
+        if mapped is None or any(u.input != "normal_map" for u in mapped):
+            return None
+    return height
 
 
 def _socket(node: Any, names: Tuple[str, ...]) -> Any:
@@ -233,7 +260,8 @@ def evaluable_inputs(node: Any, blender4: bool) -> List[Any]:
             out.append(socket)
     normal = node.inputs.get("Normal")
     if normal is not None and normal.is_linked and _normal_uses(normal) is None:
-        out.append(normal)  # baked as a tangent-space normal map (evaluate.py)
+        # A plain procedural Bump: its height; anything else: a tangent-space normal map (evaluate.py).
+        out.append(evaluable_bump_height(normal) or normal)
     return out
 
 
