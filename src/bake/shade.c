@@ -296,6 +296,12 @@ double dwvb_footprint(const dwvb_shader *shader, dwvu_vec3 view, double t)
 
 #define INV_PI 0.31830988618379067154
 
+/* Whether two normals are the same (bit for bit: the one where no correction moved it). */
+static int same_direction(dwvu_vec3 a, dwvu_vec3 b)
+{
+    return a.x == b.x && a.y == b.y && a.z == b.z;
+}
+
 /* Where a path stands (Cycles' path state): its bounces so far by kind, whether one of them was
  * diffuse (PATH_RAY_DIFFUSE_ANCESTOR), its ray's compact differentials (Cycles' ray.dP, ray.dD:
  * the footprint at the next hit is dP + t dD; dwvb_footprint), and the smallest pdf of its
@@ -529,6 +535,38 @@ static int surface_path_ray(const dwvb_shader *shader, const surface_lobes *s, d
     return 1;
 }
 
+/* The surface's mixture (dwvb_surface_sample / _pdf) as the world's strategy of its direct light
+ * where its lobes have normals of their own (dwvl_direct_lobes): one pair draws the three numbers,
+ * the choice of lobe by u0 and u0 rescaled to [0, 1) within the branch chosen (u0 / p_s, or
+ * (u0 - p_s) / (1 - p_s)), which is again uniform there. A mirror's draw is none (its delta is
+ * the singular path ray's, never a light sample's); pdf is the mixture's continuous part. */
+typedef struct surface_sampling {
+    const surface_lobes *lobes;
+    double p_specular; /* dwvb_surface_specular_probability, < 0 where nothing scatters */
+} surface_sampling;
+
+static int surface_direction(const void *context, double u0, double u1, dwvu_vec3 *w)
+{
+    const surface_sampling *d = context;
+    const surface_lobes *s = d->lobes;
+    double p = d->p_specular, choice = u0;
+    if (p < 0.0) return 0;
+    u0 = u0 < p ? u0 / p : (u0 - p) / (1.0 - p);
+    int lobe, singular;
+    if (!dwvb_surface_sample(s->material, p, s->lobe.n, s->specular_n, s->lobe.to_view, u0, u1, choice, w, &lobe,
+                             &singular))
+        return 0;
+    return !singular;
+}
+
+static double surface_direction_pdf(const void *context, dwvu_vec3 w)
+{
+    const surface_sampling *d = context;
+    const surface_lobes *s = d->lobes;
+    if (d->p_specular < 0.0) return 0.0;
+    return dwvb_surface_pdf(s->material, d->p_specular, s->lobe.n, s->specular_n, s->lobe.to_view, w);
+}
+
 /* Whether a subsurface material walks where a path meets it after a diffuse bounce. */
 static int walks_after_diffuse(const dwvb_shader *shader, const dwvb_material *material)
 {
@@ -630,7 +668,7 @@ static void shade_point(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec
         specular_n = mode != DWV_BUMP_SHADOWING_NONE ? dwvb_valid_reflection(ng, dwvu_scale(view, -1.0), n) : n;
         if (mode == DWV_BUMP_SHADOWING_CHIANG2019) n = specular_n;
     }
-    int tilted = n.x != smooth_n.x || n.y != smooth_n.y || n.z != smooth_n.z;
+    int tilted = !same_direction(n, smooth_n);
     int bumped = tilted ? dwvb_textured_bump_shadowing(scene, hit->mesh) : DWV_BUMP_SHADOWING_NONE;
     uint32_t light_pairs = dwvl_direct_pairs(&shader->env);
     /* Cycles 4.0-4.3: channels whose radius is below a quarter of the ray's footprint are
@@ -682,8 +720,16 @@ static void shade_point(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec
     if (material->specular || bumped) {
         /* (A tilted normal's shadowing goes through the general lobe too.) */
         double surface[2][3];
-        dwvl_direct_split(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, surface_factor, &lobes,
-                          surface);
+        if (material->specular && !same_direction(specular_n, n)) {
+            /* Each lobe about its own normal (4.x+: the specular's kept valid for reflection), as
+             * the path rays below are drawn. */
+            surface_sampling sampling = {&lobes, dwvb_surface_specular_probability(material, lobes.diffuse, cos_specular)};
+            dwvl_lobes own = {surface_factor, &lobes, {specular_n, n}, surface_direction, surface_direction_pdf, &sampling};
+            dwvl_direct_lobes(&shader->env, x, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, &own, surface);
+        } else {
+            dwvl_direct_split(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, surface_factor,
+                              &lobes, surface);
+        }
         for (int c = 0; c < 3; ++c) {
             light[DWVB_LOBE_GLOSSY][c] = surface[0][c];
             rgb[c] = surface[1][c];

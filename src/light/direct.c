@@ -74,13 +74,69 @@ typedef struct lobe_factors {
     dwvl_lobe_factor factor;
     dwvl_split_factor split;
     const void *context;
+    const dwvl_lobes *own; /* lobes about normals of their own (its factor then); NULL: all about n */
 } lobe_factors;
 
 static void lobe_weights(const lobe_factors *lobes, dwvu_vec3 light, double f[2][3])
 {
     for (int k = 0; k < 2; ++k) f[k][0] = f[k][1] = f[k][2] = 0.0;
-    if (lobes->split) lobes->split(lobes->context, light, f);
+    if (lobes->own) lobes->own->factor(lobes->own->context, light, f);
+    else if (lobes->split) lobes->split(lobes->context, light, f);
     else if (lobes->factor) f[0][0] = f[0][1] = f[0][2] = lobes->factor(lobes->context, light);
+}
+
+/* Lobe k's cosine to unit `light` (about its own normal where it has one, else n's cos_n), 0
+ * below its horizon; returns 0 where the light is below every lobe's horizon. */
+static int lobe_cosines(const lobe_factors *lobes, double cos_n, dwvu_vec3 light, double cosine[2])
+{
+    if (!lobes->own) {
+        cosine[0] = cosine[1] = cos_n;
+        return cos_n > 0.0;
+    }
+    for (int k = 0; k < 2; ++k) cosine[k] = fmax(dwvu_dot(lobes->own->normal[k], light), 0.0);
+    return cosine[0] > 0.0 || cosine[1] > 0.0;
+}
+
+/* The world's light from lobes about normals of their own (lobes->own): the surface's sampling
+ * (pdf p_b, pair `pair`) and, with an environment map, the map's (p_e, pair `pair` + 1), each
+ * weighted by the balance heuristic p / (p_b + p_e) (p_e = 0 without a map: the one strategy);
+ * each adds L f_k (cos_k / pi) / (p_b + p_e) where it is above lobe k's horizon and unshadowed
+ * (cos_k its own normal's; envmap_light's expression with p_b for p_c). The Lambertian about n
+ * (plain) from the same samples likewise. */
+static void own_world_light(const dwvl_environment *env, shadow_origins *origins, dwvu_vec3 n,
+                            const dwvk_sampler *sampler, uint32_t pair, const lobe_factors *lobes, double plain[3],
+                            double weighted[2][3])
+{
+    const dwvl_lobes *own = lobes->own;
+    int strategies = env->envmap ? 2 : 1;
+    for (int strategy = 0; strategy < strategies; ++strategy) {
+        double u[2];
+        dwvk_sampler_pair(sampler, pair + (uint32_t)strategy, u);
+        dwvu_vec3 w;
+        double p_e = 0.0;
+        if (strategy == 0) {
+            if (!own->sample(own->sampling, u[0], u[1], &w)) continue;
+            if (env->envmap) p_e = dwvl_envmap_pdf(env->envmap, w);
+        } else {
+            dwvl_envmap_sample(env->envmap, u[0], u[1], &w, &p_e);
+            if (!(p_e > 0.0)) continue;
+        }
+        double cos_n = dwvu_dot(n, w), cosine[2];
+        if (!lobe_cosines(lobes, cos_n, w, cosine)) continue;
+        double p_b = own->pdf(own->sampling, w);
+        if (!(p_b + p_e > 0.0) || !isfinite(p_b + p_e)) continue;
+        double radiance[3] = {env->world[0], env->world[1], env->world[2]};
+        if (env->envmap) dwvl_envmap_radiance(env->envmap, w, radiance);
+        if (!(radiance[0] > 0.0 || radiance[1] > 0.0 || radiance[2] > 0.0)) continue;
+        if (!world_visible(env, origins, w)) continue;
+        double f[2][3];
+        lobe_weights(lobes, w, f);
+        double lambert = fmax(cos_n, 0.0) * INV_PI / (p_b + p_e);
+        for (int c = 0; c < 3; ++c) {
+            plain[c] += radiance[c] * lambert;
+            for (int k = 0; k < 2; ++k) weighted[k][c] += radiance[c] * (cosine[k] * INV_PI / (p_b + p_e)) * f[k][c];
+        }
+    }
 }
 
 /* An environment map's share of direct_core: two strategies, the cosine-weighted direction about
@@ -139,15 +195,18 @@ static void direct_core(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, d
         origins.clear = top + 0.25 * eps + 0x1p-19 * coordinate;
     }
     for (uint32_t i = 0; i < env->light_count; ++i) {
-        /* A sun below the shading normal's horizon gives nothing: its pair is not drawn (each
-         * light has its own pair, which nothing else uses). */
-        if (dwvl_light_below(&env->lights[i], n)) continue;
+        /* A sun below the shading normal's horizon (every lobe's) gives nothing: its pair is not
+         * drawn (each light has its own pair, which nothing else uses). */
+        if (lobes->own ? dwvl_light_below(&env->lights[i], lobes->own->normal[0]) &&
+                             dwvl_light_below(&env->lights[i], lobes->own->normal[1])
+                       : dwvl_light_below(&env->lights[i], n))
+            continue;
         dwvl_sample s;
         double u[2];
         dwvk_sampler_pair(sampler, pair + i, u);
         dwvl_light_sample(&env->lights[i], x, u[0], u[1], &s);
-        double cos_n = dwvu_dot(n, s.direction);
-        if (!(cos_n > 0.0)) continue;
+        double cos_n = dwvu_dot(n, s.direction), cosine[2];
+        if (!lobe_cosines(lobes, cos_n, s.direction, cosine)) continue;
         if (!shadow_ray_allowed(&origins, s.direction)) continue;
         if (!(s.value[0] > 0.0 || s.value[1] > 0.0 || s.value[2] > 0.0)) continue;
         if (env->geometry) {
@@ -169,11 +228,13 @@ static void direct_core(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, d
         double f[2][3];
         lobe_weights(lobes, s.direction, f);
         for (int c = 0; c < 3; ++c) {
-            plain[c] += s.value[c] * cos_n * INV_PI;
-            for (int k = 0; k < 2; ++k) weighted[k][c] += s.value[c] * cos_n * INV_PI * f[k][c];
+            plain[c] += s.value[c] * fmax(cos_n, 0.0) * INV_PI;
+            for (int k = 0; k < 2; ++k) weighted[k][c] += s.value[c] * cosine[k] * INV_PI * f[k][c];
         }
     }
-    if (env->world_lit && env->envmap) {
+    if (env->world_lit && lobes->own) {
+        own_world_light(env, &origins, n, sampler, pair + env->light_count, lobes, plain, weighted);
+    } else if (env->world_lit && env->envmap) {
         envmap_light(env, &origins, n, sampler, pair + env->light_count, lobes, plain, weighted);
     } else if (env->world_lit) {
         /* Cosine-weighted direction about n (pdf cos / pi): the estimate is L_world x visibility
@@ -207,7 +268,7 @@ void dwvl_direct_lobe(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, dwv
                       const dwvl_terminator *terminator, double top, const dwvk_sampler *sampler, uint32_t pair,
                       dwvl_lobe_factor factor, const void *context, double lambert[3], double lobe[3])
 {
-    lobe_factors lobes = {factor, NULL, context};
+    lobe_factors lobes = {factor, NULL, context, NULL};
     double weighted[2][3];
     direct_core(env, x, n, ng, terminator, top, sampler, pair, &lobes, lambert, weighted);
     if (lobe)
@@ -218,8 +279,16 @@ void dwvl_direct_split(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, dw
                        const dwvl_terminator *terminator, double top, const dwvk_sampler *sampler, uint32_t pair,
                        dwvl_split_factor factor, const void *context, double out[2][3])
 {
-    lobe_factors lobes = {NULL, factor, context};
+    lobe_factors lobes = {NULL, factor, context, NULL};
     direct_core(env, x, n, ng, terminator, top, sampler, pair, &lobes, NULL, out);
+}
+
+void dwvl_direct_lobes(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 ng, const dwvl_terminator *terminator,
+                       double top, const dwvk_sampler *sampler, uint32_t pair, const dwvl_lobes *own,
+                       double out[2][3])
+{
+    lobe_factors lobes = {NULL, NULL, NULL, own};
+    direct_core(env, x, own->normal[1], ng, terminator, top, sampler, pair, &lobes, NULL, out);
 }
 
 void dwvl_direct(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, dwvu_vec3 ng,

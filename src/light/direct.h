@@ -66,6 +66,30 @@ void dwvl_direct_split(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, dw
                        const dwvl_terminator *terminator, double top, const dwvk_sampler *sampler, uint32_t pair,
                        dwvl_split_factor factor, const void *context, double out[2][3]);
 
+/* Two per-channel lobes with normals of their own (a Blender 4.x+ specular layer about its normal
+ * kept valid for reflection beside the diffuse lobes about the mapped normal): as Cycles evaluates
+ * each closure about its own N, lobe k takes light only from above its own horizon and with its
+ * own cosine, normal[k] . L: out[k][c] is the integral of L_in,c (1/pi) f[k][c] (normal[k] . L)+.
+ * A light's sample counts where it is above either horizon (a sun below both draws none). The
+ * world's second strategy is the surface's own sampling (the one its path rays are drawn by, in
+ * place of the cosine about one normal, which would miss the lobe whose horizon is the other):
+ * `sample` draws a direction of the BRDF's continuous part from two uniforms (0: none), `pdf` is
+ * that draw's density; an environment map is weighted against it by the balance heuristic. */
+typedef struct dwvl_lobes {
+    dwvl_split_factor factor;
+    const void *context;
+    dwvu_vec3 normal[2];
+    int (*sample)(const void *sampling, double u0, double u1, dwvu_vec3 *w);
+    double (*pdf)(const void *sampling, dwvu_vec3 w);
+    const void *sampling;
+} dwvl_lobes;
+
+/* dwvl_direct_split with each lobe about its own normal (dwvl_lobes), from the same pairs; n, the
+ * shading normal the terminator's lift is about, is the diffuse lobes' (normal[1]). */
+void dwvl_direct_lobes(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 ng, const dwvl_terminator *terminator,
+                       double top, const dwvk_sampler *sampler, uint32_t pair, const dwvl_lobes *lobes,
+                       double out[2][3]);
+
 /* The emission a path ray from `origin` along unit d finds before its first surface at distance
  * t_max (+inf: it leaves the world): every light it passes (dwvl_light_along; Cycles' rays go on
  * through lights) and, where it leaves, the world's radiance along d. Without MIS: for rays that
