@@ -88,6 +88,11 @@ _Static_assert((int)DWVW_AUTO == DWV_TECHNIQUE_AUTO && (int)DWVW_CLASSICAL == DW
  * walk than the importance stays positive, so the classical share covers every path
  * (Hesterberg's defensive mixture: the weight per event is at most 1 / share). */
 #define DWVW_SHEET_CLASSICAL_SHARE 0.01
+/* A sheet walk whose entry normal makes a cosine below minus this with the lit normal (its entry
+ * face within 60 degrees of facing away from the light: a far face) takes the entry face's inward
+ * normal as its axis; other far-side entries (a sheet's rim, faces nearly along the light) keep the
+ * lit normal (dwvw_walk_begin). */
+#define DWVW_SHEET_LOCAL_COSINE 0.5
 
 typedef struct dwvw_medium {
     int channels;                        /* 1 (grey) or 3 */
@@ -181,6 +186,7 @@ typedef struct dwvw_walk {
      * normal, the flight's normalisation N per channel, and its direction pdf per steradian (1 on
      * the first step) */
     double sheet_a[DWVW_MAX_CHANNELS], sheet_norm[DWVW_MAX_CHANNELS], sheet_mu, sheet_direction_pdf;
+    dwvu_vec3 sheet_normal; /* the walk's sheet axis: the lit normal or its entry face's (dwvw_walk_begin) */
     /* Frames about the guided axes met so far (an axis repeats from event to event for every
      * technique but closest): dwvu_frame_about is a function of the axis's bits alone. */
     uint32_t frames_made;                           /* frames made so far; the slot of the next */
