@@ -113,6 +113,28 @@ int dwvw_guide_needs_closest(const dwvw_guide *guide)
 /* Classical sampling alone: the guide of sheet walks that enter on the lit side. */
 static const dwvw_guide classical_guide = {.q_classical = 1.0, .sheet_normal = {0.0, 0.0, 1.0}};
 
+/* The sheet's axis, along which its importance rises: the entry face's inward normal where that
+ * face looks away from the light (DWVW_SHEET_LOCAL_COSINE), else the lit normal. On a flat sheet
+ * the two are one; on a curved or tilted one the lit normal is not the sheet's local thickness
+ * direction, and a walk moving along the sheet went below its entry's height along it, inside the
+ * medium, where the importance max(a, f) has (K psi) / psi up to 2.4 per event (the floor's kink,
+ * src/kernel/sheet.h): the weight x importance grew by that factor at every such event, a weight
+ * of 5,491 after 31 of 46 events there on the bent sheet, whose faces tilt up to 34 degrees from
+ * the lit normal (docs/speed.md). About the entry face's own normal the walk sees the sheet as
+ * flat over its few mean free paths. */
+static void sheet_axis(dwvw_walk *walk, dwvu_vec3 face_normal)
+{
+    const dwvw_guide *guide = walk->guide;
+    walk->sheet_normal = guide->sheet_normal;
+    if (guide->q_sheet > 0.0 && dwvu_dot(face_normal, guide->sheet_normal) < -DWVW_SHEET_LOCAL_COSINE)
+        walk->sheet_normal = dwvu_scale(face_normal, -1.0);
+}
+
+void dwvw_walk_sheet_face(dwvw_walk *walk, dwvu_vec3 face_normal)
+{
+    sheet_axis(walk, face_normal);
+}
+
 void dwvw_walk_begin(dwvw_walk *walk, const dwvw_medium *medium, const dwvw_guide *guide, uint64_t key,
                      uint32_t max_events, dwvu_vec3 point, dwvu_vec3 direction, dwvu_vec3 normal)
 {
@@ -123,18 +145,7 @@ void dwvw_walk_begin(dwvw_walk *walk, const dwvw_medium *medium, const dwvw_guid
      * sphere's variance was 10^4 times classical's). Such a walk is classical. */
     if (guide->q_sheet > 0.0 && dwvu_dot(normal, guide->sheet_normal) > 0.0) guide = &classical_guide;
     walk->guide = guide;
-    /* The sheet's axis, along which its importance rises: the entry face's inward normal where
-     * that face looks away from the light (DWVW_SHEET_LOCAL_COSINE), else the lit normal. On a
-     * flat sheet the two are one; on a curved or tilted one the lit normal is not the sheet's
-     * local thickness direction, and a walk moving along the sheet went below its entry's height
-     * along it, inside the medium, where the importance max(a, f) has (K psi) / psi up to 2.4 per
-     * event (the floor's kink, src/kernel/sheet.h): the weight x importance grew by that factor at
-     * every such event, a weight of 5,491 after 31 of 46 events there on the bent sheet, whose
-     * faces tilt up to 34 degrees from the lit normal (docs/speed.md). About the entry's own
-     * normal the walk sees the sheet as flat over its few mean free paths. */
-    walk->sheet_normal = guide->sheet_normal;
-    if (guide->q_sheet > 0.0 && dwvu_dot(normal, guide->sheet_normal) < -DWVW_SHEET_LOCAL_COSINE)
-        walk->sheet_normal = dwvu_scale(normal, -1.0);
+    sheet_axis(walk, normal);
     walk->key = key;
     walk->sampler = NULL;
     walk->index_reversed = 0u;

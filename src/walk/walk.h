@@ -205,6 +205,11 @@ int dwvw_guide_needs_closest(const dwvw_guide *guide);
  * there is `normal`; weight 1 in every channel. */
 void dwvw_walk_begin(dwvw_walk *walk, const dwvw_medium *medium, const dwvw_guide *guide, uint64_t key,
                      uint32_t max_events, dwvu_vec3 point, dwvu_vec3 direction, dwvu_vec3 normal);
+/* After dwvw_walk_begin, for a sheet walk (else nothing changes): its axis by the entry triangle's
+ * geometric normal (outward, unit or 0) instead of the entry normal, which begin takes: a smooth
+ * normal near a sheet's rim blends the far face's with the rim's, tilted toward the rim, and the
+ * walks entering there drew their importance along that tilt (the bent sheet's remaining tail). */
+void dwvw_walk_sheet_face(dwvw_walk *walk, dwvu_vec3 face_normal);
 /* After dwvw_walk_begin: draws the channel, component, direction and distance of events
  * 0 .. events - 1 from `sampler`'s pairs first_pair, first_pair + 1, ... (DWVW_PAIR_* above)
  * instead of from the walk's key; the sampler must outlive the walk. Every number is still a
