@@ -56,6 +56,7 @@ static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvw_medium 
     const dwvg_mesh *m = &shader->scene->meshes[mesh];
     const dwvg_clearance *grid = &world->clearance[mesh];
     dwvw_walk_begin(walk, medium, guide, key, shader->max_events, x, direction, entry_normal);
+    if (guide->q_sheet > 0.0) dwvw_walk_sheet_face(walk, dwvg_geometric_normal(m, entry_prim));
     dwvw_walk_stratify(walk, sampler, walk_pair, DWVB_STRATIFIED_EVENTS);
     if (pairs) dwvw_walk_share_pairs(walk, pairs);
     int needs_closest = shader->needs_closest[mesh];

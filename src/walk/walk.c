@@ -113,6 +113,28 @@ int dwvw_guide_needs_closest(const dwvw_guide *guide)
 /* Classical sampling alone: the guide of sheet walks that enter on the lit side. */
 static const dwvw_guide classical_guide = {.q_classical = 1.0, .sheet_normal = {0.0, 0.0, 1.0}};
 
+/* The sheet's axis, along which its importance rises: the entry face's inward normal where that
+ * face looks away from the light (DWVW_SHEET_LOCAL_COSINE), else the lit normal. On a flat sheet
+ * the two are one; on a curved or tilted one the lit normal is not the sheet's local thickness
+ * direction, and a walk moving along the sheet went below its entry's height along it, inside the
+ * medium, where the importance max(a, f) has (K psi) / psi up to 2.4 per event (the floor's kink,
+ * src/kernel/sheet.h): the weight x importance grew by that factor at every such event, a weight
+ * of 5,491 after 31 of 46 events there on the bent sheet, whose faces tilt up to 34 degrees from
+ * the lit normal (docs/speed.md). About the entry face's own normal the walk sees the sheet as
+ * flat over its few mean free paths. */
+static void sheet_axis(dwvw_walk *walk, dwvu_vec3 face_normal)
+{
+    const dwvw_guide *guide = walk->guide;
+    walk->sheet_normal = guide->sheet_normal;
+    if (guide->q_sheet > 0.0 && dwvu_dot(face_normal, guide->sheet_normal) < -DWVW_SHEET_LOCAL_COSINE)
+        walk->sheet_normal = dwvu_scale(face_normal, -1.0);
+}
+
+void dwvw_walk_sheet_face(dwvw_walk *walk, dwvu_vec3 face_normal)
+{
+    sheet_axis(walk, face_normal);
+}
+
 void dwvw_walk_begin(dwvw_walk *walk, const dwvw_medium *medium, const dwvw_guide *guide, uint64_t key,
                      uint32_t max_events, dwvu_vec3 point, dwvu_vec3 direction, dwvu_vec3 normal)
 {
@@ -123,6 +145,7 @@ void dwvw_walk_begin(dwvw_walk *walk, const dwvw_medium *medium, const dwvw_guid
      * sphere's variance was 10^4 times classical's). Such a walk is classical. */
     if (guide->q_sheet > 0.0 && dwvu_dot(normal, guide->sheet_normal) > 0.0) guide = &classical_guide;
     walk->guide = guide;
+    sheet_axis(walk, normal);
     walk->key = key;
     walk->sampler = NULL;
     walk->index_reversed = 0u;
@@ -353,7 +376,8 @@ static inline int walk_pair_bits(const dwvw_walk *walk, uint32_t pair, uint64_t 
 }
 
 /* The sheet technique's linear importance a = sigma_t h + z_e per channel at the walk's position,
- * h its height above the entry point toward the lit side, of either sign; the importance is
+ * h its height above the entry point along the walk's sheet axis (walk->sheet_normal, toward the
+ * lit side), of either sign; the importance is
  * max(a, DWVK_SHEET_FLOOR) (src/kernel/sheet.h). Not held at h >= 0: a curved sheet's walk goes
  * below its entry's height inside the medium, and an importance held there would not be the one
  * its flight followed (the weight x importance a walk keeps then jumped by z_e / (a + mu tau),
@@ -361,7 +385,7 @@ static inline int walk_pair_bits(const dwvw_walk *walk, uint32_t pair, uint64_t 
 static void sheet_importance(const dwvw_walk *walk, double a[DWVW_MAX_CHANNELS])
 {
     const dwvw_medium *m = walk->medium;
-    double h = dwvu_dot(dwvu_sub(walk->position, walk->entry_point), walk->guide->sheet_normal);
+    double h = dwvu_dot(dwvu_sub(walk->position, walk->entry_point), walk->sheet_normal);
     for (int c = 0; c < m->channels; ++c) a[c] = m->sigma_t[c] * h + DWVK_SHEET_EXTRAPOLATION;
 }
 
@@ -374,7 +398,7 @@ static double sheet_sample(dwvw_walk *walk, int channel, const double *choice, f
 {
     const dwvw_medium *m = walk->medium;
     const dwvw_guide *guide = walk->guide;
-    const dwvu_vec3 normal = guide->sheet_normal;
+    const dwvu_vec3 normal = walk->sheet_normal;
     /* two components for the tally of mixture terms (shade.c); the weight update is sheet_weight_update */
     walk->component_count = 2;
     walk->single_component = -1;

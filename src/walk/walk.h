@@ -88,6 +88,11 @@ _Static_assert((int)DWVW_AUTO == DWV_TECHNIQUE_AUTO && (int)DWVW_CLASSICAL == DW
  * walk than the importance stays positive, so the classical share covers every path
  * (Hesterberg's defensive mixture: the weight per event is at most 1 / share). */
 #define DWVW_SHEET_CLASSICAL_SHARE 0.01
+/* A sheet walk whose entry normal makes a cosine below minus this with the lit normal (its entry
+ * face within 60 degrees of facing away from the light: a far face) takes the entry face's inward
+ * normal as its axis; other far-side entries (a sheet's rim, faces nearly along the light) keep the
+ * lit normal (dwvw_walk_begin). */
+#define DWVW_SHEET_LOCAL_COSINE 0.5
 
 typedef struct dwvw_medium {
     int channels;                        /* 1 (grey) or 3 */
@@ -181,6 +186,7 @@ typedef struct dwvw_walk {
      * normal, the flight's normalisation N per channel, and its direction pdf per steradian (1 on
      * the first step) */
     double sheet_a[DWVW_MAX_CHANNELS], sheet_norm[DWVW_MAX_CHANNELS], sheet_mu, sheet_direction_pdf;
+    dwvu_vec3 sheet_normal; /* the walk's sheet axis: the lit normal or its entry face's (dwvw_walk_begin) */
     /* Frames about the guided axes met so far (an axis repeats from event to event for every
      * technique but closest): dwvu_frame_about is a function of the axis's bits alone. */
     uint32_t frames_made;                           /* frames made so far; the slot of the next */
@@ -199,6 +205,11 @@ int dwvw_guide_needs_closest(const dwvw_guide *guide);
  * there is `normal`; weight 1 in every channel. */
 void dwvw_walk_begin(dwvw_walk *walk, const dwvw_medium *medium, const dwvw_guide *guide, uint64_t key,
                      uint32_t max_events, dwvu_vec3 point, dwvu_vec3 direction, dwvu_vec3 normal);
+/* After dwvw_walk_begin, for a sheet walk (else nothing changes): its axis by the entry triangle's
+ * geometric normal (outward, unit or 0) instead of the entry normal, which begin takes: a smooth
+ * normal near a sheet's rim blends the far face's with the rim's, tilted toward the rim, and the
+ * walks entering there drew their importance along that tilt (the bent sheet's remaining tail). */
+void dwvw_walk_sheet_face(dwvw_walk *walk, dwvu_vec3 face_normal);
 /* After dwvw_walk_begin: draws the channel, component, direction and distance of events
  * 0 .. events - 1 from `sampler`'s pairs first_pair, first_pair + 1, ... (DWVW_PAIR_* above)
  * instead of from the walk's key; the sampler must outlive the walk. Every number is still a

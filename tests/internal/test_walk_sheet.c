@@ -14,8 +14,11 @@
  *      dir_pdf = (1 + s mu) / (2 pi Z), s = up for mu >= 0, down below, Z = 2 + (up - down) / 2,
  *        the chords of N(a_guide, mu) either side of 0: up = min(N(a, 1) / N(a, 0) - 1, 1 / z_e),
  *        down = 1 - N(a, -1) / N(a, 0),
- *      a_c = sigma_c h + z_e, h the height above the entry point along the lit normal (of either
- *        sign),
+ *      a_c = sigma_c h + z_e, h the height above the entry point along the walk's sheet axis (of
+ *        either sign): the entry face's inward normal where that face looks away from the light
+ *        (entry normal . lit normal < -DWVW_SHEET_LOCAL_COSINE), else the lit normal (walk.h); mu
+ *        the cosine to the same axis. Main's walk before the entry-face axis (the lit normal for
+ *        every walk) fails here in the cases of a tilted far face, about half of them,
  *      f_c' = phase sigma_c' alpha_c' exp(-sigma_c' t) (event) or phase exp(-sigma_c' t) (leaving),
  *      phase = dir_pdf = 1 on the first step; q_cl = max(0.01, |g|), q_sheet = 1 - q_cl,
  *    for random states (grey and RGB media, equal and unequal extinctions, channels of P = 0, first
@@ -179,6 +182,7 @@ typedef struct step_case {
     dwvw_guide guide;
     dwvw_walk walk;
     dwvu_vec3 normal;   /* the lit normal expected (the strongest patch's) */
+    dwvu_vec3 axis;     /* the walk's sheet axis expected: the entry face's inward normal or the lit one */
     dwvu_vec3 previous; /* the direction before the step */
     double t;
     int exited, overridden_p, overridden_t;
@@ -234,6 +238,9 @@ static int make_case(uint64_t index, step_case *s)
     double facing = dwvu_dot(entry_normal, s->normal);
     if (fabs(facing) < 1e-3) entry_normal = dwvu_normalize(dwvu_madd(entry_normal, s->normal, -0.5));
     if (dwvu_dot(entry_normal, s->normal) > 0.0) entry_normal = dwvu_scale(entry_normal, -1.0);
+    /* the axis: the entry face's inward normal where it looks away from the light, else the lit
+     * normal (a rim): both kinds occur */
+    s->axis = dwvu_dot(entry_normal, s->normal) < -DWVW_SHEET_LOCAL_COSINE ? dwvu_scale(entry_normal, -1.0) : s->normal;
     dwvu_vec3 entry_direction = random_unit(key, &dim);
     if (dwvu_dot(entry_direction, entry_normal) > 0.0) entry_direction = dwvu_scale(entry_direction, -1.0);
     dwvu_vec3 entry_point = dwvu_v(10.0 * uniform(key, &dim) - 5.0, 10.0 * uniform(key, &dim) - 5.0,
@@ -244,6 +251,9 @@ static int make_case(uint64_t index, step_case *s)
     CHECK(w->guide == &s->guide, "case %llu: a walk entering on the far side does not run the sheet",
           (unsigned long long)index);
     if (w->guide != &s->guide) return 0;
+    CHECK(same_vec(w->sheet_normal, s->axis), "case %llu: the walk's sheet axis (%g %g %g), expected (%g %g %g)",
+          (unsigned long long)index, w->sheet_normal.x, w->sheet_normal.y, w->sheet_normal.z, s->axis.x, s->axis.y,
+          s->axis.z);
     for (int c = 0; c < channels; ++c) w->weight[c] = START_WEIGHT * (0.25 + uniform(key, &dim));
 
     if (uniform(key, &dim) >= 0.35) {
@@ -253,8 +263,8 @@ static int make_case(uint64_t index, step_case *s)
         double optical = uniform(key, &dim) < 0.2 ? -3.0 * uniform(key, &dim) : 12.0 * uniform(key, &dim);
         double h = optical / s->medium.sigma_t[s->medium.guide_channel];
         dwvu_vec3 lateral = random_unit(key, &dim);
-        lateral = dwvu_sub(lateral, dwvu_scale(s->normal, dwvu_dot(lateral, s->normal)));
-        w->position = dwvu_add(dwvu_madd(entry_point, s->normal, h), dwvu_scale(lateral, 3.0 * uniform(key, &dim)));
+        lateral = dwvu_sub(lateral, dwvu_scale(s->axis, dwvu_dot(lateral, s->axis)));
+        w->position = dwvu_add(dwvu_madd(entry_point, s->axis, h), dwvu_scale(lateral, 3.0 * uniform(key, &dim)));
         w->direction = random_unit(key, &dim);
     }
     s->previous = w->direction;
@@ -280,7 +290,7 @@ static int make_case(uint64_t index, step_case *s)
     /* the distance: as sampled, or another (as test_walk_weight), or about where a channel's
      * flight meets the floor, where the direction points down */
     double t = sampled, choice = uniform(key, &dim);
-    double mu = dwvw_cosine(w->direction, s->normal);
+    double mu = dwvw_cosine(w->direction, s->axis);
     if (choice < 0.3) {
         s->overridden_t = 1;
         t = -log(1.0 - uniform(key, &dim)) * pow(10.0, 2.5 * uniform(key, &dim) - 1.0) /
@@ -288,7 +298,7 @@ static int make_case(uint64_t index, step_case *s)
     } else if (choice < 0.45 && mu < -1e-3) {
         s->overridden_t = 1;
         int c = (int)(channels * uniform(key, &dim)) % channels;
-        double h = dwvu_dot(dwvu_sub(w->position, w->entry_point), s->normal);
+        double h = dwvu_dot(dwvu_sub(w->position, w->entry_point), s->axis);
         double a = s->medium.sigma_t[c] * h + DWVK_SHEET_EXTRAPOLATION;
         t = fabs(a - (double)FLOOR) / -mu / s->medium.sigma_t[c] * (1.0 + 1e-3 * (2.0 * uniform(key, &dim) - 1.0));
     }
@@ -304,8 +314,8 @@ static long double direct_ratio(const step_case *s, int cw, int planted, long do
     const dwvw_walk *w = &s->walk;
     const dwvw_medium *m = &s->medium;
     long double t = s->t;
-    long double h = dot_l(dwvu_sub(w->position, w->entry_point), s->normal);
-    long double mu = dot_l(w->direction, s->normal);
+    long double h = dot_l(dwvu_sub(w->position, w->entry_point), s->axis);
+    long double mu = dot_l(w->direction, s->axis);
     mu = mu < -1.0L ? -1.0L : mu > 1.0L ? 1.0L : mu;
     long double a_guide = (long double)m->sigma_t[m->guide_channel] * h + DWVK_SHEET_EXTRAPOLATION;
     long double first = w->events == 0;
@@ -361,8 +371,8 @@ static void test_weight_update(void)
             ++skipped;
             continue;
         }
-        long double mu = dot_l(w->direction, s.normal);
-        long double h = dot_l(dwvu_sub(w->position, w->entry_point), s.normal);
+        long double mu = dot_l(w->direction, s.axis);
+        long double h = dot_l(dwvu_sub(w->position, w->entry_point), s.axis);
         ++kinds[w->events > 0][s.exited];
         below += h < 0.0L;
         negative_mu += mu < 0.0L;
@@ -463,7 +473,7 @@ static void test_roulette(void)
         }
         if (!(largest > 1e-250L && largest < 1e250L)) continue;
         dwvu_vec3 moved = dwvu_madd(w->position, w->direction, s.t);
-        long double h = dot_l(dwvu_sub(moved, w->entry_point), s.normal);
+        long double h = dot_l(dwvu_sub(moved, w->entry_point), s.axis);
         long double importance =
             fmaxl((long double)m->sigma_t[m->guide_channel] * h + DWVK_SHEET_EXTRAPOLATION, FLOOR) / DWVK_SHEET_EXTRAPOLATION;
         /* scale the weights so that L = largest x importance is uniform in (0, 0.7) */
