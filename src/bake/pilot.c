@@ -126,7 +126,7 @@ enum { PILOT_CLASSICAL = 0, PILOT_ENTRY = 1, PILOT_GUIDED = 2, PILOT_SHEET = 3 }
 /* Of the PILOT_BLOCKS blocks, the first that every candidate runs (pilot_survivors). */
 #define PILOT_FIRST_BLOCKS 16u
 
-/* A surface is closed (mesh_mean_chord) where its vector area is at most this share of its area
+/* A surface is closed (dwvb_mesh_mean_chord) where its vector area is at most this share of its area
  * (rounding of float positions in double sums: far below it on the benchmark's closed meshes). */
 #define PILOT_CLOSED_SURFACE 1e-6
 /* The sheet walk's importance is linear in depth from the lit side (src/kernel/sheet.h): the
@@ -134,7 +134,7 @@ enum { PILOT_CLASSICAL = 0, PILOT_ENTRY = 1, PILOT_GUIDED = 2, PILOT_SHEET = 3 }
  * the importance rises through the whole solid, its walks run thousands of events (the marble:
  * ~3,000 against classical's 188) and the sheet candidates, which never won there, took up to half
  * of the whole bake in the pilot (docs/speed.md). They are not run on a mesh whose mean chord
- * (mesh_mean_chord) exceeds this many mean free paths of its most transparent channel (1 /
+ * (dwvb_mesh_mean_chord) exceeds this many mean free paths of its most transparent channel (1 /
  * the least sigma_t). The benchmark's meshes, in those units: leaf_textured 4.0, disc_back 4.7,
  * sheet 9.7, bowl 13, candle 16, box_side 25, cylinder_front 27, torus 50, heads 69, marble 167;
  * the sheet candidates win on the first two and come nowhere near winning from the torus on
@@ -183,7 +183,7 @@ static void pilot_candidate(const dwvb_bake *bake, uint32_t m, int candidate, dw
                         &channel_guides[c]);
 }
 
-/* The mean chord length of mesh m's solid, 4 V / A (V its volume, A its surface area: Cauchy's
+/* The mean chord length of a mesh's solid (pilot.h), 4 V / A (V its volume, A its surface area: Cauchy's
  * formula, the mean length inside the solid of uniform isotropic random lines that meet it; for
  * a non-convex solid each segment of a line inside counts as a chord, Dirac's chord theorem), or
  * -1 where the mesh does not bound a solid the formula can be trusted on: a surface that is not
@@ -192,7 +192,7 @@ static void pilot_candidate(const dwvb_bake *bake, uint32_t m, int candidate, dw
  * finite. V is the divergence theorem's sum of signed tetrahedra from the origin, in double
  * precision; on a closed surface it does not depend on the origin. A slab of thickness d has
  * chord 2 d, a sphere of radius r 4 r / 3. */
-static double mesh_mean_chord(const dwvg_mesh *mesh)
+double dwvb_mesh_mean_chord(const dwvg_mesh *mesh)
 {
     double volume = 0.0, area = 0.0, vector_area[3] = {0.0, 0.0, 0.0};
     for (uint32_t t = 0; t < mesh->triangle_count; ++t) {
@@ -213,14 +213,14 @@ static double mesh_mean_chord(const dwvg_mesh *mesh)
 
 /* Whether the sheet candidates may run for mesh m (PILOT_SHEET_MAX_CHORD): a lit side to aim at
  * (else they are classical walks) and a solid not far thicker than a mean free path, or one whose
- * thickness mesh_mean_chord cannot tell. */
+ * thickness dwvb_mesh_mean_chord cannot tell. */
 static int sheet_may_win(const dwvb_scene *scene, uint32_t m)
 {
     if (scene->patch_count[m] <= 0) return 0;
     const dwvw_medium *medium = &scene->shading[scene->meshes[m].material_id].medium;
     double sigma_t = INFINITY;
     for (int c = 0; c < medium->channels; ++c) sigma_t = fmin(sigma_t, medium->sigma_t[c]);
-    return !(mesh_mean_chord(&scene->meshes[m]) * sigma_t > PILOT_SHEET_MAX_CHORD);
+    return !(dwvb_mesh_mean_chord(&scene->meshes[m]) * sigma_t > PILOT_SHEET_MAX_CHORD);
 }
 
 typedef struct pilot_sums {
