@@ -71,18 +71,22 @@
 #define PILOT_COST_RAY 0.0
 #define PILOT_COST_QUERY 6028.0
 #define PILOT_COST_TERM 25.22
-/* A ray of a path after the first scattering (indirect light, dwvb_tally.path_rays): what a camera
- * sample's own work is, a ray and its hit shaded with direct light (the walk a path vertex runs
- * is counted with the walks). Not in the fit above, whose scenes trace no paths: without it the
- * pilot priced channel walks, which send one path per channel where a shared walk sends one, too
- * low on concave scenes with indirect light (the benchmark's bowl: 0.53-0.65 path rays per sample
- * with channel walks against 0.19-0.24 shared; its pick, backward with channel walks, had 0.44 of
- * the efficiency of incident shared: docs/speed.md). */
-#define PILOT_COST_PATH_RAY PILOT_COST_SAMPLE
+/* A ray of a path after the first scattering (indirect light, dwvb_tally.path_rays): its
+ * intersection, the hit's direct light and what else a path vertex does beyond the walks counted
+ * above. Not in the fit above, whose scenes trace no paths; fitted alone (the other coefficients
+ * held) to the worker's instructions in callgrind on the benchmark's bowl, 32 x 32 pixels, 16 spp,
+ * classical / backward / incident shared and classical / backward with channel walks: 7,700-9,400
+ * per path ray with channel walks, least squares 7,900 over the five. Without it the pilot priced
+ * channel walks, which send one path per channel where a shared walk sends one, too low on
+ * concave scenes with indirect light: on the bowl 0.52-0.66 path rays per sample with channel
+ * walks against 0.21-0.24 shared, and its model put backward with channel walks at 8,774
+ * instructions per sample where callgrind counted 13,851 (incident shared 8,684 against 10,532). */
+#define PILOT_COST_PATH_RAY 7900.0
 /* Pilot samples per candidate: a sixteenth of the bake's samples, at most PILOT_MAX (the first
  * quarter of them for every candidate, the rest for those not clearly worse: pilot_survivors); below
  * PILOT_MIN the estimate is too noisy to act on and auto keeps its mixture. A mesh needs
- * PILOT_MESH_MIN of them to be decided. */
+ * PILOT_MESH_MIN of them to be decided (of the blocks run: a quarter of it where one candidate is
+ * left after the first blocks, which then is the pick). */
 #define PILOT_MAX 4096u
 #define PILOT_MIN 256u
 #define PILOT_MESH_MIN 64.0
@@ -495,6 +499,7 @@ int dwvb_pilot_choose(dwvb_bake *bake)
     int *trial_walks = malloc(slots * sizeof *trial_walks);
     pilot_sums *sums = calloc(slots, sizeof *sums); /* [candidate][mesh] */
     int stopped = -1;
+    uint32_t blocks_run = PILOT_FIRST_BLOCKS; /* by every candidate left at the choice */
     pilot_run run = {.bake = bake, .samples = n, .meshes = meshes, .block_sums = NULL};
     if (!trial || !trial_channels || !trial_closest || !trial_walks || !sums) goto done;
     dwvb_shader shaders[PILOT_CANDIDATES];
@@ -534,13 +539,21 @@ int dwvb_pilot_choose(dwvb_bake *bake)
         for (int k = 0; k < candidate_count; ++k) ran[k] = candidates[k];
         ran_count = candidate_count;
         candidate_count = pilot_survivors(bake, sums, trial_walks, candidates, candidate_count);
-        stopped = run_blocks(&run, candidates, candidate_count, PILOT_FIRST_BLOCKS, PILOT_BLOCKS);
+        /* A lone survivor is the pick: the rest of the blocks would only refine its walks per
+         * channel, for up to three quarters of a candidate's pilot (the benchmark's head_point and
+         * disc_back at 48 px, 32 spp: auto 1.8x the time of its pick's forced bake, docs/speed.md). */
+        if (candidate_count > 1) {
+            stopped = run_blocks(&run, candidates, candidate_count, PILOT_FIRST_BLOCKS, PILOT_BLOCKS);
+            blocks_run = PILOT_BLOCKS;
+        }
     }
     if (stopped == 0) {
         merge_blocks(&run, sums);
         for (uint32_t m = 0; m < meshes; ++m) {
             /* Every candidate traced the same camera rays, so each saw the mesh equally often. */
-            if (!bake->auto_choice[m] || sums[(size_t)candidates[0] * meshes + m].count < PILOT_MESH_MIN) continue;
+            if (!bake->auto_choice[m] ||
+                sums[(size_t)candidates[0] * meshes + m].count < PILOT_MESH_MIN * blocks_run / PILOT_BLOCKS)
+                continue;
             /* variance x cost, per sample that saw the mesh; the variance is the three channels'
              * together, as the image's RMSE over RGB counts it: the luminance would hide the
              * colour noise of shared walks, whose channels' weights move against each other. */
