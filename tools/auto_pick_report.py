@@ -3,6 +3,7 @@
 efficiency against each fixed technique, without Blender:
 
     PYTHONPATH=python_shim python3 tools/auto_pick_report.py --size 48 --spp 32 --seeds 4 [--scenes a,b]
+        [--scene-files DIR] [--json OUT.json] [--fixed-from EARLIER.json] [--before EARLIER.json]
 
 Every scene is baked (one thread, through the shim) with auto and with each fixed technique the
 pilot chooses among (classical, backward, incident, sheet; channel walks shared and separate), at
@@ -12,7 +13,12 @@ image's pixel), times the samples per pixel; the cost is the CPU time of the bak
 around Scene.bake on one thread: the pilot and the passes, not the scene's load), averaged over
 the seeds, so efficiency = 1 / (variance per sample x seconds per sample). Printed: per scene the features of auto's bakes
 (which technique it walked with), each configuration's variance, seconds and efficiency relative
-to the best fixed configuration, as a Markdown table. CPU time moves less with the machine's load
+to the best fixed configuration, as a Markdown table; before it a summary, one row per scene: every
+configuration's efficiency relative to the best, what auto walked in each seed, its efficiency and ms
+per sample (the pilot included), and where it walked one configuration in every seed, its time over
+that configuration's forced bake (the pilot's and the extra channel walks' share); with --before,
+an earlier run's auto (another library) beside it. The real-asset scenes are Blender-built: their
+scene files come from the add-on's farm export of benchmark_scenes.build(NAME) (--scene-files). CPU time moves less with the machine's load
 than wall time, but still some (caches and memory shared with other processes).
 """
 from __future__ import annotations
