@@ -1,6 +1,7 @@
 /* dwivedi_bake_counts: bakes a scene with one technique and prints what auto's pilot counts to
  * price a sample (src/bake/pilot.c, PILOT_COST_*): samples, walk events, Embree rays, closest-point
- * queries and mixture terms, with the bake's seconds. tools/fit_pilot_cost.py runs it over scenes
+ * queries, mixture terms and the rays of paths after the first scattering (indirect light), with the
+ * bake's seconds. tools/fit_pilot_cost.py runs it over scenes
  * and techniques and fits the pilot's cost per count by least squares, to wall time or to
  * callgrind's instruction count in bake.c's `worker`. The counts are internal (the image object,
  * src/bake/image.h), not part of the C API, hence a program linked against the static archive.
@@ -99,8 +100,8 @@ int main(int argc, char **argv)
     printf("{\"scene\": \"%s\", \"technique\": \"%s\", \"seconds\": [", argv[1], argv[2]);
     for (unsigned long long k = 0; k < repeats; ++k) printf("%s%.9g", k ? ", " : "", seconds[k]);
     printf("], \"samples\": %llu, \"walks\": %llu, \"events\": %llu, \"rays\": %llu, \"point_queries\": %llu, "
-           "\"mixture_terms\": %llu, \"mean_rgb\": [%.9g, %.9g, %.9g]}\n",
+           "\"mixture_terms\": %llu, \"path_rays\": %llu, \"mean_rgb\": [%.9g, %.9g, %.9g]}\n",
            (unsigned long long)stats.samples, (unsigned long long)stats.walks, (unsigned long long)stats.events, rays,
-           point_queries, mixture_terms, stats.mean_rgb[0], stats.mean_rgb[1], stats.mean_rgb[2]);
+           point_queries, mixture_terms, (unsigned long long)stats.path_rays, stats.mean_rgb[0], stats.mean_rgb[1], stats.mean_rgb[2]);
     return 0;
 }

@@ -6,6 +6,7 @@
 
 #include "bake/guides.h"
 #include "kernel/rng.h"
+#include "util/vec3.h"
 
 /* ---- auto: the technique that pays, per mesh --------------------------------------------------
  * Guiding lowers a walk's variance but costs work per event (a mixture of components, each with
@@ -70,10 +71,22 @@
 #define PILOT_COST_RAY 0.0
 #define PILOT_COST_QUERY 6028.0
 #define PILOT_COST_TERM 25.22
+/* A ray of a path after the first scattering (indirect light, dwvb_tally.path_rays): its
+ * intersection, the hit's direct light and what else a path vertex does beyond the walks counted
+ * above. Not in the fit above, whose scenes trace no paths; fitted alone (the other coefficients
+ * held) to the worker's instructions in callgrind on the benchmark's bowl, 32 x 32 pixels, 16 spp,
+ * classical / backward / incident shared and classical / backward with channel walks: 7,700-9,400
+ * per path ray with channel walks, least squares 7,900 over the five. Without it the pilot priced
+ * channel walks, which send one path per channel where a shared walk sends one, too low on
+ * concave scenes with indirect light: on the bowl 0.52-0.66 path rays per sample with channel
+ * walks against 0.21-0.24 shared, and its model put backward with channel walks at 8,774
+ * instructions per sample where callgrind counted 13,851 (incident shared 8,684 against 10,532). */
+#define PILOT_COST_PATH_RAY 7900.0
 /* Pilot samples per candidate: a sixteenth of the bake's samples, at most PILOT_MAX (the first
  * quarter of them for every candidate, the rest for those not clearly worse: pilot_survivors); below
  * PILOT_MIN the estimate is too noisy to act on and auto keeps its mixture. A mesh needs
- * PILOT_MESH_MIN of them to be decided. */
+ * PILOT_MESH_MIN of them to be decided (of the blocks run: a quarter of it where one candidate is
+ * left after the first blocks, which then is the pick). */
 #define PILOT_MAX 4096u
 #define PILOT_MIN 256u
 #define PILOT_MESH_MIN 64.0
@@ -117,6 +130,21 @@ enum { PILOT_CLASSICAL = 0, PILOT_ENTRY = 1, PILOT_GUIDED = 2, PILOT_SHEET = 3 }
 /* Of the PILOT_BLOCKS blocks, the first that every candidate runs (pilot_survivors). */
 #define PILOT_FIRST_BLOCKS 16u
 
+/* A surface is closed (dwvb_mesh_mean_chord) where its vector area is at most this share of its area
+ * (rounding of float positions in double sums: far below it on the benchmark's closed meshes). */
+#define PILOT_CLOSED_SURFACE 1e-6
+/* The sheet walk's importance is linear in depth from the lit side (src/kernel/sheet.h): the
+ * zero-variance walk of a sheet thin against the mean free path. On a solid much thicker than that
+ * the importance rises through the whole solid, its walks run thousands of events (the marble:
+ * ~3,000 against classical's 188) and the sheet candidates, which never won there, took up to half
+ * of the whole bake in the pilot (docs/speed.md). They are not run on a mesh whose mean chord
+ * (dwvb_mesh_mean_chord) exceeds this many mean free paths of its most transparent channel (1 /
+ * the least sigma_t). The benchmark's meshes, in those units: leaf_textured 4.0, disc_back 4.7,
+ * sheet 9.7, bowl 13, candle 16, box_side 25, cylinder_front 27, torus 50, heads 69, marble 167;
+ * the sheet candidates win on the first two and come nowhere near winning from the torus on
+ * (docs/speed.md). */
+#define PILOT_SHEET_MAX_CHORD 32.0
+
 /* Technique `technique` (PILOT_*) of the pilot for a mesh of `medium` whose guide auto made
  * (`mixture`: auto's mixture, or classical where the albedo is too low to guide). */
 static void pilot_guide(const dwvb_bake *bake, uint32_t m, int technique, const dwvw_medium *medium,
@@ -157,6 +185,46 @@ static void pilot_candidate(const dwvb_bake *bake, uint32_t m, int candidate, dw
         if (!material->grey && material->walk_scale[c] > 0.0)
             pilot_guide(bake, m, technique, &material->channel_medium[c], &bake->channel_guides[3u * m + (uint32_t)c],
                         &channel_guides[c]);
+}
+
+/* The mean chord length of a mesh's solid (pilot.h), 4 V / A (V its volume, A its surface area: Cauchy's
+ * formula, the mean length inside the solid of uniform isotropic random lines that meet it; for
+ * a non-convex solid each segment of a line inside counts as a chord, Dirac's chord theorem), or
+ * -1 where the mesh does not bound a solid the formula can be trusted on: a surface that is not
+ * closed (its vector area, the sum of its triangles' area vectors, is zero only for a closed
+ * surface), a volume that is not positive (inward-facing triangles) or coordinates that are not
+ * finite. V is the divergence theorem's sum of signed tetrahedra from the origin, in double
+ * precision; on a closed surface it does not depend on the origin. A slab of thickness d has
+ * chord 2 d, a sphere of radius r 4 r / 3. */
+double dwvb_mesh_mean_chord(const dwvg_mesh *mesh)
+{
+    double volume = 0.0, area = 0.0, vector_area[3] = {0.0, 0.0, 0.0};
+    for (uint32_t t = 0; t < mesh->triangle_count; ++t) {
+        const uint32_t *i = &mesh->indices[3u * t];
+        const float *a = &mesh->positions[3u * i[0]], *b = &mesh->positions[3u * i[1]], *c = &mesh->positions[3u * i[2]];
+        dwvu_vec3 pa = dwvu_v(a[0], a[1], a[2]), pb = dwvu_v(b[0], b[1], b[2]), pc = dwvu_v(c[0], c[1], c[2]);
+        dwvu_vec3 n = dwvu_cross(dwvu_sub(pb, pa), dwvu_sub(pc, pa)); /* twice the area vector */
+        volume += dwvu_dot(pa, dwvu_cross(pb, pc)) / 6.0;
+        area += 0.5 * dwvu_length(n);
+        vector_area[0] += 0.5 * n.x;
+        vector_area[1] += 0.5 * n.y;
+        vector_area[2] += 0.5 * n.z;
+    }
+    double open = sqrt(vector_area[0] * vector_area[0] + vector_area[1] * vector_area[1] + vector_area[2] * vector_area[2]);
+    if (!(area > 0.0) || !isfinite(volume) || !(volume > 0.0) || !(open <= PILOT_CLOSED_SURFACE * area)) return -1.0;
+    return 4.0 * volume / area;
+}
+
+/* Whether the sheet candidates may run for mesh m (PILOT_SHEET_MAX_CHORD): a lit side to aim at
+ * (else they are classical walks) and a solid not far thicker than a mean free path, or one whose
+ * thickness dwvb_mesh_mean_chord cannot tell. */
+static int sheet_may_win(const dwvb_scene *scene, uint32_t m)
+{
+    if (scene->patch_count[m] <= 0) return 0;
+    const dwvw_medium *medium = &scene->shading[scene->meshes[m].material_id].medium;
+    double sigma_t = INFINITY;
+    for (int c = 0; c < medium->channels; ++c) sigma_t = fmin(sigma_t, medium->sigma_t[c]);
+    return !(dwvb_mesh_mean_chord(&scene->meshes[m]) * sigma_t > PILOT_SHEET_MAX_CHORD);
 }
 
 typedef struct pilot_sums {
@@ -227,7 +295,8 @@ static void *pilot_worker(void *arg)
                 double event_cost = PILOT_COST_EVENT + (candidate % PILOT_TECHNIQUES == PILOT_CLASSICAL ? 0.0 : PILOT_COST_GUIDED_EVENT);
                 p->cost += PILOT_COST_SAMPLE + PILOT_COST_WALK * (double)tally.walks + event_cost * (double)tally.events +
                            PILOT_COST_RAY * (double)tally.rays +
-                           PILOT_COST_QUERY * (double)tally.point_queries + PILOT_COST_TERM * (double)tally.mixture_terms;
+                           PILOT_COST_QUERY * (double)tally.point_queries + PILOT_COST_TERM * (double)tally.mixture_terms +
+                           PILOT_COST_PATH_RAY * (double)tally.path_rays;
                 for (int c = 0; c < 3; ++c)
                     p->channel_cost[c] += PILOT_COST_WALK * (double)tally.channel_walks[c] +
                                           event_cost * (double)tally.channel_events[c] +
@@ -382,8 +451,11 @@ static int pilot_survivors(const dwvb_bake *bake, const pilot_sums *sums, const 
         if (!bake->auto_choice[m] || sums[(size_t)candidates[0] * meshes + m].count < seen_enough) continue;
         const dwvb_material *material = &scene->shading[scene->meshes[m].material_id];
         double low[PILOT_CANDIDATES], best_high = INFINITY;
+        int sheet = sheet_may_win(scene, m);
         for (int k = 0; k < candidate_count; ++k) {
             size_t slot = (size_t)candidates[k] * meshes + m;
+            low[k] = INFINITY; /* a sheet candidate the mesh leaves out (sheet_may_win) keeps nothing here */
+            if (candidates[k] % PILOT_TECHNIQUES == PILOT_SHEET && !sheet) continue;
             uint8_t counts[3];
             low[k] = candidate_work(&sums[slot], material, trial_walks[slot], -PILOT_CONFIDENCE, counts);
             best_high = fmin(best_high, candidate_work(&sums[slot], material, trial_walks[slot], PILOT_CONFIDENCE, counts));
@@ -402,11 +474,11 @@ int dwvb_pilot_choose(dwvb_bake *bake)
 {
     const dwvb_scene *scene = bake->scene;
     uint32_t meshes = scene->mesh_count, deciding = 0;
-    int separable = 0, lit = 0;
+    int separable = 0, sheet_runs = 0;
     for (uint32_t m = 0; m < meshes; ++m) {
         deciding += (uint32_t)bake->auto_choice[m];
         separable |= bake->auto_choice[m] && !scene->shading[scene->meshes[m].material_id].grey;
-        lit |= bake->auto_choice[m] && scene->patch_count[m] > 0;
+        sheet_runs |= bake->auto_choice[m] && sheet_may_win(scene, m);
     }
     if (deciding == 0) return 0;
     uint64_t budget = active_pixels(bake) * bake->options.samples / 16u;
@@ -416,10 +488,9 @@ int dwvb_pilot_choose(dwvb_bake *bake)
     int candidates[PILOT_CANDIDATES], candidate_count = 0, ran[PILOT_CANDIDATES], ran_count = 0;
     int shared = bake->options.channel_walks != DWV_CHANNEL_WALKS_SEPARATE || !separable;
     int separate = separable && bake->options.channel_walks != DWV_CHANNEL_WALKS_SHARED;
-    /* The sheet walks only where some deciding mesh has a lit side to aim at (else they are
-     * classical ones). */
+    /* The sheet walks only where they may win on some deciding mesh (sheet_may_win). */
     for (int c = 0; c < PILOT_CANDIDATES; ++c)
-        if ((c < PILOT_TECHNIQUES ? shared : separate) && (c % PILOT_TECHNIQUES != PILOT_SHEET || lit))
+        if ((c < PILOT_TECHNIQUES ? shared : separate) && (c % PILOT_TECHNIQUES != PILOT_SHEET || sheet_runs))
             candidates[candidate_count++] = c;
     size_t slots = PILOT_CANDIDATES * (size_t)meshes;
     dwvw_guide *trial = malloc(slots * sizeof *trial);
@@ -428,6 +499,7 @@ int dwvb_pilot_choose(dwvb_bake *bake)
     int *trial_walks = malloc(slots * sizeof *trial_walks);
     pilot_sums *sums = calloc(slots, sizeof *sums); /* [candidate][mesh] */
     int stopped = -1;
+    uint32_t blocks_run = PILOT_FIRST_BLOCKS; /* by every candidate left at the choice */
     pilot_run run = {.bake = bake, .samples = n, .meshes = meshes, .block_sums = NULL};
     if (!trial || !trial_channels || !trial_closest || !trial_walks || !sums) goto done;
     dwvb_shader shaders[PILOT_CANDIDATES];
@@ -467,13 +539,21 @@ int dwvb_pilot_choose(dwvb_bake *bake)
         for (int k = 0; k < candidate_count; ++k) ran[k] = candidates[k];
         ran_count = candidate_count;
         candidate_count = pilot_survivors(bake, sums, trial_walks, candidates, candidate_count);
-        stopped = run_blocks(&run, candidates, candidate_count, PILOT_FIRST_BLOCKS, PILOT_BLOCKS);
+        /* A lone survivor is the pick: the rest of the blocks would only refine its walks per
+         * channel, for up to three quarters of a candidate's pilot (the benchmark's head_point and
+         * disc_back at 48 px, 32 spp: auto 1.8x the time of its pick's forced bake, docs/speed.md). */
+        if (candidate_count > 1) {
+            stopped = run_blocks(&run, candidates, candidate_count, PILOT_FIRST_BLOCKS, PILOT_BLOCKS);
+            blocks_run = PILOT_BLOCKS;
+        }
     }
     if (stopped == 0) {
         merge_blocks(&run, sums);
         for (uint32_t m = 0; m < meshes; ++m) {
             /* Every candidate traced the same camera rays, so each saw the mesh equally often. */
-            if (!bake->auto_choice[m] || sums[(size_t)candidates[0] * meshes + m].count < PILOT_MESH_MIN) continue;
+            if (!bake->auto_choice[m] ||
+                sums[(size_t)candidates[0] * meshes + m].count < PILOT_MESH_MIN * blocks_run / PILOT_BLOCKS)
+                continue;
             /* variance x cost, per sample that saw the mesh; the variance is the three channels'
              * together, as the image's RMSE over RGB counts it: the luminance would hide the
              * colour noise of shared walks, whose channels' weights move against each other. */
@@ -487,7 +567,9 @@ int dwvb_pilot_choose(dwvb_bake *bake)
             for (int k = 0; k < ran_count; ++k)
                 if (ran[k] % PILOT_TECHNIQUES == PILOT_CLASSICAL)
                     classical_share = fmin(classical_share, tail_share(&sums[(size_t)ran[k] * meshes + m]));
+            int sheet = sheet_may_win(scene, m);
             for (int k = 0; k < candidate_count; ++k) {
+                if (candidates[k] % PILOT_TECHNIQUES == PILOT_SHEET && !sheet) continue; /* ran for another mesh */
                 const pilot_sums *p = &sums[(size_t)candidates[k] * meshes + m];
                 uint8_t counts[3];
                 double work = candidate_work(p, material, trial_walks[(size_t)candidates[k] * meshes + m], 0.0, counts);

@@ -10,4 +10,8 @@
  * time, -1 out of memory. */
 int dwvb_pilot_choose(dwvb_bake *bake);
 
+/* The mean chord length 4 V / A of the solid the mesh bounds, or -1 where it bounds none that can
+ * be trusted (open, inward-facing, non-finite): pilot.c says why the pilot asks. */
+double dwvb_mesh_mean_chord(const dwvg_mesh *mesh);
+
 #endif

@@ -12,6 +12,10 @@ static inline dwvu_vec3 dwvu_sub(dwvu_vec3 a, dwvu_vec3 b) { return dwvu_v(a.x -
 static inline dwvu_vec3 dwvu_scale(dwvu_vec3 a, double s) { return dwvu_v(a.x * s, a.y * s, a.z * s); }
 static inline dwvu_vec3 dwvu_madd(dwvu_vec3 a, dwvu_vec3 d, double t) { return dwvu_v(a.x + d.x * t, a.y + d.y * t, a.z + d.z * t); }
 static inline double dwvu_dot(dwvu_vec3 a, dwvu_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static inline dwvu_vec3 dwvu_cross(dwvu_vec3 a, dwvu_vec3 b)
+{
+    return dwvu_v(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
 static inline double dwvu_length(dwvu_vec3 a) { return sqrt(dwvu_dot(a, a)); }
 static inline dwvu_vec3 dwvu_normalize(dwvu_vec3 a) { return dwvu_scale(a, 1.0 / dwvu_length(a)); }
 
