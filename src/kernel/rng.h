@@ -16,8 +16,7 @@ static inline uint64_t dwvk_mix64(uint64_t z)
     return z ^ (z >> 31);
 }
 
-/* One key per (seed, stream, sample): chained bijections, so distinct triples give distinct
- * inputs to each stage. Hoist it out of the per-dimension loop. */
+/* The first stage of dwvk_rng_key (below): a function of the seed alone. */
 static inline uint64_t dwvk_rng_seed_base(uint64_t seed)
 {
     return dwvk_mix64(seed + DWVK_GOLDEN_GAMMA);
@@ -30,6 +29,8 @@ static inline uint64_t dwvk_rng_key_from_base(uint64_t seed_base, uint64_t strea
     return dwvk_mix64(dwvk_mix64(seed_base ^ stream) + sample * DWVK_GOLDEN_GAMMA);
 }
 
+/* One key per (seed, stream, sample): chained bijections, so distinct triples give distinct
+ * inputs to each stage. Hoist it out of the per-dimension loop. */
 static inline uint64_t dwvk_rng_key(uint64_t seed, uint64_t stream, uint64_t sample)
 {
     return dwvk_rng_key_from_base(dwvk_rng_seed_base(seed), stream, sample);
