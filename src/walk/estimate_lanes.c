@@ -40,15 +40,15 @@
 
 _Static_assert(DWVW_LANES <= 32, "the flagged lanes are a 32-bit mask (lanes_run_in)");
 
-
 /* The log table's rows {1/c, log c} for 16 lanes' indices. On x86-64 processors with AVX-512 the
  * table's 32 rows are held as columns in registers (lane_log_columns, four vectors of 8 doubles
  * each) and read by two-source permutes (vpermi2pd): 2 permutes and a blend per 8 lanes and column,
  * where the scalar loop extracts each index and loads each entry (the lookups were about a seventh
- * of the poe step's instructions). GCC's vector extensions are written for the AVX-512 copy only
- * (target "arch=x86-64-v4": another target lowers them to scalar code, slower than the loop), so
- * the lane steps choose by the processor at run time (lane_state.permute: the same test as the
- * clones' resolver). The same table entries either way: the values do not depend on the path. */
+ * of the poe step's instructions). The permutes are GCC's vector extensions, compiled into every
+ * copy of a step, but only the AVX-512 copy makes them vpermi2pd (the others lower them to scalar
+ * code, slower than the loop), so the steps choose by the processor at run time (lane_state.permute,
+ * the test the clones' resolver makes for the AVX-512 copy). The same table entries either way: no
+ * value depends on the path. */
 _Static_assert(DWVK_LOG_TABLE_SIZE == 32, "the permuted lookup holds 32 rows in four 8-double vectors");
 
 typedef struct lane_log_columns {
@@ -126,14 +126,14 @@ typedef struct lane_state {
 } lane_state;
 
 /* What every walk of a run starts from, worked out once per run: the key's first hash (a
- * function of the seed alone), and, where every walk enters the same way, its entry
- * direction and first constant. */
+ * function of the seed alone), and, where every walk enters the same way, its entry direction
+ * (a fixed incidence: a square root per walk before). */
 typedef struct lane_template {
     uint64_t seed_base;
     uint64_t counter_offset;       /* the key's counter of event 0's stepped dimension, less the key */
     int same_entry;
     dwvu_vec3 direction;           /* same_entry: the entry direction */
-    double first_constant;         /* same_entry and plan->first_known: log(alpha / s0) */
+    double first_constant;         /* plan->first_known: log(alpha / s0) */
 } lane_template;
 
 static lane_template lane_template_for(const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
