@@ -16,13 +16,24 @@ static inline uint64_t dwvk_mix64(uint64_t z)
     return z ^ (z >> 31);
 }
 
+/* The first stage of dwvk_rng_key (below): a function of the seed alone. */
+static inline uint64_t dwvk_rng_seed_base(uint64_t seed)
+{
+    return dwvk_mix64(seed + DWVK_GOLDEN_GAMMA);
+}
+
+/* The later stages alone, from dwvk_rng_seed_base(seed): for loops over many keys of one seed
+ * (two hashes per key instead of three). */
+static inline uint64_t dwvk_rng_key_from_base(uint64_t seed_base, uint64_t stream, uint64_t sample)
+{
+    return dwvk_mix64(dwvk_mix64(seed_base ^ stream) + sample * DWVK_GOLDEN_GAMMA);
+}
+
 /* One key per (seed, stream, sample): chained bijections, so distinct triples give distinct
  * inputs to each stage. Hoist it out of the per-dimension loop. */
 static inline uint64_t dwvk_rng_key(uint64_t seed, uint64_t stream, uint64_t sample)
 {
-    uint64_t h = dwvk_mix64(seed + DWVK_GOLDEN_GAMMA);
-    h = dwvk_mix64(h ^ stream);
-    return dwvk_mix64(h + sample * DWVK_GOLDEN_GAMMA);
+    return dwvk_rng_key_from_base(dwvk_rng_seed_base(seed), stream, sample);
 }
 
 /* The counter that dimension `dimension` of `key` mixes; dimension d + j is this + j gamma, so a

@@ -4,6 +4,7 @@
  * over the lanes per stage, selects for branches). */
 #include <math.h>
 #include <stdatomic.h>
+#include <string.h>
 
 #include "estimate_walkers.h"
 #include "geometry.h"
@@ -39,6 +40,74 @@
 
 _Static_assert(DWVW_LANES <= 32, "the flagged lanes are a 32-bit mask (lanes_run_in)");
 
+/* The log table's rows {1/c, log c} for 16 lanes' indices. On x86-64 processors with AVX-512 the
+ * table's 32 rows are held as columns in registers (lane_log_columns, four vectors of 8 doubles
+ * each) and read by two-source permutes (vpermi2pd): 2 permutes and a blend per 8 lanes and column,
+ * where the scalar loop extracts each index and loads each entry (the lookups were about a seventh
+ * of the poe step's instructions). The permutes are GCC's vector extensions, compiled into every
+ * copy of a step, but only the AVX-512 copy makes them vpermi2pd (the others lower them to scalar
+ * code, slower than the loop), so the steps choose by the processor at run time (lane_state.permute,
+ * the test the clones' resolver makes for the AVX-512 copy). The same table entries either way: no
+ * value depends on the path. */
+_Static_assert(DWVK_LOG_TABLE_SIZE == 32, "the permuted lookup holds 32 rows in four 8-double vectors");
+
+typedef struct lane_log_columns {
+    double invc[DWVK_LOG_TABLE_SIZE], logc[DWVK_LOG_TABLE_SIZE];
+} lane_log_columns;
+
+static void lane_log_columns_fill(lane_log_columns *columns)
+{
+    for (int i = 0; i < DWVK_LOG_TABLE_SIZE; ++i) {
+        columns->invc[i] = DWVK_LOG_TABLE[i][0];
+        columns->logc[i] = DWVK_LOG_TABLE[i][1];
+    }
+}
+
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && __GNUC__ >= 12
+#define DWVW_LANE_PERMUTE 1
+typedef double lane_v8d __attribute__((vector_size(64)));
+typedef int64_t lane_v8l __attribute__((vector_size(64)));
+
+/* Entry `index` (0 .. 31) of 8 lanes from a 32-entry column held as four vectors: the lower or
+ * upper 16 by bit 4 of the index (the permute reads bits 0-3). Written to memory, not returned (a
+ * vector return would change the ABI between the clones). */
+static DWVW_ALWAYS_INLINE void lane_permute32(const lane_v8d column[4], lane_v8l index, double *out)
+{
+    lane_v8l upper = -((index >> 4) & 1);
+    lane_v8l low = (lane_v8l)__builtin_shuffle(column[0], column[1], index);
+    lane_v8l high = (lane_v8l)__builtin_shuffle(column[2], column[3], index);
+    lane_v8l entry = (low & ~upper) | (high & upper);
+    memcpy(out, &entry, sizeof entry);
+}
+
+static DWVW_ALWAYS_INLINE void lanes_log_rows_permute(const lane_log_columns *columns, const int32_t *index,
+                                                   double *invc, double *logc)
+{
+    lane_v8d invc_column[4], logc_column[4];
+    memcpy(invc_column, columns->invc, sizeof invc_column);
+    memcpy(logc_column, columns->logc, sizeof logc_column);
+    for (int h = 0; h < DWVW_LANES; h += 8) {
+        lane_v8l lanes_index;
+        for (int j = 0; j < 8; ++j) lanes_index[j] = index[h + j];
+        lane_permute32(invc_column, lanes_index, invc + h);
+        lane_permute32(logc_column, lanes_index, logc + h);
+    }
+}
+
+static int lanes_can_permute(void)
+{
+    return __builtin_cpu_supports("x86-64-v4") != 0;
+}
+#else
+#define DWVW_LANE_PERMUTE 0
+static int lanes_can_permute(void)
+{
+    return 0;
+}
+#endif
+
+_Static_assert(DWVW_LANES % 8 == 0, "the permuted lookup takes the lanes 8 at a time");
+
 /* The lanes' state. p: position; d: the direction of the step being taken (for a lane at
  * events = 0, its entry direction). log_constants and exponent as in guided_walk_in, weight as in
  * mixture_walk_in. */
@@ -52,19 +121,43 @@ typedef struct lane_state {
     uint32_t events[DWVW_LANES];
     int exited[DWVW_LANES], flagged[DWVW_LANES];
     double weight[DWVW_LANES];         /* the mixture's throughput (mixture_lanes_step_in) */
+    lane_log_columns log_columns;      /* the log table by columns, and whether to permute it */
+    int permute;                       /*   (lanes_unit_flights) */
 } lane_state;
 
-/* Puts walk `index` into lane l at its entry, as guided_walk_in starts it. */
-static void lane_begin(lane_state *L, int l, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan,
-                       uint64_t index)
+/* What every walk of a run starts from, worked out once per run: the key's first hash (a
+ * function of the seed alone), and, where every walk enters the same way, its entry direction
+ * (a fixed incidence: a square root per walk before). */
+typedef struct lane_template {
+    uint64_t seed_base;
+    uint64_t counter_offset;       /* the key's counter of event 0's stepped dimension, less the key */
+    int same_entry;
+    dwvu_vec3 direction;           /* same_entry: the entry direction */
+    double first_constant;         /* plan->first_known: log(alpha / s0) */
+} lane_template;
+
+static lane_template lane_template_for(const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan)
 {
-    uint64_t key = dwvk_rng_key(setup->seed, index, 0);
-    dwvu_vec3 direction = dwvw_entry_direction(setup, key);
-    L->key[l] = key;
+    lane_template t;
+    t.seed_base = dwvk_rng_seed_base(setup->seed);
     /* The guided walk steps the counter of an event's direction dimension, the mixture that of its
      * first (channel) dimension. */
     uint32_t dimension = plan->walker == DWVW_WALKER_MIXTURE ? DWVW_DIM_CHANNEL : DWVW_DIM_DIRECTION;
-    L->counter[l] = dwvk_rng_counter(key, dwvw_event_dim(0) + dimension);
+    t.counter_offset = dwvk_rng_counter(0, dwvw_event_dim(0) + dimension);
+    t.same_entry = !setup->incidence_diffuse;
+    t.direction = dwvw_entry_direction(setup, 0); /* the key is not read for a fixed incidence */
+    t.first_constant = plan->log_first;
+    return t;
+}
+
+/* Puts walk `index` into lane l at its entry, as guided_walk_in starts it. */
+static void lane_begin(lane_state *L, int l, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan,
+                       const lane_template *t, uint64_t index)
+{
+    uint64_t key = dwvk_rng_key_from_base(t->seed_base, index, 0); /* = dwvk_rng_key(seed, index, 0) */
+    dwvu_vec3 direction = t->same_entry ? t->direction : dwvw_entry_direction(setup, key);
+    L->key[l] = key;
+    L->counter[l] = key + t->counter_offset; /* dwvk_rng_counter: the same sum mod 2^64 */
     L->px[l] = DWVW_ENTRY_POINT.x;
     L->py[l] = DWVW_ENTRY_POINT.y;
     L->pz[l] = DWVW_ENTRY_POINT.z;
@@ -75,7 +168,7 @@ static void lane_begin(lane_state *L, int l, const dwvw_estimate_setup *setup, c
     L->log_constants[l] = L->exponent[l] = L->log_weight[l] = 0.0;
     L->weight[l] = 1.0;
     if (plan->first_known) {
-        L->first_constant[l] = plan->log_first;
+        L->first_constant[l] = t->first_constant;
     } else {
         double stretch = dwvk_dwivedi_stretch_d(&setup->medium.dwivedi, dwvw_aligned_cosine(plan, direction));
         L->first_constant[l] = log(setup->medium.albedo[0] / stretch);
@@ -84,16 +177,23 @@ static void lane_begin(lane_state *L, int l, const dwvw_estimate_setup *setup, c
 
 /* The lanes' unit free flights dwvk_free_flight(u) = -log(1 - u), bit for bit, in three loops: the
  * logarithm's arithmetic before and after its table lookups (vectorised), and the lookups between
- * (gathers, which keep a loop from being vectorised). Apart from the step's main loop for the same
- * reason. */
-static inline void lanes_unit_flights(const float *u, double *unit_flight)
+ * (gathers, which keep a loop from being vectorised, or the permutes above). Apart from the step's
+ * main loop for the same reason. */
+static inline void lanes_unit_flights(const lane_state *L, const float *u, double *unit_flight)
 {
     int32_t index[DWVW_LANES], k[DWVW_LANES];
     double z[DWVW_LANES], invc[DWVW_LANES], logc[DWVW_LANES];
     for (int l = 0; l < DWVW_LANES; ++l) index[l] = dwvk_log_fast_split(1.0f - u[l], &k[l], &z[l]);
-    for (int l = 0; l < DWVW_LANES; ++l) {
-        invc[l] = DWVK_LOG_TABLE[index[l]][0];
-        logc[l] = DWVK_LOG_TABLE[index[l]][1];
+#if DWVW_LANE_PERMUTE
+    if (L->permute) {
+        lanes_log_rows_permute(&L->log_columns, index, invc, logc);
+    } else
+#endif
+    {
+        for (int l = 0; l < DWVW_LANES; ++l) {
+            invc[l] = DWVK_LOG_TABLE[index[l]][0];
+            logc[l] = DWVK_LOG_TABLE[index[l]][1];
+        }
     }
     for (int l = 0; l < DWVW_LANES; ++l) unit_flight[l] = -dwvk_log_fast_join(k[l], z[l], invc[l], logc[l]);
 }
@@ -142,7 +242,7 @@ static DWVW_ALWAYS_INLINE int guided_lanes_step_in(lane_state *L, const dwvw_est
         L->counter[l] += DWVW_EVENT_COUNTER_STEP;
     }
     double unit_flight[DWVW_LANES];
-    lanes_unit_flights(udist, unit_flight);
+    lanes_unit_flights(L, udist, unit_flight);
     for (int l = 0; l < DWVW_LANES; ++l) {
         dwvk_dwivedi_event_cosine_f s = dwvk_dwivedi_event_sample_select_f(d, ua[l]);
         dwvk_unit2_f azimuth = dwvk_azimuth_f(ub[l]); /* turned by its quarter turns */
@@ -391,7 +491,7 @@ static DWVW_ALWAYS_INLINE int mixture_lanes_step_in(lane_state *L, const dwvw_es
      * the weight is long, and short loops let the core run the lanes' chains side by side. */
     double stretch_of[DWVW_LANES], t_of[DWVW_LANES], decay_of[DWVW_LANES], unit_flight[DWVW_LANES];
     int exited_of[DWVW_LANES];
-    lanes_unit_flights(udist, unit_flight);
+    lanes_unit_flights(L, udist, unit_flight);
     for (int l = 0; l < DWVW_LANES; ++l) {
         double pz = L->pz[l], z = wz[l];
         double mu = dwvw_clamp_cosine(axis_sign * z);
@@ -506,41 +606,47 @@ static inline void lanes_run_in(const dwvw_estimate_setup *setup, const dwvw_fas
                                 lane_feed *feed)
 {
     lane_state L;
+    lane_log_columns_fill(&L.log_columns);
+    L.permute = lanes_can_permute();
+    const lane_template start = lane_template_for(setup, plan);
     uint64_t sequence[DWVW_LANES];
-    int live[DWVW_LANES], live_count = 0;
+    /* Bit l: lane l holds a walk. Masks, visited lowest lane first (the order of a scan over the
+     * lanes), instead of a branch per lane: a lane's end is a coin toss, and per-lane tests were
+     * the hottest lines of this loop in perf. */
+    const uint32_t all_lanes = DWVW_LANES == 32 ? 0xffffffffu : (1u << (DWVW_LANES % 32)) - 1u;
+    uint32_t live = 0;
     for (int l = 0; l < DWVW_LANES; ++l) {
         uint64_t index;
-        live[l] = feed_next(feed, &index, &sequence[l]);
-        if (live[l]) lane_begin(&L, l, setup, plan, index);
-        else lane_begin(&L, l, setup, plan, 0); /* an idle lane computes on a valid state */
-        live_count += live[l];
+        int begun = feed_next(feed, &index, &sequence[l]);
+        lane_begin(&L, l, setup, plan, &start, begun ? index : 0); /* an idle lane computes on a valid state */
+        live |= (uint32_t)begun << l;
     }
-    while (live_count > 0) {
+    while (live) {
         if (!lanes_step(&L, setup, plan, kind)) continue;
-        /* The live flagged lanes as a bit mask, visited lowest first (the order of a scan over the
-         * lanes) without a branch per lane: about half the steps flag a lane, seldom the same one. */
-        uint32_t pending = 0;
-        for (int l = 0; l < DWVW_LANES; ++l) pending |= (uint32_t)(L.flagged[l] & live[l]) << l;
-        int freed = 0;
-        for (; pending; pending &= pending - 1u) {
+        /* The live flagged lanes: about half the steps flag a lane, seldom the same one. */
+        uint32_t flagged = 0;
+        for (int l = 0; l < DWVW_LANES; ++l) flagged |= (uint32_t)L.flagged[l] << l;
+        uint32_t freed = 0;
+        for (uint32_t pending = flagged & live; pending; pending &= pending - 1u) {
             int l = __builtin_ctz(pending);
             dwvw_walk_end end;
             int ended = plan->walker == DWVW_WALKER_MIXTURE ? mixture_lane_end(&L, l, setup, kind, &end)
                                                             : guided_lane_end(&L, l, setup, plan, kind, &end);
             if (!ended) continue;
             feed_done(feed, setup, sequence[l], &end);
-            live[l] = 0;
-            --live_count;
-            freed = 1;
+            freed |= 1u << l;
         }
         if (!freed) continue;
-        /* Refill every idle lane: a lane left idle by a full ring may go on once the ring drained. */
-        for (int l = 0; l < DWVW_LANES; ++l) {
+        live &= ~freed;
+        /* Refill every idle lane: a lane left idle by a full ring may go on once the ring drained.
+         * Once feed_next has none, it has none for the lanes after it either (the ring and the
+         * blocks do not move in between). */
+        for (uint32_t idle = all_lanes & ~live; idle; idle &= idle - 1u) {
+            int l = __builtin_ctz(idle);
             uint64_t index;
-            if (live[l] || !feed_next(feed, &index, &sequence[l])) continue;
-            lane_begin(&L, l, setup, plan, index);
-            live[l] = 1;
-            ++live_count;
+            if (!feed_next(feed, &index, &sequence[l])) break;
+            lane_begin(&L, l, setup, plan, &start, index);
+            live |= 1u << l;
         }
     }
 }

@@ -58,6 +58,22 @@ int main(void)
     }
     CHECK(wrong == 0, "unmix64 is not the inverse of dwvk_mix64 on %d of 10000 values", wrong);
 
+    /* A key from its seed's first stage (dwvk_rng_seed_base, once per run in the estimator's
+     * lanes) is the key of the three chained stages written out, for every seed, stream and
+     * sample tried (including the ends of their ranges). */
+    const uint64_t spread[] = {0, 1, 2, 17, 0xdeadbeefull, 0x8000000000000000ull, UINT64_MAX - 1u, UINT64_MAX};
+    int key_wrong = 0;
+    for (int a = 0; a < 8; ++a)
+        for (int b = 0; b < 8; ++b)
+            for (int c = 0; c < 8; ++c) {
+                uint64_t seed = spread[a], stream = spread[b], sample = spread[c];
+                uint64_t chained = dwvk_mix64(dwvk_mix64(dwvk_mix64(seed + DWVK_GOLDEN_GAMMA) ^ stream) +
+                                              sample * DWVK_GOLDEN_GAMMA);
+                key_wrong += dwvk_rng_key_from_base(dwvk_rng_seed_base(seed), stream, sample) != chained;
+                key_wrong += dwvk_rng_key(seed, stream, sample) != chained;
+            }
+    CHECK(key_wrong == 0, "a key from its seed base differs from the chained stages in %d of 1024 cases", key_wrong);
+
     const uint64_t seeds[] = {0, 1, 0xdeadbeefull};
     const uint32_t dimensions[] = {0, 1, 4000000000u};
     for (int i = 0; i < 3; ++i) {
