@@ -73,14 +73,15 @@
 #define PILOT_COST_TERM 25.22
 /* A ray of a path after the first scattering (indirect light, dwvb_tally.path_rays): its
  * intersection, the hit's direct light and what else a path vertex does beyond the walks counted
- * above. Not in the fit above, whose scenes trace no paths; fitted alone (the other coefficients
- * held) to the worker's instructions in callgrind on the benchmark's bowl, 32 x 32 pixels, 16 spp,
- * classical / backward / incident shared and classical / backward with channel walks: 7,700-9,400
- * per path ray with channel walks, least squares 7,900 over the five. Without it the pilot priced
- * channel walks, which send one path per channel where a shared walk sends one, too low on
- * concave scenes with indirect light: on the bowl 0.52-0.66 path rays per sample with channel
- * walks against 0.21-0.24 shared, and its model put backward with channel walks at 8,774
- * instructions per sample where callgrind counted 13,851 (incident shared 8,684 against 10,532). */
+ * above. Not in the fit above, whose scenes trace no paths (tools/fit_pilot_cost.py holds it);
+ * fitted alone (the other coefficients held) to the worker's instructions in callgrind on the
+ * benchmark's bowl, 32 x 32 pixels, 16 spp, classical / backward / incident shared and classical /
+ * backward with channel walks: 7,700-9,400 per path ray with channel walks, least squares 7,900
+ * over the five. Without it the pilot priced channel walks, which send one path per channel where a
+ * shared walk sends one, too low on concave scenes with indirect light: on the bowl 0.52-0.66 path
+ * rays per sample with channel walks against 0.21-0.24 shared, and its model put backward with
+ * channel walks at 8,774 instructions per sample where callgrind counted 13,851 (incident shared
+ * 8,684 against 10,532). */
 #define PILOT_COST_PATH_RAY 7900.0
 /* Pilot samples per candidate: a sixteenth of the bake's samples, at most PILOT_MAX (the first
  * quarter of them for every candidate, the rest for those not clearly worse: pilot_survivors); below
