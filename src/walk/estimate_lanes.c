@@ -188,6 +188,8 @@ static inline void lanes_unit_flights(const lane_state *L, const float *u, doubl
     if (L->permute) {
         lanes_log_rows_permute(&L->log_columns, index, invc, logc);
     } else
+#else
+    (void)L; /* a build without the permuted lookup (not GCC 12+ on x86-64 Linux) */
 #endif
     {
         for (int l = 0; l < DWVW_LANES; ++l) {
