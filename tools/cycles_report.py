@@ -1,6 +1,6 @@
 """The error-against-run-time report: python3 tools/cycles_report.py --out DIR [--quick] [--no-cycles]
 [--sections v0,techniques,cycles] [--cycles-scenes slab,leaf,sphere] [--repeats N]
-[--cycles-blenders host,trixie,sid] [--library PATH]
+[--cycles-blenders host,trixie,sid] [--walk-event-cap N] [--library PATH]
 
 Runs benchmark scenes through the shim and writes DIR/report.md, DIR/report.json and plots
 (matplotlib, Debian python3-matplotlib; without it the report has tables only):
@@ -28,6 +28,8 @@ Runs benchmark scenes through the shim and writes DIR/report.md, DIR/report.json
    tests make and enter them, tests/blender/run_package_tests.py), with the same scene script and
    the add-on's export for that version; --library names the library the bakes use (the chroots
    need the self-contained one). One Blender per run is fine too (a report per version).
+   dwivedi's bakes end walks after Cycles' 256 events (--walk-event-cap, default 256: the same
+   image as Cycles'; 0 for the add-on's default 10^6, which keeps the light Cycles loses).
 
 Timings are measured on whatever else runs on the machine: ratios within one run are fair,
 absolute seconds are not. Exit status 1 with a message on failure.
@@ -371,8 +373,8 @@ def cycles_section(quick: bool, blender: str, size: int, scenes: Sequence[str], 
     dwivedi library the bakes use (default the shim's; a chroot needs the self-contained one,
     build/portable/libdwivedi.so.1). `deadline` (time.time() seconds): scenes not begun by then
     are left out and listed. `event_cap`: every dwivedi bake's cap on scattering events per walk
-    (the add-on's Walk Event Cap; 0: the library's 10^6). Returns {"blender": version, "scenes": {name: entry}, "not_run":
-    [names]}."""
+    (the add-on's Walk Event Cap; 0: the library's 10^6). Returns {"blender": version, "scenes":
+    {name: entry}, "not_run": [names], "where": where, "walk_event_cap": event_cap}."""
     scenes_dir = SOURCE_DIR / "tests" / "blender"
     addon_dir = SOURCE_DIR / "blender_addon"
     shim_dir = Path(dwivedi.__file__).resolve().parent.parent
@@ -585,8 +587,9 @@ def markdown(data: Dict[str, Any], made: List[str]) -> str:
                   "method, the medium of the other versions). Each renderer's RMSE is measured against its own "
                   "converged image (Cycles and dwivedi each at 4x their largest count, other seeds), so that "
                   "noise is compared with noise; how far the two converged images lie apart is its own column "
-                  f"({event_cap_words(first.get('walk_event_cap'))}). Both sides are timed the same way, as the whole operator an "
-                  "artist runs: Cycles' F12 (bpy.ops.render.render writing the EXR: scene sync, render, file) "
+                  f"({event_cap_words(first.get('walk_event_cap'))}). Both sides are timed the same way, as "
+                  "the whole operator an artist runs: Cycles' F12 (bpy.ops.render.render writing the EXR: "
+                  "scene sync, render, file) "
                   "and dwivedi's Bake (bpy.ops.dwivedi.bake: the add-on's export and the library's scene commit, "
                   "the bake with its auto pilot, EXR + PNG written and loaded as a Blender image; the add-on's "
                   "export cache emptied before each, as Cycles syncs every render without Persistent Data); the speed-up "
