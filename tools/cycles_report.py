@@ -1,6 +1,6 @@
 """The error-against-run-time report: python3 tools/cycles_report.py --out DIR [--quick] [--no-cycles]
 [--sections v0,techniques,cycles] [--cycles-scenes slab,leaf,sphere] [--repeats N]
-[--cycles-blenders host,trixie,sid] [--library PATH]
+[--cycles-blenders host,trixie,sid] [--walk-event-cap N] [--library PATH]
 
 Runs benchmark scenes through the shim and writes DIR/report.md, DIR/report.json and plots
 (matplotlib, Debian python3-matplotlib; without it the report has tables only):
@@ -28,6 +28,8 @@ Runs benchmark scenes through the shim and writes DIR/report.md, DIR/report.json
    tests make and enter them, tests/blender/run_package_tests.py), with the same scene script and
    the add-on's export for that version; --library names the library the bakes use (the chroots
    need the self-contained one). One Blender per run is fine too (a report per version).
+   dwivedi's bakes end walks after Cycles' 256 events (--walk-event-cap, default 256: the same
+   image as Cycles'; 0 for the add-on's default 10^6, which keeps the light Cycles loses).
 
 Timings are measured on whatever else runs on the machine: ratios within one run are fair,
 absolute seconds are not. Exit status 1 with a message on failure.
@@ -141,6 +143,12 @@ SCENES = {"default": default_scene, "slab": slab_scene, "sphere": sphere_scene}
 SECTIONS = ("v0", "techniques", "cycles")
 CYCLES_SCENES = ("slab", "leaf", "sphere")
 BLENDERS = ("host", "trixie", "sid")
+# Cycles ends a subsurface walk after 256 scattering events (BSSRDF_MAX_BOUNCES, every version
+# here) and drops its light; dwivedi's bakes against it end theirs there too (the add-on's Walk
+# Event Cap, as tests/blender/harness.py), so that the two converged images estimate the same
+# image: uncapped (the add-on's default, 10^6), the thick, bright benchmark torus came out 2.8% /
+# 1.6% / 0.2% brighter than Cycles 3.4 in R / G / B, at the cap 0.06% / 0.27% / 0.16%.
+CYCLES_EVENT_CAP = 256
 
 
 # ---------------------------------------------------------------------------------------------
@@ -227,7 +235,7 @@ def operator_bake(scene, spp, seed, folder):
     """The whole bake from the operator; (wall seconds, its parts, RGBA rows from the bottom)."""
     props = scene.dwivedi_bake
     props.target = 'CAMERA'; props.samples = spp; props.seed = seed; props.threads = 2
-    props.output_dir = folder; props.load_result = False
+    props.output_dir = folder; props.load_result = False; props.walk_event_cap = args["event_cap"]
     parts.clear()
     # Cold, as Cycles renders without Persistent Data: the add-on's export cache (which would make
     # a bake of the unchanged scene reuse the last one's export and commit) is emptied first.
@@ -306,7 +314,7 @@ for index, name in enumerate(args["scenes_list"]):
     # against it, as Cycles' is against Cycles' own; the two converged images are compared apart.
     own_spp = 4 * args["dwivedi_counts"][-1]
     own = dwivedi.bake(exported.scene, width=exported.width, height=exported.height, samples=own_spp, threads=2,
-                       seed=1234, **paths)
+                       seed=1234, max_events=args["event_cap"], **paths)
     exported.scene.close()
     own_ref = flip(list(own.pixels()), own.width, own.height)
     entry["dwivedi_reference_samples"] = own_spp
@@ -358,14 +366,15 @@ write_result()
 
 def cycles_section(quick: bool, blender: str, size: int, scenes: Sequence[str], repeats: int,
                    where: str = "host", library: Optional[str] = None,
-                   deadline: Optional[float] = None) -> Dict[str, Any]:
+                   deadline: Optional[float] = None, event_cap: int = CYCLES_EVENT_CAP) -> Dict[str, Any]:
     """The Cycles comparison in one Blender: `blender` on the host (where = "host"), or the Blender
     of the trixie / sid chroot (scripts/blender-chroots.sh, run the way the tests run it:
     tests/blender/run_package_tests.py's make_chroot and blender_command; root). `library`: the
     dwivedi library the bakes use (default the shim's; a chroot needs the self-contained one,
     build/portable/libdwivedi.so.1). `deadline` (time.time() seconds): scenes not begun by then
-    are left out and listed. Returns {"blender": version, "scenes": {name: entry}, "not_run":
-    [names]}."""
+    are left out and listed. `event_cap`: every dwivedi bake's cap on scattering events per walk
+    (the add-on's Walk Event Cap; 0: the library's 10^6). Returns {"blender": version, "scenes":
+    {name: entry}, "not_run": [names], "where": where, "walk_event_cap": event_cap}."""
     scenes_dir = SOURCE_DIR / "tests" / "blender"
     addon_dir = SOURCE_DIR / "blender_addon"
     shim_dir = Path(dwivedi.__file__).resolve().parent.parent
@@ -408,7 +417,7 @@ def cycles_section(quick: bool, blender: str, size: int, scenes: Sequence[str], 
         result_path = stage / "result.json"
         args = {**{key: inside(value) for key, value in paths.items()}, "work": inside(stage),
                 "result": inside(result_path), "size": size, "scenes_list": list(scenes), "repeats": repeats,
-                "deadline": deadline,
+                "deadline": deadline, "event_cap": event_cap,
                 # Counts large enough that Cycles' render time, not its per-render overhead, is
                 # what is measured.
                 "cycles_counts": [32, 128, 512] if quick else [64, 256, 1024],
@@ -435,6 +444,7 @@ def cycles_section(quick: bool, blender: str, size: int, scenes: Sequence[str], 
             raise RuntimeError(f"the Blender benchmark ({where}) failed:\n{tail}")
         result = json.loads(result_path.read_text())
         result["where"] = where
+        result["walk_event_cap"] = event_cap
         return result
 
 
@@ -466,6 +476,18 @@ def time_to_rmse(points: List[Dict[str, float]], target: float) -> Optional[floa
 # ---------------------------------------------------------------------------------------------
 # Output
 # ---------------------------------------------------------------------------------------------
+
+def event_cap_words(cap: Optional[int]) -> str:
+    """What the report says of dwivedi's walk event cap against Cycles' 256 (None: a report.json
+    from before the cap was recorded, whose bakes ran uncapped)."""
+    if cap == CYCLES_EVENT_CAP:
+        return (f"dwivedi's walks end after {cap} scattering events, as Cycles' do (BSSRDF_MAX_BOUNCES): both lose "
+                "the same light on thick, bright objects, docs/cycles_energy_loss.md")
+    events = f"{cap}" if cap else "10^6"
+    return (f"dwivedi's walks end after {events} scattering events, Cycles' after 256: where their counts differ, "
+            "on thick, bright objects, the two converged images differ by the light one of them loses, "
+            "docs/cycles_energy_loss.md")
+
 
 def cycles_entries(data: Dict[str, Any]) -> List[Tuple[str, str, Dict[str, Any]]]:
     """(where, scene, entry) of every Cycles comparison of the report, per Blender in run order."""
@@ -565,9 +587,9 @@ def markdown(data: Dict[str, Any], made: List[str]) -> str:
                   "method, the medium of the other versions). Each renderer's RMSE is measured against its own "
                   "converged image (Cycles and dwivedi each at 4x their largest count, other seeds), so that "
                   "noise is compared with noise; how far the two converged images lie apart is its own column "
-                  "(Cycles stops walks at 256 bounces and loses energy where dwivedi does not, "
-                  "docs/cycles_energy_loss.md). Both sides are timed the same way, as the whole operator an "
-                  "artist runs: Cycles' F12 (bpy.ops.render.render writing the EXR: scene sync, render, file) "
+                  f"({event_cap_words(first.get('walk_event_cap'))}). Both sides are timed the same way, as "
+                  "the whole operator an artist runs: Cycles' F12 (bpy.ops.render.render writing the EXR: "
+                  "scene sync, render, file) "
                   "and dwivedi's Bake (bpy.ops.dwivedi.bake: the add-on's export and the library's scene commit, "
                   "the bake with its auto pilot, EXR + PNG written and loaded as a Blender image; the add-on's "
                   "export cache emptied before each, as Cycles syncs every render without Persistent Data); the speed-up "
@@ -666,6 +688,10 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     parser.add_argument("--budget-minutes", type=float, default=None,
                         help="against Cycles: scenes not begun this many minutes after the start are left out "
                              "(listed as not run in the report); the scenes finished are kept. Default: no limit")
+    parser.add_argument("--walk-event-cap", type=int, default=CYCLES_EVENT_CAP,
+                        help=f"against Cycles: every dwivedi bake's cap on scattering events per walk (default "
+                             f"{CYCLES_EVENT_CAP}, Cycles' own, so that both estimate the same image; 0: the add-on's "
+                             "default 10^6, which keeps the light Cycles loses on thick, bright objects)")
     parser.add_argument("--library", default=None,
                         help="the dwivedi library the Cycles part bakes with (default the shim's; the chroots need "
                              "the self-contained build/portable/libdwivedi.so.1)")
@@ -680,10 +706,12 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
                + [n for n in cycles_scenes if n not in CYCLES_SCENES + BENCHMARK_SCENES]
                + [n for n in blenders if n not in BLENDERS])
     budget_bad = args.budget_minutes is not None and not (math.isfinite(args.budget_minutes) and args.budget_minutes > 0)
-    if unknown or not sections or not cycles_scenes or not blenders or not 1 <= repeats <= 100 or budget_bad:
+    cap_bad = not 0 <= args.walk_event_cap <= 2 ** 31 - 1  # the add-on's IntProperty
+    if unknown or not sections or not cycles_scenes or not blenders or not 1 <= repeats <= 100 or budget_bad or cap_bad:
         problem = (f"unknown section, scene or Blender {unknown[0]!r}" if unknown else "no section, scene or Blender "
                    "given" if not sections or not cycles_scenes or not blenders else
                    f"--budget-minutes {args.budget_minutes} is not a positive number of minutes" if budget_bad else
+                   f"--walk-event-cap {args.walk_event_cap} is outside 0 to {2 ** 31 - 1}" if cap_bad else
                    f"--repeats {repeats} is outside 1 to 100")
         print(f"cycles_report: {problem} (sections: {', '.join(SECTIONS)}; scenes: {', '.join(CYCLES_SCENES)}; "
               f"Blenders: {', '.join(BLENDERS)})", file=sys.stderr)
@@ -714,7 +742,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
                 print(f"Cycles ({where})", file=sys.stderr, flush=True)
                 try:
                     data["cycles"][where] = cycles_section(args.quick, args.blender, cycles_size, cycles_scenes,
-                                                           repeats, where, args.library, deadline)
+                                                           repeats, where, args.library, deadline,
+                                                           args.walk_event_cap)
                 except RuntimeError as error:  # the other Blenders' figures are still written
                     data.setdefault("cycles_failed", {})[where] = str(error)
                     print(f"cycles_report: {error}", file=sys.stderr, flush=True)

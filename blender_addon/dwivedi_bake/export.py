@@ -1052,6 +1052,10 @@ def _export(context: Any, settings: Any, dwivedi: Any, out: Exported, cache: Opt
         for instance in depsgraph.object_instances:
             obj = instance.object
             matrix = instance.matrix_world.copy()
+            # Disabled in renders (the object's camera icon): Cycles' render leaves it out, a light
+            # as a mesh. The depsgraph here is the view layer's, which still holds it.
+            if obj.hide_render:
+                continue
             if obj.type == 'LIGHT':
                 light = _light(obj, matrix, dwivedi, warnings)
                 if light is not None:
@@ -1061,8 +1065,6 @@ def _export(context: Any, settings: Any, dwivedi: Any, out: Exported, cache: Opt
             if not _is_geometry(obj):
                 if obj.type not in {'CAMERA', 'EMPTY', 'LIGHT_PROBE', 'SPEAKER', 'ARMATURE', 'LATTICE'}:
                     skipped.append(obj.name)
-                continue
-            if obj.hide_render:
                 continue
             original = obj.original if hasattr(obj, "original") else obj
             is_uv_target = (uv_object is not None and original == uv_object and not instance.is_instance)

@@ -55,9 +55,10 @@ BASE_LIBRARIES = {"libc.so.6", "libm.so.6", "libstdc++.so.6", "libgcc_s.so.1", "
 TIMES = {}
 # The headless test scripts of tests/blender this runner can run (test_ui.py: with --ui).
 SCRIPTS = tuple(sorted(p.name for p in Path(__file__).resolve().parent.glob("test_*.py") if p.name != "test_ui.py"))
-# Passed on to test_fidelity.py (its settings, for a diagnosis run; CI uses its defaults).
+# Passed on to test_fidelity.py and test_indirect.py (their settings, for a diagnosis run; CI uses their defaults).
 FIDELITY_SETTINGS = ("DWIVEDI_FIDELITY_EVENT_CAP", "DWIVEDI_FIDELITY_ONLY", "DWIVEDI_FIDELITY_RESOLUTION",
-                     "DWIVEDI_FIDELITY_CYCLES_SPP", "DWIVEDI_FIDELITY_DWIVEDI_SPP", "DWIVEDI_FOOTPRINT_PLANTED")
+                     "DWIVEDI_FIDELITY_CYCLES_SPP", "DWIVEDI_FIDELITY_DWIVEDI_SPP", "DWIVEDI_FOOTPRINT_PLANTED",
+                     "DWIVEDI_INDIRECT_ONLY", "DWIVEDI_INDIRECT_PLANTED")
 
 
 def fail(message):

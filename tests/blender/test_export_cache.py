@@ -2,7 +2,7 @@
 change, and reuses only what did not change.
 
 For each change (a mesh edit, a modifier, a material and a material slot, a transform, a light's
-strength and direction, the world, the camera, an object hidden, a mesh shared by two objects
+strength and direction, the world, the camera, an object hidden, a light hidden, a mesh shared by two objects
 edited, the bake's export settings) the scene is exported through the cache and without it: the
 two must hand the library the same scene (every call that builds it, arrays within 1e-6), which
 differs from the one before the change (so the change is seen), and the meshes read again are
@@ -231,6 +231,10 @@ class CacheTest(harness.unittest.TestCase):
 
     def test_hidden_object(self):
         self.check_change(lambda: setattr(self.scene.objects["monkey1"], "hide_render", True), 0)
+
+    def test_hidden_light(self):
+        # A light disabled in renders is out of Cycles' render: it was exported all the same.
+        self.check_change(lambda: setattr(self.scene.objects["sun"], "hide_render", True), 0)
 
     def test_shared_mesh(self):
         # Both objects of the linked duplicate read their (one) mesh again.

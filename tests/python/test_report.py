@@ -54,6 +54,15 @@ class ReportTest(unittest.TestCase):
         self.assertAlmostEqual(report.time_to_rmse(report.noise_only(points, reference), target), 4.096, delta=1e-9)
         self.assertAlmostEqual(report.time_to_rmse(points, target), 1.25 * 4.096, delta=1e-9)
 
+    def test_event_cap_is_said(self):
+        # Against Cycles the bakes end walks at Cycles' 256 events unless told otherwise, and the
+        # report says which cap its converged images were made with (an old report.json: uncapped).
+        import cycles_report as report
+        self.assertEqual(report.CYCLES_EVENT_CAP, 256)
+        self.assertIn("as Cycles' do", report.event_cap_words(256))
+        for cap, said in ((0, "10^6"), (None, "10^6"), (1000, "1000")):
+            self.assertIn(f"end after {said} scattering events, Cycles' after 256", report.event_cap_words(cap))
+
     def test_sections_alone_and_bad_choices(self):
         env = {**os.environ, "PYTHONPATH": str(SOURCE_DIR / "python_shim")}
         with tempfile.TemporaryDirectory() as tmp:
@@ -68,7 +77,8 @@ class ReportTest(unittest.TestCase):
                                  (["--cycles-scenes", "cube"], "unknown section, scene or Blender 'cube'"),
                                  (["--cycles-blenders", "bookworm"], "unknown section, scene or Blender 'bookworm'"),
                                  (["--sections", ","], "no section, scene or Blender given"),
-                                 (["--repeats", "0"], "--repeats 0 is outside 1 to 100")):
+                                 (["--repeats", "0"], "--repeats 0 is outside 1 to 100"),
+                                 (["--walk-event-cap", "-1"], "--walk-event-cap -1 is outside 0 to 2147483647")):
                 result = subprocess.run([sys.executable, str(REPORT), "--out", tmp] + bad,
                                         capture_output=True, text=True, env=env, timeout=60)
                 self.assertEqual(result.returncode, 1, bad)
