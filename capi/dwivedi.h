@@ -844,9 +844,13 @@ enum {
  * input = (1 - blend) x input + blend x value; bindings apply in the order they were made (so
  * Blender 3.x's Subsurface Color = mix(Base Color, Subsurface Color, Subsurface) is a Base Color
  * texture bound to DWV_INPUT_SUBSURFACE_COLOR with blend 1 - Subsurface over the material's own
- * Subsurface Color). Normal map: N = normalize(x T + y B + z N_s) with (x, y, z) = 2 rgb - 1,
- * B = sign N_s x T (the mesh's tangents for that UV layer), then normalize(N_s + strength (N - N_s))
- * (Cycles' svm_node_normal_map). Bump (after a normal map, if both): N' = normalize(N - distance
+ * Subsurface Color). Normal map (Cycles' svm_node_normal_map): with (x, y, z) = 2 rgb - 1, T the
+ * mesh's tangent for that UV layer and N_i the vertex normal, both interpolated and not
+ * normalised, B = sign N_i x T and N_s the unit smooth normal, by the binding's bump_shadowing
+ * release: Blender 3.x (DWV_BUMP_SHADOWING_CHIANG2019, and NONE) N = normalize(x T + y B + z N_i),
+ * then normalize(N_s + strength (N - N_s)); Blender 4.0+ (CHIANG2019_MAPPED, CONTY2019) the
+ * strength in tangent space, N = normalize(strength x T + strength y B + (1 + (z - 1)
+ * min(strength, 1)) N_i). Bump (after a normal map, if both): N' = normalize(N - distance
  * grad h) with grad h the height's gradient along the surface, negated by `invert`, then
  * normalize(strength N' + (1 - strength) N) (Cycles' svm_node_set_bump in the limit of small
  * differentials). At most one normal map and one bump per material. */

@@ -340,7 +340,8 @@ def bump_shadowing(version: Tuple[int, ...]) -> str:
     Chiang 2019's shadowing of diffuse lobes, with 3.x's ensure_valid_reflection on every closure
     (4.x applies it to specular closures only; measured against 4.3's Cycles); 5.x Conty Estevez
     2019's (measured against 5.2; the release between 4.3 and 5.2 that changed it is not known
-    here: 5.0 is assumed)."""
+    here: 5.0 is assumed). The library also takes the normal map's Strength rule from it (4.0+
+    scales the map's tangent part, Cycles d71e0f45d; 3.x extrapolates in world space)."""
     version = tuple(version)
     if version < (4, 0, 0):
         return "chiang2019"

@@ -265,7 +265,7 @@ static void exit_light(const dwvb_shader *shader, uint32_t mesh_id, const dwvb_m
     }
     /* Cycles shades the exit as a surface point of its triangle: the same terminator offset. */
     double cutoff = scene->terminator_offsets[mesh_id];
-    dwvl_terminator exit_terminator = {mesh, exit->prim, exit->u, exit->v, cutoff};
+    dwvl_terminator exit_terminator = {mesh, exit->prim, exit->u, exit->v, cutoff, exit_smooth_n};
     const dwvl_terminator *exit_smooth = mesh->normals && cutoff > 0.0 ? &exit_terminator : NULL;
     double exit_top = dwvg_world_top(&scene->geometry, mesh_id, exit->prim);
     int mode = dwvb_textured_bump_shadowing(scene, mesh_id);
@@ -693,7 +693,7 @@ static void shade_point(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec
     /* Shadow rays of smooth-shaded triangles leave from the smooth surface near the terminator,
      * as in Cycles with the mesh's geometry offset (src/light/terminator.h). */
     double cutoff = scene->terminator_offsets[hit->mesh];
-    dwvl_terminator terminator = {mesh, hit->prim, hit->u, hit->v, cutoff};
+    dwvl_terminator terminator = {mesh, hit->prim, hit->u, hit->v, cutoff, smooth_n};
     const dwvl_terminator *smooth = mesh->normals && cutoff > 0.0 ? &terminator : NULL;
     /* The world's top along ng is known for the outward side of the triangle only. */
     double top = ng_flipped ? INFINITY : dwvg_world_top(&scene->geometry, hit->mesh, hit->prim);

@@ -184,8 +184,30 @@ static uint32_t run_position(const dwvb_material_textures *t, const dwvb_scene *
     return 0u;
 }
 
-/* Cycles' svm_node_normal_map, tangent space: N = normalize(x T + y B + z n), (x, y, z) = 2 rgb - 1,
- * B = sign (n x T); then normalize(n + strength (N - n)); n where the result vanishes. */
+/* The interpolated vertex normal at (u, v), not normalised (Cycles'
+ * triangle_smooth_normal_unnormalized), where n (the unit shading normal) is that normal's
+ * direction; n itself where the mesh has no vertex normals or n is the geometric normal in its
+ * place (dwvg_shading_normal: a vertex normal on the far side). */
+static dwvu_vec3 interpolated_normal(const dwvg_mesh *mesh, uint32_t prim, double u, double v, dwvu_vec3 n)
+{
+    if (!mesh->normals) return n;
+    const uint32_t *index = mesh->indices + 3u * (size_t)prim;
+    float corners[9];
+    for (int k = 0; k < 3; ++k)
+        for (int c = 0; c < 3; ++c) corners[3 * k + c] = mesh->normals[3u * (size_t)index[k] + (size_t)c];
+    dwvu_vec3 r = dwvu_v(corner_mix(corners, 3, 0, u, v), corner_mix(corners, 3, 1, u, v), corner_mix(corners, 3, 2, u, v));
+    return dwvu_dot(r, n) > 0.0 ? r : n;
+}
+
+/* Cycles' svm_node_normal_map, tangent space, with (x, y, z) = 2 rgb - 1, T the interpolated
+ * tangent and N the interpolated vertex normal, both not normalised ("get _unnormalized_
+ * interpolated normal and tangent"), B = sign (N x T), n the unit smooth normal (sd->N):
+ * - Blender 3.x (bump_shadowing DWV_BUMP_SHADOWING_CHIANG2019, and NONE):
+ *   M = normalize(x T + y B + z N), then normalize(n + strength (M - n)) where strength != 1;
+ * - Blender 4.0+ (CHIANG2019_MAPPED, CONTY2019; Cycles d71e0f45d, "Normal Map node strength
+ *   interpolation artifacts", in 4.0 to 5.2): the strength in tangent space,
+ *   normalize(strength x T + strength y B + mix(1, z, min(strength, 1)) N).
+ * n where the result vanishes. */
 static dwvu_vec3 normal_map(const dwvb_scene *scene, uint32_t mesh_id, uint32_t layer, const dwvb_binding *b,
                             uint32_t prim, double u, double v, dwvu_vec3 n)
 {
@@ -196,13 +218,21 @@ static dwvu_vec3 normal_map(const dwvb_scene *scene, uint32_t mesh_id, uint32_t 
     dwvu_vec3 tangent = dwvu_v(corner_mix(tangents, 4, 0, u, v), corner_mix(tangents, 4, 1, u, v),
                                corner_mix(tangents, 4, 2, u, v));
     double sign = corner_mix(tangents, 4, 3, u, v);
-    dwvu_vec3 bitangent = dwvu_scale(cross3(n, tangent), sign);
-    dwvu_vec3 mapped = dwvu_add(dwvu_add(dwvu_scale(tangent, 2.0 * rgb[0] - 1.0), dwvu_scale(bitangent, 2.0 * rgb[1] - 1.0)),
-                                dwvu_scale(n, 2.0 * rgb[2] - 1.0));
+    dwvu_vec3 normal = interpolated_normal(&scene->meshes[mesh_id], prim, u, v, n);
+    dwvu_vec3 bitangent = dwvu_scale(cross3(normal, tangent), sign);
+    double x = 2.0 * rgb[0] - 1.0, y = 2.0 * rgb[1] - 1.0, z = 2.0 * rgb[2] - 1.0;
+    int tangent_strength = b->bump_shadowing == DWV_BUMP_SHADOWING_CHIANG2019_MAPPED ||
+                           b->bump_shadowing == DWV_BUMP_SHADOWING_CONTY2019;
+    if (tangent_strength) {
+        x *= b->strength;
+        y *= b->strength;
+        z = 1.0 + (z - 1.0) * fmin(b->strength, 1.0);
+    }
+    dwvu_vec3 mapped = dwvu_add(dwvu_add(dwvu_scale(tangent, x), dwvu_scale(bitangent, y)), dwvu_scale(normal, z));
     double length = dwvu_length(mapped);
     if (!(length > 0.0) || !isfinite(length)) return n;
     mapped = dwvu_scale(mapped, 1.0 / length);
-    if (b->strength != 1.0) {
+    if (!tangent_strength && b->strength != 1.0) {
         mapped = dwvu_madd(n, dwvu_sub(mapped, n), b->strength);
         length = dwvu_length(mapped);
         if (!(length > 0.0)) return n;

@@ -7,12 +7,13 @@
 
 #define INV_PI 0.31830988618379067154
 
-/* The origins of one shading point's shadow rays: x + epsilon ng, moved by a ray's share of the
- * smooth surface's lift (terminator.h), which is computed once, for the first ray that takes some. */
+/* The origins of one shading point's shadow rays: x + epsilon ng, or x - epsilon ng for a ray that
+ * leaves from the other side (shadow_side), moved by a ray's share of the smooth surface's lift
+ * on its side (terminator.h), which is computed once per side, for the first ray that takes some. */
 typedef struct shadow_origins {
     const dwvl_terminator *terminator; /* NULL: a flat-shaded point */
-    dwvu_vec3 n, ng, flat, lift;
-    int have_lift;
+    dwvu_vec3 ng, flat, under, lift[2];
+    int have_lift[2];
     double clear; /* ng.origin above this, rising along ng: the ray meets nothing (clear_of) */
 } shadow_origins;
 
@@ -28,32 +29,52 @@ static int clear_of(const shadow_origins *o, dwvu_vec3 origin, dwvu_vec3 d)
     return dwvu_dot(d, o->ng) > 0.0 && dwvu_dot(origin, o->ng) > o->clear;
 }
 
-/* The share of the lift a shadow ray along unit `light` takes. */
-static double lift_amount(const shadow_origins *o, dwvu_vec3 light)
+/* The side a shadow ray along unit `light` leaves from, as Cycles' shadow_ray_offset (3.x to 5.x,
+ * light/sample.h) decides it by the smooth normal sd->N, not by any normal a normal map or bump
+ * gave the lobes: 0, ng's, where the smooth normal faces the light; 1, the other, where it does
+ * not (Cycles' "transmit": Ng and the lift turned inward, the smooth surface below the flat
+ * triangle). A lobe whose mapped normal faces a light that the smooth normal does not is thus
+ * shadowed by the mesh behind (a closed mesh's own far side), as in Cycles. */
+static int shadow_side(const shadow_origins *o, dwvu_vec3 light)
 {
-    const dwvl_terminator *t = o->terminator;
-    return t ? dwvl_terminator_amount(dwvu_dot(o->n, light), dwvu_dot(o->ng, light), t->cutoff) : 0.0;
+    return o->terminator && dwvu_dot(o->terminator->n, light) < 0.0;
 }
 
-static dwvu_vec3 shadow_origin(shadow_origins *o, double amount)
+/* The share of the lift a shadow ray along unit `light` takes from side `side` (its cosines to the
+ * smooth and the geometric normal both turned to that side). */
+static double lift_amount(const shadow_origins *o, dwvu_vec3 light, int side)
 {
-    if (!(amount > 0.0)) return o->flat;
-    if (!o->have_lift) {
+    const dwvl_terminator *t = o->terminator;
+    if (!t) return 0.0;
+    double cos_n = dwvu_dot(t->n, light), cos_g = dwvu_dot(o->ng, light);
+    return side ? dwvl_terminator_amount(-cos_n, -cos_g, t->cutoff) : dwvl_terminator_amount(cos_n, cos_g, t->cutoff);
+}
+
+/* The origin of the shadow ray along unit `light`; *amount gets the share of the lift it took. */
+static dwvu_vec3 shadow_origin(shadow_origins *o, dwvu_vec3 light, double *amount)
+{
+    int side = shadow_side(o, light);
+    *amount = lift_amount(o, light, side);
+    dwvu_vec3 start = side ? o->under : o->flat;
+    if (!(*amount > 0.0)) return start;
+    if (!o->have_lift[side]) {
         const dwvl_terminator *t = o->terminator;
-        o->lift = dwvl_terminator_lift_at(t->mesh, t->prim, t->u, t->v, o->ng);
-        o->have_lift = 1;
+        o->lift[side] = dwvl_terminator_lift_at(t->mesh, t->prim, t->u, t->v, side ? dwvu_scale(o->ng, -1.0) : o->ng);
+        o->have_lift[side] = 1;
     }
-    return dwvu_madd(o->flat, o->lift, amount);
+    return dwvu_madd(start, o->lift[side], *amount);
 }
 
 /* Whether a light the shading normal faces gets a shadow ray. The lift never goes below the flat
- * triangle. Light above the flat triangle (ng.light > 0) always does: the ray cannot meet its own
- * triangle, so the epsilon does what Cycles' skipping of the triangle itself (its
- * self-intersection test when Ng.L > 0) does. Light below it (ng.light <= 0, the shading normal's
- * terminator lies beyond the flat one's) does only from the smooth surface, as in Cycles: the ray
- * takes the whole lift (dwvl_terminator_amount is 1 there) and, Cycles not skipping its own
- * triangle then, is shadowed where it passes through that triangle. A flat point (no terminator,
- * or cutoff 0) is unlit there: its ray would enter the mesh at once. */
+ * triangle on its side. Light above the flat triangle (ng.light > 0) always does: the ray cannot
+ * meet its own triangle, so the epsilon does what Cycles' skipping of the triangle itself (its
+ * self-intersection test when Ng.L > 0 on the ray's side) does. Light below it (ng.light <= 0,
+ * the shading normal's terminator lies beyond the flat one's) does only from a smooth surface,
+ * as in Cycles: from above (the smooth normal facing the light) the ray takes the whole lift
+ * (dwvl_terminator_amount is 1 there) and, Cycles not skipping its own triangle then, is
+ * shadowed where it passes through that triangle; from below (shadow_side 1) it leaves from
+ * under the triangle. A flat point (no terminator, or cutoff 0) is unlit there: its ray would
+ * enter the mesh at once. */
 static int shadow_ray_allowed(const shadow_origins *o, dwvu_vec3 light)
 {
     return dwvu_dot(o->ng, light) > 0.0 || (o->terminator && o->terminator->cutoff > 0.0);
@@ -64,7 +85,8 @@ static int world_visible(const dwvl_environment *env, shadow_origins *origins, d
 {
     if (!shadow_ray_allowed(origins, w)) return 0;
     if (!env->geometry) return 1;
-    dwvu_vec3 origin = shadow_origin(origins, lift_amount(origins, w));
+    double amount;
+    dwvu_vec3 origin = shadow_origin(origins, w, &amount);
     return clear_of(origins, origin, w) || !dwvg_occluded(env->geometry, origin, w, 0.0, INFINITY);
 }
 
@@ -188,7 +210,8 @@ static void direct_core(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, d
 {
     double plain[3] = {0.0, 0.0, 0.0}, weighted[2][3] = {{0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}};
     double eps = env->geometry ? env->geometry->epsilon : 0.0;
-    shadow_origins origins = {terminator, n, ng, dwvu_madd(x, ng, eps), dwvu_v(0.0, 0.0, 0.0), 0, INFINITY};
+    shadow_origins origins = {terminator, ng, dwvu_madd(x, ng, eps), dwvu_madd(x, ng, -eps),
+                              {dwvu_v(0.0, 0.0, 0.0), dwvu_v(0.0, 0.0, 0.0)}, {0, 0}, INFINITY};
     if (top < INFINITY) {
         /* eps is 2^-17 of the largest coordinate: the margin is 2^-19 of it and of the origin's. */
         double coordinate = fmax(fabs(x.x), fmax(fabs(x.y), fabs(x.z))) + eps;
@@ -210,8 +233,8 @@ static void direct_core(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, d
         if (!shadow_ray_allowed(&origins, s.direction)) continue;
         if (!(s.value[0] > 0.0 || s.value[1] > 0.0 || s.value[2] > 0.0)) continue;
         if (env->geometry) {
-            double amount = lift_amount(&origins, s.direction);
-            dwvu_vec3 origin = shadow_origin(&origins, amount);
+            double amount;
+            dwvu_vec3 origin = shadow_origin(&origins, s.direction, &amount);
             dwvu_vec3 toward = s.direction;
             double distance = s.distance;
             if (amount > 0.0 && isfinite(distance)) {
@@ -245,7 +268,8 @@ static void direct_core(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, d
         dwvu_vec3 w = dwvk_direction_about(n, mu, 1.0 - mu, 1.0 + mu, u[1]);
         int blocked = !shadow_ray_allowed(&origins, w);
         if (!blocked && env->geometry) {
-            dwvu_vec3 origin = shadow_origin(&origins, lift_amount(&origins, w));
+            double amount;
+            dwvu_vec3 origin = shadow_origin(&origins, w, &amount);
             blocked = !clear_of(&origins, origin, w) && dwvg_occluded(env->geometry, origin, w, 0.0, INFINITY);
         }
         if (!blocked) {

@@ -39,7 +39,10 @@ static inline uint32_t dwvl_direct_pairs(const dwvl_environment *env)
  * smooth surface's lift (terminator.h), as Cycles does for smooth-shaded triangles; a light at a
  * finite distance is then aimed at from the moved origin. With a terminator whose cutoff is
  * above 0, light that n faces but the flat triangle does not (ng.light <= 0) is also tested, from
- * the smooth surface, as Cycles does; without one it is taken as shadowed. */
+ * the smooth surface, as Cycles does; without one it is taken as shadowed. The side a shadow ray
+ * leaves from and its share of the lift follow the terminator's smooth normal (Cycles' sd->N in
+ * shadow_ray_offset), not n: where a normal map turned n toward a light that the smooth normal
+ * faces away from, the ray leaves from under the triangle (a closed mesh's far side shadows it). */
 void dwvl_direct(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 n, dwvu_vec3 ng,
                  const dwvl_terminator *terminator, double top, const dwvk_sampler *sampler, uint32_t pair, double out[3]);
 
@@ -84,8 +87,8 @@ typedef struct dwvl_lobes {
     const void *sampling;
 } dwvl_lobes;
 
-/* dwvl_direct_split with each lobe about its own normal (dwvl_lobes), from the same pairs; n, the
- * shading normal the terminator's lift is about, is the diffuse lobes' (normal[1]). */
+/* dwvl_direct_split with each lobe about its own normal (dwvl_lobes), from the same pairs; n (the
+ * Lambertian `plain` sum's normal) is the diffuse lobes' (normal[1]). */
 void dwvl_direct_lobes(const dwvl_environment *env, dwvu_vec3 x, dwvu_vec3 ng, const dwvl_terminator *terminator,
                        double top, const dwvk_sampler *sampler, uint32_t pair, const dwvl_lobes *lobes,
                        double out[2][3]);

@@ -27,6 +27,9 @@ typedef struct dwvl_terminator {
     uint32_t prim;         /* the point's triangle */
     double u, v;           /* the point's barycentrics on it (Embree's) */
     double cutoff;         /* the geometry offset: cosines below it take (part of) the lift; 0: none */
+    /* The smooth normal there (dwvg_shading_normal on the shaded side; Cycles' sd->N), which
+     * decides the lift whatever normal a normal map or bump gave the lobes (shadow_ray_offset). */
+    dwvu_vec3 n;
 } dwvl_terminator;
 
 /* The lift at the point with barycentric weights b[0..2] of the triangle with corners v[0..2] and
@@ -49,7 +52,8 @@ dwvu_vec3 dwvl_terminator_lift(const dwvu_vec3 v[3], const dwvu_vec3 n[3], const
 dwvu_vec3 dwvl_terminator_lift_at(const dwvg_mesh *mesh, uint32_t prim, double u, double v, dwvu_vec3 ng);
 
 /* The share of the lift a shadow ray toward unit direction L takes, with cos_n = N.L >= 0 (the
- * shading normal) and cos_g = Ng.L (the geometric normal on the same side), after Cycles:
+ * smooth normal, dwvl_terminator.n, on the side it faces L from) and cos_g = Ng.L (the geometric
+ * normal on that same side), after Cycles:
  *   cos_n < cutoff:  clamp(2 - (cos_g + cos_n) / cutoff, 0, 1)
  *   otherwise:       clamp(1 - cos_g / cutoff, 0, 1)
  * (continuous at cos_n = cutoff): 1 at grazing light, 0 once the flat triangle faces the light

@@ -176,23 +176,35 @@ def render_and_bake(name, scene, cycles_samples, dwivedi_samples, work, event_ca
 
 
 def compare_two_seeds(cycles_pair, ours_pair):
-    """Cycles' and dwivedi's two-seed images of one scene (RGBA lists) compared: means per
-    channel of the two-seed means, their relative difference, and per channel the noise ratio
-    R = sum (ours - cycles)^2 / sum (var_ours + var_cycles), each side's per-pixel variance of its
-    two-seed mean estimated from the two seeds, (a1 - a2)^2 / 4: 1 in expectation when both
-    estimate the same image, larger with any bias; and the standard error of the difference of
-    the means from the same variances, sqrt(sum (var_ours + var_cycles)) / pixels, relative to
-    Cycles' mean (what the mean test's tolerance must stand well above)."""
-    (c1, c2), (o1, o2) = cycles_pair, ours_pair
-    cycles = [(a + b) / 2 for a, b in zip(c1, c2)]
-    ours = [(a + b) / 2 for a, b in zip(o1, o2)]
+    """Cycles' and dwivedi's two-seed images of one scene (RGBA lists) compared: compare_seeds
+    with two seeds each."""
+    return compare_seeds(cycles_pair, ours_pair)
+
+
+def compare_seeds(cycles_images, ours_images):
+    """Cycles' and dwivedi's images of one scene from k >= 2 seeds each (RGBA lists) compared:
+    means per channel of the k-seed means, their relative difference, and per channel the noise
+    ratio R = sum (ours - cycles)^2 / sum (var_ours + var_cycles), each side's per-pixel variance
+    of its k-seed mean estimated from the k seeds, sum (a_j - mean)^2 / (k (k - 1)) (with two
+    seeds (a1 - a2)^2 / 4): 1 in expectation when both estimate the same image, larger with any
+    bias; and the standard error of the difference of the means from the same variances,
+    sqrt(sum (var_ours + var_cycles)) / pixels, relative to Cycles' mean (what the mean test's
+    tolerance must stand well above). More seeds steady R where a few pixels hold most of the
+    variance (each pixel's estimate has k - 1 degrees of freedom)."""
+    def mean_and_variance(images):
+        k = len(images)
+        mean = [sum(values) / k for values in zip(*images)]
+        variance = [sum((a - m) ** 2 for a in values) / (k * (k - 1)) for values, m in zip(zip(*images), mean)]
+        return mean, variance
+    cycles, var_cycles = mean_and_variance(cycles_images)
+    ours, var_ours = mean_and_variance(ours_images)
     n = len(ours) // 4
     cm = [sum(cycles[c::4]) / n for c in range(3)]
     om = [sum(ours[c::4]) / n for c in range(3)]
     ratios, errors = [], []
     for c in range(3):
         num = sum((ours[i] - cycles[i]) ** 2 for i in range(c, len(ours), 4))
-        den = sum(((o1[i] - o2[i]) ** 2 + (c1[i] - c2[i]) ** 2) / 4 for i in range(c, len(ours), 4))
+        den = sum(var_ours[i] + var_cycles[i] for i in range(c, len(ours), 4))
         ratios.append(num / den if den > 0 else (0.0 if num == 0 else math.inf))
         errors.append(math.sqrt(den) / n / cm[c] if cm[c] > 0 else None)
     return {

@@ -6,11 +6,12 @@ sphere's UV map) and its Normal from a Normal Map node fed by a generated tangen
 map (8-bit Non-Color, through a UV Map node), lit by a sun; once as wax (Blender 3.x Subsurface
 0.5: the walk's colour is mix(Base Color, Subsurface Color, 0.5) per entry point; 4.x+ Subsurface
 Weight 0.5: half Lambertian, half a walk of the Base Color) and once as diffuse (Subsurface 0). Rendered by Cycles and baked by the add-on (with Cycles' cap of 256
-events per walk) twice with different seeds at 32 x 32, then (harness.compare_two_seeds):
+events per walk) twice with different seeds at 32 x 32 (the normal-mapped glossy sphere eight
+times), then (harness.compare_seeds):
 
 - mean radiance per channel within 2%;
 - per-pixel differences consistent with noise: R = sum (ours - cycles)^2 / sum (var_ours +
-  var_cycles), each variance from the two seeds, below 1.5 (1 in expectation);
+  var_cycles), each variance from the seeds, below 1.5 (1 in expectation);
 - the texture memory per texel of the exported scene is printed (3 bytes: two 8-bit RGB images).
 
 A Checker Texture on Base Color is evaluated by Blender (an emission bake into a 256 x 256
@@ -95,13 +96,13 @@ def textured_sphere(resolution, samples, subsurface, base=True, normal=True):
     return scene
 
 
-def compare(name, build):
+def compare(name, build, seeds=(1, 2)):
     scene = build(RESOLUTION, CYCLES_SAMPLES)
-    cycles = [harness.cycles_render(scene, seed, CYCLES_SAMPLES, WORK / f"{name}_cycles_{seed}.exr") for seed in (1, 2)]
+    cycles = [harness.cycles_render(scene, seed, CYCLES_SAMPLES, WORK / f"{name}_cycles_{seed}.exr") for seed in seeds]
     # Cycles' own cap of 256 events per walk (BSSRDF_MAX_BOUNCES), as test_fidelity.py.
     ours = [harness.dwivedi_bake(scene, seed, DWIVEDI_SAMPLES, WORK / f"{name}_dwivedi_{seed}", CYCLES_EVENT_CAP)
-            for seed in (1, 2)]
-    figures = harness.compare_two_seeds([p for p, _ in cycles], [p for p, _ in ours])
+            for seed in seeds]
+    figures = harness.compare_seeds([p for p, _ in cycles], [p for p, _ in ours])
     # The exported scene's texture memory, as the add-on builds it (its own modules and shim).
     addon = harness.addon_module()
     exported = addon.export.export_scene(bpy.context, scene.dwivedi_bake, addon.shim())
@@ -141,11 +142,11 @@ class TexturesTest(harness.unittest.TestCase):
         """A black-based glossy sphere (Roughness 0.35) with the normal map, lit from behind and
         the side: its rim highlight lies where the view is grazing, so 4.x+'s specular normal (kept
         valid for reflection) differs from the mapped one, and the sun lies between their horizons
-        at some pixels: each lobe takes its light about its own normal (Strength 1.5). 3.x has one
-        normal for every closure and is biased there at Strength above 1 (open, issue 18: at 1.5
-        and 4x these samples +1.97%, noise ratio 13.6, a rim pixel 2.40 against Cycles' 2.05; at
-        1.0 +1.73%, 1.96), not at Strength 0 (-0.03%, 1.61 at 4x): 3.x runs at 0.5 (+0.44%, 0.76)."""
-        strength = 1.5 if bpy.app.version >= (4, 0, 0) else 0.5
+        at some pixels: each lobe takes its light about its own normal (Strength 1.5, beyond 1:
+        each release's strength rule, 3.x's world-space extrapolation, 4.0+'s tangent-space
+        scaling). Past the smooth terminator the mapped normal faces the sun: Cycles' shadow ray
+        leaves from under the triangle there (its side is the smooth normal's) and the sphere
+        shadows it (3.4 was +2.0% with the side taken from the mapped normal)."""
         def build(resolution, samples):
             scene = textured_sphere(resolution, samples, 0.0, base=False)
             tree = bpy.data.objects["Sphere"].data.materials[0].node_tree
@@ -155,12 +156,16 @@ class TexturesTest(harness.unittest.TestCase):
             # The scenes' materials have no specular layer: Blender's default level here.
             key = "Specular IOR Level" if "Specular IOR Level" in bsdf.inputs else "Specular"
             bsdf.inputs[key].default_value = 0.5
-            tree.nodes["Normal Map"].inputs["Strength"].default_value = strength
+            tree.nodes["Normal Map"].inputs["Strength"].default_value = 1.5
             sun = next(o for o in scene.objects if o.type == 'LIGHT')
             sun.rotation_euler = (math.radians(70.0), 0.0, math.radians(135.0))
             sun.data.energy = 8.0
             return scene
-        self.check(compare("normal_mapped_glossy", build))
+        # Eight seeds: a few highlight pixels hold most of the variance, so a two-seed estimate
+        # of it (one degree of freedom a pixel) makes R spread widely on an image that agrees
+        # (3.4: 0.34 to 2.36 over four seed pairs; 0.53 from twelve seeds, their pixels' means
+        # within 1.4 standard errors of Cycles').
+        self.check(compare("normal_mapped_glossy", build, seeds=tuple(range(1, 9))))
 
     def test_procedural_base_color(self):
         """A Checker Texture on Base Color: evaluated by Blender into an image (an emission bake

@@ -2,7 +2,8 @@
  * colour input given one channel, a UV layer the mesh lacks, a second normal map), and bakes
  * whose answer is known: a diffuse quad under a sun of irradiance pi seen straight on is its
  * albedo, so a 2 x 2 texture bakes to its texels' mean, a constant normal map tilted by 30
- * degrees gives cos 30 of it (60 degrees: sqrt(0.505), Cycles' ensure_valid_reflection) and a
+ * degrees gives cos 30 of it (60 degrees: sqrt(0.505), Cycles' ensure_valid_reflection; at
+ * Strength 1.5 the normal each Blender release's rule gives, 3.x's and 4.0+'s) and a
  * height ramp of slope s through a bump of distance d gives 1 / sqrt(1 + (d s)^2); and a subsurface slab whose colour texture is A on one half and B on
  * the other bakes each half as the slab of constant colour A or B does (the medium is the entry
  * point's: pixel differences within 5 standard errors, often bit-identical as the same numbers
@@ -214,6 +215,32 @@ static void diffuse_bakes(void)
         r = bake(scene, 8, 2);
         CHECK(r.rgba && fabs(r.mean[0] - 0.8 * cosines[k]) < 2e-4, "normal map tilted %g: %g (%g)", tilts[k], r.mean[0],
               0.8 * cosines[k]);
+        free(r.rgba);
+        dwv_scene_release(scene);
+    }
+
+    /* Strength 1.5 of that 30-degree map (M = (sin 30, 0, cos 30) in the quad's frame), by each
+     * release's rule (Cycles' svm_node_normal_map): 3.x extrapolates in world space,
+     * normalize(n + 1.5 (M - n)); 4.0+ (Cycles d71e0f45d) scales the map's tangent part,
+     * normalize(1.5 sin 30, 0, cos 30). The sun along n is at 0 degrees from the smooth normal:
+     * no bump shadowing term dims it (Chiang's g >= 1, Conty's tan theta_i = 0). */
+    const dwv_bump_shadowing_t releases[3] = {DWV_BUMP_SHADOWING_CHIANG2019, DWV_BUMP_SHADOWING_CHIANG2019_MAPPED,
+                                              DWV_BUMP_SHADOWING_CONTY2019};
+    const double sx = 1.5 * sin(tilts[0]), world_z = 1.0 + 1.5 * (cos(tilts[0]) - 1.0), tangent_z = cos(tilts[0]);
+    const double strengthened[3] = {world_z / hypot(sx, world_z), tangent_z / hypot(sx, tangent_z),
+                                    tangent_z / hypot(sx, tangent_z)};
+    for (int k = 0; k < 3; ++k) {
+        scene = new_scene();
+        material = diffuse_material(scene);
+        const float tilt[3] = {(float)(0.5 + 0.5 * sin(tilts[0])), 0.5f, (float)(0.5 + 0.5 * cos(tilts[0]))};
+        t = add_texture(scene, 1, 1, 3, DWV_INTERPOLATION_LINEAR, DWV_EXTENSION_REPEAT, tilt);
+        dwv_texture_binding_t b = DWV_TEXTURE_BINDING_INIT;
+        b.input = DWV_INPUT_NORMAL_MAP, b.texture_id = t, b.strength = 1.5, b.bump_shadowing = releases[k];
+        CHECK(dwv_scene_bind_texture(scene, material, &b) == DWV_SUCCESS, "bind: %s", dwv_last_error_message());
+        quad_scene(scene, material, NULL, 0, NULL);
+        r = bake(scene, 8, 2);
+        CHECK(r.rgba && fabs(r.mean[0] - 0.8 * strengthened[k]) < 2e-4, "normal map strength 1.5, bump shadowing %d: %g (%g)",
+              (int)releases[k], r.mean[0], 0.8 * strengthened[k]);
         free(r.rgba);
         dwv_scene_release(scene);
     }
