@@ -3,8 +3,27 @@
 #include <math.h>
 #include <string.h>
 
+#include "kernel/exp_batch.h"
 #include "kernel/sheet.h"
 #include "step.h"
+
+/* The loops over a mixture's components and a guide's patches (incident_shares,
+ * component_stretches, grey_denominator) are written for a compiler to vectorise, their
+ * exponentials by dwvk_exp_fast_inner (src/kernel/exp_batch.h); on x86-64 they are compiled
+ * three times, for the baseline (SSE2: two doubles a vector), x86-64-v3 (AVX2: four) and
+ * x86-64-v4 (AVX-512: eight), and the first call picks the copy the processor runs (GCC's
+ * target_clones, an ifunc).
+ * Every copy does the same IEEE operations in the same order: this file is compiled with
+ * -ffp-contract=off (no fused multiply-add, which rounds differently) and -fno-trapping-math
+ * (which lets a select be computed on both sides, changing no value), so a walk is the same to
+ * the last bit on every processor, and the same as before these loops were vectorised (all of
+ * tools/behaviour_hashes.py's hashes; tests/internal/test_exp_batch.c checks the exponentials in
+ * each copy the processor runs), as the lanes' are (src/walk/estimate_lanes.c). */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && __GNUC__ >= 12
+#define DWVW_MIXTURE_CLONES __attribute__((target_clones("default", "arch=x86-64-v3", "arch=x86-64-v4")))
+#else
+#define DWVW_MIXTURE_CLONES
+#endif
 
 /* Two axes whose cosine is at least this are one component's (add_component). */
 #define DWVW_SAME_AXIS_COSINE (1.0 - 1e-12)
@@ -67,6 +86,18 @@ void dwvw_guide_init(dwvw_guide *guide, dwvw_technique technique, const dwvw_med
         guide->patches[i] = patches[i];
         guide->patches[i].log_power = log(patches[i].power);
         guide->patch_frames[i] = dwvu_frame_about(guide->patches[i].normal);
+        const dwvu_vec3 point = guide->patches[i].point, normal = guide->patches[i].normal;
+        guide->patch_point[0][i] = point.x, guide->patch_point[1][i] = point.y, guide->patch_point[2][i] = point.z;
+        guide->patch_normal[0][i] = normal.x, guide->patch_normal[1][i] = normal.y, guide->patch_normal[2][i] = normal.z;
+        guide->patch_log_power[i] = guide->patches[i].log_power;
+        guide->patch_is_plane[i] = guide->patches[i].is_plane != 0;
+    }
+    /* The rest, up to DWVW_MAX_PATCHES, which incident_shares' loops run over: a plane through the
+     * origin of log power -infinity, its weight's logarithm -infinity wherever a walk is. */
+    for (int i = guide->patch_count; i < DWVW_MAX_PATCHES; ++i) {
+        for (int c = 0; c < 3; ++c) guide->patch_point[c][i] = guide->patch_normal[c][i] = 0.0;
+        guide->patch_log_power[i] = -INFINITY;
+        guide->patch_is_plane[i] = 1;
     }
     guide->patches_distinct = 1;
     for (int i = 0; i < guide->patch_count; ++i)
@@ -166,6 +197,11 @@ void dwvw_walk_begin(dwvw_walk *walk, const dwvw_medium *medium, const dwvw_guid
     walk->closest_normal = normal;
     walk->step_distance = 0.0;
     walk->component_count = 0;
+    /* every slot defined: grey_denominator's loop runs over all of them */
+    for (int k = 0; k < DWVW_MAX_COMPONENTS; ++k) {
+        walk->component_q[k] = 0.0;
+        walk->component_pdf[k] = walk->component_stretch[k] = 1.0;
+    }
     /* Closest aims at a new point, and several patches are weighed anew, at every event; backward
      * from the event after its probe found the opposite interface (dwvw_walk_complete). Otherwise
      * the components depend on nothing that moves: build_components gives the same at every event. */
@@ -189,33 +225,45 @@ void dwvw_walk_set_closest(dwvw_walk *walk, dwvu_vec3 normal)
     walk->closest_known = 1;
 }
 
+static dwvu_vec3 component_axis(const dwvw_walk *walk, int k)
+{
+    return dwvu_v(walk->component_axis[0][k], walk->component_axis[1][k], walk->component_axis[2][k]);
+}
+
+/* Appends component `q`, `axis`, taking patch `patch`'s frame (or -1). */
+static void append_component(dwvw_walk *walk, double q, dwvu_vec3 axis, int patch)
+{
+    const int k = walk->component_count++;
+    walk->component_q[k] = q;
+    walk->component_axis[0][k] = axis.x, walk->component_axis[1][k] = axis.y, walk->component_axis[2][k] = axis.z;
+    walk->component_patch[k] = patch;
+}
+
 /* Adds a guided component, or its weight to one with the same axis: the mixture is the same, and
  * every component costs a pdf and an exponential per channel at every event. */
 static void add_component(dwvw_walk *walk, double q, dwvu_vec3 axis)
 {
     if (!(q > 0.0)) return;
     for (int k = 1; k < walk->component_count; ++k) {
-        if (dwvu_dot(walk->component_axis[k], axis) >= DWVW_SAME_AXIS_COSINE) {
+        if (dwvu_dot(component_axis(walk, k), axis) >= DWVW_SAME_AXIS_COSINE) {
             walk->component_q[k] += q;
             return;
         }
     }
     if (walk->component_count >= DWVW_MAX_COMPONENTS) return;
-    walk->component_q[walk->component_count] = q;
-    walk->component_axis[walk->component_count] = axis;
-    walk->component_patch[walk->component_count] = -1;
-    ++walk->component_count;
+    append_component(walk, q, axis, -1);
 }
 
 /* Patches whose weight is below this share of the largest patch's are left out of a step's
  * mixture (add_incident_components). */
 #define DWVW_PATCH_PRUNE_LOG (-6.931471805599453) /* log(1e-3) */
 
-/* The incident technique's patch weights: power_j exp(-sigma_t d_j / v), normalised in the log
- * domain so that distant patches do not underflow all at once.
+/* The incident technique's patch weights w_j = power_j exp(-sigma_t d_j / v), normalised in the
+ * log domain so that distant patches do not underflow all at once, and their shares
+ * q w_j / sum w of the incident weight q (add_incident_components).
  *
- * A patch whose weight is below 1e-3 of the largest one's is left out (its exponential not
- * taken): each component costs a stretch, a pdf and three exponentials per channel at every
+ * A patch whose weight is below 1e-3 of the largest one's is left out (its weight 0, no
+ * component made): each component costs a stretch, a pdf and three exponentials per channel at every
  * event, and inside a thick mesh most patches are many mean free paths farther than the nearest
  * (exp(-sigma_t d / v) below 1e-3 is 6.9 / kappa mean free paths farther), guiding a share below
  * 1e-3 of the incident weight each. The estimate stays unbiased: the step samples the mixture it
@@ -224,6 +272,42 @@ static void add_component(dwvw_walk *walk, double q, dwvu_vec3 axis)
  * the same as with every patch (exp underflowing to 0 already left out patches at 1e-308). The
  * weights' exponentials are fastmath.h's (5e-16 relative: they only set the mixture's shares),
  * about half libm's instructions. */
+static DWVW_MIXTURE_CLONES void incident_shares(const dwvw_guide *guide, dwvu_vec3 position, double decay, double q,
+                                                 double share[DWVW_MAX_PATCHES])
+{
+    /* The loops without a sum run over every slot, the guide's unused ones too (dwvw_guide_init
+     * fills them), and are vectorised without a remainder; the sums over the patches alone. */
+    const int n = guide->patch_count;
+    double log_w[DWVW_MAX_PATCHES], w[DWVW_MAX_PATCHES], largest = -INFINITY;
+    for (int j = 0; j < DWVW_MAX_PATCHES; ++j) {
+        /* the plane's and the point's distances both formed, one taken (the same bits as a branch) */
+        double x = position.x - guide->patch_point[0][j], y = position.y - guide->patch_point[1][j],
+               z = position.z - guide->patch_point[2][j];
+        double along = fabs(x * guide->patch_normal[0][j] + y * guide->patch_normal[1][j] + z * guide->patch_normal[2][j]);
+        double length = sqrt(x * x + y * y + z * z);
+        log_w[j] = guide->patch_log_power[j] - decay * (guide->patch_is_plane[j] ? along : length);
+    }
+    for (int j = 0; j < n; ++j) largest = log_w[j] > largest ? log_w[j] : largest; /* not NaN: no libm fmax */
+    /* Every patch's exponential taken (a pruned one's too, and not used), then dwvk_exp_fast where
+     * a kept patch's argument was beyond the fast range (a NaN: the value the scalar loop gave). */
+    int edges = 0;
+    for (int j = 0; j < DWVW_MAX_PATCHES; ++j) {
+        double relative = log_w[j] - largest;
+        double e = dwvk_exp_fast_inner(relative);
+        int pruned = relative < DWVW_PATCH_PRUNE_LOG;
+        edges |= dwvk_exp_fast_is_edge(relative) & !pruned & (j < n);
+        w[j] = pruned ? 0.0 : e;
+    }
+    if (edges)
+        for (int j = 0; j < n; ++j) {
+            double relative = log_w[j] - largest;
+            w[j] = relative < DWVW_PATCH_PRUNE_LOG ? 0.0 : dwvk_exp_fast(relative);
+        }
+    double sum = 0.0;
+    for (int j = 0; j < n; ++j) sum += w[j];
+    for (int j = 0; j < DWVW_MAX_PATCHES; ++j) share[j] = q * w[j] / sum;
+}
+
 static void add_incident_components(dwvw_walk *walk, double q)
 {
     const dwvw_guide *guide = walk->guide;
@@ -233,35 +317,19 @@ static void add_incident_components(dwvw_walk *walk, double q)
         return;
     }
     double decay = m->sigma_t[m->guide_channel] * m->dwivedi.kappa; /* sigma_t / v */
-    double log_w[DWVW_MAX_PATCHES], largest = -INFINITY;
-    for (int j = 0; j < guide->patch_count; ++j) {
-        const dwvw_light_patch *patch = &guide->patches[j];
-        dwvu_vec3 offset = dwvu_sub(walk->position, patch->point);
-        double distance = patch->is_plane ? fabs(dwvu_dot(offset, patch->normal)) : dwvu_length(offset);
-        log_w[j] = patch->log_power - decay * distance;
-        largest = log_w[j] > largest ? log_w[j] : largest; /* not NaN: no call to libm's fmax */
-    }
-    double sum = 0.0, w[DWVW_MAX_PATCHES];
-    for (int j = 0; j < guide->patch_count; ++j) {
-        double relative = log_w[j] - largest;
-        sum += (w[j] = relative < DWVW_PATCH_PRUNE_LOG ? 0.0 : dwvk_exp_fast(relative));
-    }
+    double share[DWVW_MAX_PATCHES];
+    incident_shares(guide, walk->position, decay, q, share);
     if (guide->patches_distinct && walk->component_count == 1) {
         /* Only the classical component before them, and no two patches merge: add_component's
          * search for a component of the same axis (all patches against all, per event) would find
          * none, so each patch of weight > 0 takes the next component, as there, and its frame is
          * the guide's. */
         for (int j = 0; j < guide->patch_count; ++j) {
-            double share = q * w[j] / sum;
-            if (!(share > 0.0)) continue;
-            walk->component_q[walk->component_count] = share;
-            walk->component_axis[walk->component_count] = guide->patches[j].normal;
-            walk->component_patch[walk->component_count] = j;
-            ++walk->component_count;
+            if (share[j] > 0.0) append_component(walk, share[j], guide->patches[j].normal, j);
         }
         return;
     }
-    for (int j = 0; j < guide->patch_count; ++j) add_component(walk, q * w[j] / sum, guide->patches[j].normal);
+    for (int j = 0; j < guide->patch_count; ++j) add_component(walk, share[j], guide->patches[j].normal);
 }
 
 static void build_components(dwvw_walk *walk)
@@ -447,6 +515,35 @@ static double sheet_sample(dwvw_walk *walk, int channel, const double *choice, f
     return walk->step_distance;
 }
 
+/* Every guided component's stretch and direction pdf at the walk's sampled direction (the pdf is
+ * 1 for all on the first step, whose direction was not sampled): p(mu) / (2 pi) = a / (4 pi
+ * stretch). */
+static DWVW_MIXTURE_CLONES void component_stretches(dwvw_walk *walk)
+{
+    const dwvw_medium *m = walk->medium;
+    const double kappa = m->dwivedi.kappa, one_minus_kappa = m->dwivedi.one_minus_kappa;
+    const double pdf_scale = m->guided_pdf_scale;
+    const dwvu_vec3 d = walk->direction;
+    const int count = walk->component_count;
+    const double *restrict x = walk->component_axis[0], *restrict y = walk->component_axis[1],
+                           *restrict z = walk->component_axis[2];
+    double *restrict stretch = walk->component_stretch, *restrict pdf = walk->component_pdf;
+    for (int k = 1; k < count; ++k) {
+        /* dwvk_dwivedi_stretch_d, both sides formed and one taken by a bit mask (the same bits):
+         * across a mixture's axes the cosine's sign is a coin toss, and as a branch (which GCC
+         * makes of a select of doubles) it was mispredicted, the hottest spot of
+         * dwvw_walk_sample on the benchmark's torus (perf). The pdf's division in a loop of its
+         * own, without the first step's case in it: a division under a condition is control flow
+         * the vectoriser leaves alone (it may not compute it where the condition is false). */
+        double mu = dwvw_clamp_cosine(d.x * x[k] + d.y * y[k] + d.z * z[k]); /* dwvw_cosine's sum, in its order */
+        stretch[k] = select_nonnegative(mu, one_minus_kappa + kappa * (1.0 - mu), 1.0 - kappa * mu);
+    }
+    if (walk->events > 0)
+        for (int k = 1; k < count; ++k) pdf[k] = pdf_scale / stretch[k];
+    else
+        for (int k = 1; k < count; ++k) pdf[k] = 1.0;
+}
+
 double dwvw_walk_sample(dwvw_walk *walk)
 {
     const dwvw_medium *m = walk->medium;
@@ -507,34 +604,18 @@ double dwvw_walk_sample(dwvw_walk *walk)
             /* a patch's frame is the guide's (the same bits: a frame is a function of its axis) */
             int patch = walk->component_patch[chosen];
             const dwvu_frame *frame = patch >= 0 ? &walk->guide->patch_frames[patch]
-                                                 : frame_about_axis(walk, walk->component_axis[chosen]);
+                                                 : frame_about_axis(walk, component_axis(walk, chosen));
             walk->direction = dwvw_guided_direction(frame, &m->dwivedi_event, u);
         }
         walk->phase = dwvw_phase_value(g, previous, walk->direction);
     } else {
         walk->phase = 1.0;
     }
-    /* Every component's direction pdf and stretch at the sampled direction (the pdf is 1 for all
-     * on the first step, whose direction was not sampled): p(mu) / (2 pi) = a / (4 pi stretch). */
+    /* Every component's direction pdf and stretch at the sampled direction: the classical one's
+     * the phase function's, the guided ones' component_stretches'. */
     walk->component_pdf[0] = walk->phase;
     walk->component_stretch[0] = 1.0;
-    const double kappa = m->dwivedi.kappa, one_minus_kappa = m->dwivedi.one_minus_kappa;
-    const double pdf_scale = m->guided_pdf_scale;
-    const int count = walk->component_count;
-    for (int k = 1; k < count; ++k) {
-        /* dwvk_dwivedi_stretch_d, both sides formed and one taken by a bit mask (the same bits):
-         * across a mixture's axes the cosine's sign is a coin toss, and as a branch (which GCC
-         * makes of a select of doubles) it was mispredicted, the hottest spot of
-         * dwvw_walk_sample on the benchmark's torus (perf). The pdf's division in a loop of its
-         * own, without the first step's case in it: a division under a condition is control flow
-         * the vectoriser leaves alone (it may not compute it where the condition is false). */
-        double mu = dwvw_cosine(walk->direction, walk->component_axis[k]);
-        walk->component_stretch[k] = select_nonnegative(mu, one_minus_kappa + kappa * (1.0 - mu), 1.0 - kappa * mu);
-    }
-    if (walk->events > 0)
-        for (int k = 1; k < count; ++k) walk->component_pdf[k] = pdf_scale / walk->component_stretch[k];
-    else
-        for (int k = 1; k < count; ++k) walk->component_pdf[k] = 1.0;
+    component_stretches(walk);
     float u_distance = stratified ? flight_distance : dwvk_rng_uniform_f(walk->key, dim + DWVW_DIM_DISTANCE);
     walk->step_distance = dwvw_flight(m->sigma_t[channel] * walk->component_stretch[chosen], u_distance);
     return walk->step_distance;
@@ -679,6 +760,39 @@ static void sheet_weight_update(dwvw_walk *walk, double t, int exited)
     }
 }
 
+/* The sum of a grey step's dwvw_grey_term over the walk's components (Q p formed as
+ * mixture_weight_update forms it), in component order, the components of Q p = 0 left out: every
+ * slot's term formed in a vectorised loop over all DWVW_MAX_COMPONENTS slots (dwvw_walk_begin
+ * fills the unused ones; dwvw_grey_decay's exponential by dwvk_exp_fast_inner, taken where it is
+ * not needed too, then dwvw_grey_decay itself where a used argument was beyond its fast range),
+ * and the sum then formed in order (a left-out term adds +0 to a sum that is +0 or more: the same
+ * bits as skipping it). */
+static DWVW_MIXTURE_CLONES double grey_denominator(const dwvw_walk *walk, double sigma_t, double t, int exited)
+{
+    const int n = walk->component_count;
+    const double *restrict q = walk->component_q, *restrict pdf = walk->component_pdf,
+                           *restrict stretch = walk->component_stretch;
+    double term[DWVW_MAX_COMPONENTS];
+    int edges = 0;
+    for (int k = 0; k < DWVW_MAX_COMPONENTS; ++k) {
+        double qp = q[k] * pdf[k];
+        double argument = sigma_t * (1.0 - stretch[k]) * t; /* dwvw_grey_decay's */
+        double e = dwvk_exp_fast_inner(argument);
+        double decay = stretch[k] == 1.0 ? 1.0 : e;
+        int used = (k < n) & (qp > 0.0);
+        edges |= dwvk_exp_fast_is_edge(argument) & used;
+        term[k] = used ? dwvw_grey_term(qp, stretch[k], decay, exited) : 0.0;
+    }
+    if (edges)
+        for (int k = 0; k < n; ++k) {
+            double qp = q[k] * pdf[k];
+            term[k] = qp > 0.0 ? dwvw_grey_term(qp, stretch[k], dwvw_grey_decay(sigma_t, stretch[k], t), exited) : 0.0;
+        }
+    double denominator = 0.0;
+    for (int k = 0; k < n; ++k) denominator += term[k];
+    return denominator;
+}
+
 /* The weight update of a step of Dwivedi and classical components (every technique but sheet). */
 static void mixture_weight_update(dwvw_walk *walk, double t, int exited)
 {
@@ -693,22 +807,22 @@ static void mixture_weight_update(dwvw_walk *walk, double t, int exited)
         first = walk->single_component;
         end = first + 1;
     }
-    double qp[DWVW_MAX_COMPONENTS];
-    for (int k = first; k < end; ++k) qp[k] = walk->component_q[k] * walk->component_pdf[k];
     if (m->channels == 1) {
         /* Grey medium: one channel, P = 1. */
-        double sigma_t = m->sigma_t[0], denominator = 0.0;
-        for (int k = first; k < end; ++k) {
-            if (!(qp[k] > 0.0)) continue;
-            double stretch = walk->component_stretch[k];
-            denominator += dwvw_grey_term(qp[k], stretch, dwvw_grey_decay(sigma_t, stretch, t), exited);
+        double denominator = 0.0;
+        if (walk->single_component >= 0) {
+            double qp = walk->component_q[first] * walk->component_pdf[first], stretch = walk->component_stretch[first];
+            if (qp > 0.0) denominator = dwvw_grey_term(qp, stretch, dwvw_grey_decay(m->sigma_t[0], stretch, t), exited);
+        } else {
+            denominator = grey_denominator(walk, m->sigma_t[0], t, exited);
         }
         walk->weight[0] *= dwvw_grey_ratio(walk->phase, m->albedo[0], denominator, exited);
-    } else if (walk->single_component >= 0) {
-        rgb_weight_update_single(walk, qp[first], walk->component_stretch[first], t, exited);
-    } else {
-        rgb_weight_update(walk, qp, first, end, t, exited);
+        return;
     }
+    double qp[DWVW_MAX_COMPONENTS];
+    for (int k = first; k < end; ++k) qp[k] = walk->component_q[k] * walk->component_pdf[k];
+    if (walk->single_component >= 0) rgb_weight_update_single(walk, qp[first], walk->component_stretch[first], t, exited);
+    else rgb_weight_update(walk, qp, first, end, t, exited);
 }
 
 double dwvw_walk_probe_reach(const dwvw_walk *walk)

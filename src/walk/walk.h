@@ -124,6 +124,12 @@ typedef struct dwvw_guide {
     dwvw_light_patch patches[DWVW_MAX_PATCHES];
     int patches_distinct; /* no two patch normals as close as a component's merge (dwvw_guide_init) */
     dwvu_frame patch_frames[DWVW_MAX_PATCHES]; /* dwvu_frame_about of each patch's normal, made once */
+    /* The patches' points, normals, log powers and kinds again, by coordinate (copied by
+     * dwvw_guide_init), for the patch weights' loop over patches, which a compiler vectorises
+     * (walk.c, incident_weights). */
+    double patch_point[3][DWVW_MAX_PATCHES], patch_normal[3][DWVW_MAX_PATCHES];
+    double patch_log_power[DWVW_MAX_PATCHES];
+    int64_t patch_is_plane[DWVW_MAX_PATCHES]; /* 64 bits, as the doubles it selects between */
 } dwvw_guide;
 
 typedef enum dwvw_status {
@@ -175,7 +181,9 @@ typedef struct dwvw_walk {
     int components_vary;                            /* rebuilt at every event (else kept) */
     int single_component;                           /* the only component with q > 0, else -1 */
     double component_q[DWVW_MAX_COMPONENTS];
-    dwvu_vec3 component_axis[DWVW_MAX_COMPONENTS]; /* unused for component 0 (classical) */
+    /* the components' axes by coordinate (x, y, z), for the loop of cosines over components,
+     * which a compiler vectorises (walk.c, component_stretches); unused for component 0 (classical) */
+    double component_axis[3][DWVW_MAX_COMPONENTS];
     int component_patch[DWVW_MAX_COMPONENTS];      /* the patch whose frame it takes (the guide's), or -1 */
     double component_pdf[DWVW_MAX_COMPONENTS];     /* direction pdf per steradian */
     double component_stretch[DWVW_MAX_COMPONENTS];
