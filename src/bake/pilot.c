@@ -85,12 +85,32 @@
 #define PILOT_COST_PATH_RAY 7900.0
 /* Pilot samples per candidate: a sixteenth of the bake's samples, at most PILOT_MAX (the first
  * quarter of them for every candidate, the rest for those not clearly worse: pilot_survivors); below
- * PILOT_MIN the estimate is too noisy to act on and auto keeps its mixture. A mesh needs
- * PILOT_MESH_MIN of them to be decided (of the blocks run: a quarter of it where one candidate is
- * left after the first blocks, which then is the pick). */
+ * PILOT_MIN the estimate is too noisy to act on and auto keeps its mixture. */
 #define PILOT_MAX 4096u
 #define PILOT_MIN 256u
-#define PILOT_MESH_MIN 64.0
+
+/* The pilot's variance is the image's: that of a pixel's mean over its stratified samples, not
+ * that of one sample. A pixel's samples are stratified (dwvb_bake_sample, kernel/sampler.h: pixel
+ * position, entry, lights and the walk's first events), and stratification removes more variance
+ * from some candidates than from others: on the benchmark's bowl, one sample per random pixel (the
+ * pilot before) gave backward with channel walks 0.76x incident shared's variance, the 32-spp
+ * images 1.10x, and auto took the wrong one (docs/speed.md). So the pilot shades pixel groups: a
+ * random pixel's first G samples as the bake takes them (two stratified replicates, even and odd
+ * samples, of G / 2 each, in a stream of the group's own), G the bake's samples per pixel up to
+ * PILOT_GROUP_MAX; the group's variance per sample in the image is G / 4 (m0 - m1)^2 per channel,
+ * m0 and m1 the replicates' means (their difference has twice a replicate mean's variance, the
+ * pixel's mean half of it: as the bake's error estimate, pixel_sums.c), averaged over the groups.
+ * Beyond PILOT_GROUP_MAX samples per pixel the pilot rates the variance at that many (a net's
+ * variance falls further with more samples, alike for the candidates where the integrand is alike).
+ * A group is at most a PILOT_MIN_GROUPS-th of the pilot's samples, so that the mean over groups
+ * has some PILOT_MIN_GROUPS terms; and a mesh needs PILOT_MESH_MIN_GROUPS groups that saw it to be
+ * decided (in the first blocks where one candidate is left after them, which then is the pick).
+ * Unlike one sample per pixel, the groups' estimate holds no spread of the pixels' means across the
+ * image (the picture itself, the same for every candidate, which pulled the pilot's ratios toward
+ * 1). */
+#define PILOT_GROUP_MAX 32u
+#define PILOT_MIN_GROUPS 64u
+#define PILOT_MESH_MIN_GROUPS 16.0
 
 /* The candidates, in the order of the pilot (a tie keeps the earlier, cheaper one): the four
  * techniques with the channels walked together, then the same with one walk per channel. */
@@ -123,7 +143,7 @@ enum { PILOT_CLASSICAL = 0, PILOT_ENTRY = 1, PILOT_GUIDED = 2, PILOT_SHEET = 3 }
 #define PILOT_TAIL_SHARE 0.25
 #define PILOT_TAIL_RATIO 10.0
 
-/* The standard errors of a variance estimate (block_spread) either side of it that bound it in
+/* The standard errors of a variance estimate (group_spread) either side of it that bound it in
  * pilot_survivors. The choice among the candidates left takes the estimate itself: taking its upper
  * bound instead (2 standard errors) changed no pick on the benchmark's scenes at 48 x 48 pixels,
  * 32 spp, seeds 1-4 (docs/speed.md). */
@@ -229,9 +249,12 @@ static int sheet_may_win(const dwvb_scene *scene, uint32_t m)
 }
 
 typedef struct pilot_sums {
-    double count, sum[3], sum_squares[3], largest[3], cost;
+    double count, sum_squares[3], largest[3], cost; /* over the samples that saw the mesh */
     double channel_cost[3]; /* of the cost, the channel walks' own, by channel */
-    double variance_error[3]; /* the standard error of the channel's variance estimate (block_spread) */
+    /* Over the pixel groups that saw the mesh: their count, and per channel the sum of their
+     * variances per sample (group_variance) and of those squared. */
+    double groups, variance_sum[3], variance_squares[3];
+    double variance_error[3]; /* the standard error of the channel's variance estimate (group_spread) */
 } pilot_sums;
 
 static uint64_t active_pixels(const dwvb_bake *bake)
@@ -241,10 +264,11 @@ static uint64_t active_pixels(const dwvb_bake *bake)
     return active;
 }
 
-/* The pilot's samples are cut into PILOT_BLOCKS fixed blocks that the bake's threads share; each
- * block sums its samples in order and the blocks are added in block order, so the sums, the choice
- * and the image are the same for any thread count. On one thread the pilot would be serial work
- * beside the passes (a few percent of a short bake: Amdahl's law on the 1 -> 2 thread speed-up). */
+/* The pilot's pixel groups are cut into PILOT_BLOCKS fixed blocks that the bake's threads share;
+ * each block sums its groups in order and the blocks are added in block order, so the sums, the
+ * choice and the image are the same for any thread count. On one thread the pilot would be serial
+ * work beside the passes (a few percent of a short bake: Amdahl's law on the 1 -> 2 thread
+ * speed-up). */
 #define PILOT_BLOCKS 64u
 
 typedef struct pilot_run {
@@ -253,88 +277,107 @@ typedef struct pilot_run {
     const int *candidates;      /* the candidates run (PILOT_*), candidate_count of them */
     int candidate_count;
     pilot_sums *block_sums;     /* [block][candidate][mesh] */
-    uint32_t samples, meshes;
+    uint32_t groups, group_size, meshes; /* pixel groups of group_size samples (even, <= PILOT_GROUP_MAX) */
     uint32_t end_block;         /* the blocks run: next_block's first value to end_block - 1 */
     atomic_uint next_block;
     atomic_int stopped;
 } pilot_run;
+
+/* A mesh's share of one pixel group: the sums of its samples' values in each replicate (samples
+ * that saw another mesh or none add 0 to it: the mesh's part of the pixel's mean). */
+typedef struct group_part {
+    uint32_t mesh;
+    double replicate_sum[REPLICATES][3];
+} group_part;
+
+/* The variance per sample in the image of a group of `size` samples (two replicates of size / 2)
+ * whose replicate sums are `part`'s, for channel c: size x the variance of the pixel's mean,
+ * estimated by (m0 - m1)^2 / 4 (E (m0 - m1)^2 = 2 Var m_r, and the mean of both has half Var m_r). */
+static double group_variance(const group_part *part, uint32_t size, int c)
+{
+    double replicate = 0.5 * size, difference = (part->replicate_sum[0][c] - part->replicate_sum[1][c]) / replicate;
+    return 0.25 * size * difference * difference;
+}
 
 static void *pilot_worker(void *arg)
 {
     pilot_run *run = arg;
     dwvb_bake *bake = run->bake;
     uint64_t pixels = (uint64_t)bake->width * bake->height;
+    group_part parts[PILOT_GROUP_MAX]; /* of one group, one per mesh its samples saw, in the order seen */
     for (;;) {
         uint32_t block = atomic_fetch_add(&run->next_block, 1u);
         if (block >= run->end_block || atomic_load(&run->stopped)) break;
-        uint32_t first = (uint32_t)((uint64_t)run->samples * block / PILOT_BLOCKS);
-        uint32_t end = (uint32_t)((uint64_t)run->samples * (block + 1u) / PILOT_BLOCKS);
+        uint32_t first = (uint32_t)((uint64_t)run->groups * block / PILOT_BLOCKS);
+        uint32_t end = (uint32_t)((uint64_t)run->groups * (block + 1u) / PILOT_BLOCKS);
         pilot_sums *sums = &run->block_sums[(size_t)block * PILOT_CANDIDATES * run->meshes];
         /* The same pixel samples for every candidate. */
         for (int k = 0; k < run->candidate_count; ++k) {
             int candidate = run->candidates[k];
-            for (uint32_t i = first; i < end; ++i) {
-                if (dwvb_bake_must_stop(bake)) {
-                    atomic_store(&run->stopped, 1);
-                    return NULL;
-                }
-                uint32_t index = (uint32_t)(dwvk_rng_u64(dwvk_rng_key(bake->options.seed, PILOT_STREAM, i), 0u) % pixels);
+            for (uint32_t g = first; g < end; ++g) {
+                uint32_t index = (uint32_t)(dwvk_rng_u64(dwvk_rng_key(bake->options.seed, PILOT_STREAM, g), 0u) % pixels);
                 if (!dwvb_bake_pixel_active(bake, index)) continue;
-                double rgb[3], alpha;
-                dwvb_shade_parts parts;
-                uint32_t mesh;
-                dwvb_tally tally = {0};
-                dwvb_bake_sample(bake, &run->shaders[candidate], PILOT_STREAM, index, i, &parts, rgb, &alpha, &mesh, &tally);
-                if (mesh == UINT32_MAX || !bake->auto_choice[mesh]) continue;
-                pilot_sums *p = &sums[(size_t)candidate * run->meshes + mesh];
-                p->count += 1.0;
-                for (int c = 0; c < 3; ++c) {
-                    p->sum[c] += rgb[c];
-                    p->sum_squares[c] += rgb[c] * rgb[c];
-                    p->largest[c] = fmax(p->largest[c], fabs(rgb[c]));
+                /* A stream per group: a pixel drawn twice gets independent scrambles and walks.
+                 * Bits 32-60, clear of the pixel index and the stream bits (g < PILOT_MAX). */
+                uint64_t stream = PILOT_STREAM | (uint64_t)g << 32;
+                uint32_t part_count = 0;
+                for (uint32_t s = 0; s < run->group_size; ++s) {
+                    if (dwvb_bake_must_stop(bake)) {
+                        atomic_store(&run->stopped, 1);
+                        return NULL;
+                    }
+                    double rgb[3], alpha;
+                    dwvb_shade_parts shade_parts;
+                    uint32_t mesh;
+                    dwvb_tally tally = {0};
+                    dwvb_bake_sample(bake, &run->shaders[candidate], stream, index, s, &shade_parts, rgb, &alpha, &mesh, &tally);
+                    if (mesh == UINT32_MAX || !bake->auto_choice[mesh]) continue;
+                    uint32_t j = 0;
+                    while (j < part_count && parts[j].mesh != mesh) ++j;
+                    if (j == part_count) parts[part_count++] = (group_part){.mesh = mesh};
+                    pilot_sums *p = &sums[(size_t)candidate * run->meshes + mesh];
+                    p->count += 1.0;
+                    for (int c = 0; c < 3; ++c) {
+                        parts[j].replicate_sum[s % REPLICATES][c] += rgb[c];
+                        p->sum_squares[c] += rgb[c] * rgb[c];
+                        p->largest[c] = fmax(p->largest[c], fabs(rgb[c]));
+                    }
+                    double event_cost = PILOT_COST_EVENT + (candidate % PILOT_TECHNIQUES == PILOT_CLASSICAL ? 0.0 : PILOT_COST_GUIDED_EVENT);
+                    p->cost += PILOT_COST_SAMPLE + PILOT_COST_WALK * (double)tally.walks + event_cost * (double)tally.events +
+                               PILOT_COST_RAY * (double)tally.rays +
+                               PILOT_COST_QUERY * (double)tally.point_queries + PILOT_COST_TERM * (double)tally.mixture_terms +
+                               PILOT_COST_PATH_RAY * (double)tally.path_rays;
+                    for (int c = 0; c < 3; ++c)
+                        p->channel_cost[c] += PILOT_COST_WALK * (double)tally.channel_walks[c] +
+                                              event_cost * (double)tally.channel_events[c] +
+                                              PILOT_COST_TERM * (double)tally.channel_terms[c];
                 }
-                double event_cost = PILOT_COST_EVENT + (candidate % PILOT_TECHNIQUES == PILOT_CLASSICAL ? 0.0 : PILOT_COST_GUIDED_EVENT);
-                p->cost += PILOT_COST_SAMPLE + PILOT_COST_WALK * (double)tally.walks + event_cost * (double)tally.events +
-                           PILOT_COST_RAY * (double)tally.rays +
-                           PILOT_COST_QUERY * (double)tally.point_queries + PILOT_COST_TERM * (double)tally.mixture_terms +
-                           PILOT_COST_PATH_RAY * (double)tally.path_rays;
-                for (int c = 0; c < 3; ++c)
-                    p->channel_cost[c] += PILOT_COST_WALK * (double)tally.channel_walks[c] +
-                                          event_cost * (double)tally.channel_events[c] +
-                                          PILOT_COST_TERM * (double)tally.channel_terms[c];
+                for (uint32_t j = 0; j < part_count; ++j) {
+                    pilot_sums *p = &sums[(size_t)candidate * run->meshes + parts[j].mesh];
+                    p->groups += 1.0;
+                    for (int c = 0; c < 3; ++c) {
+                        double v = group_variance(&parts[j], run->group_size, c);
+                        p->variance_sum[c] += v;
+                        p->variance_squares[c] += v * v;
+                    }
+                }
             }
         }
     }
     return NULL;
 }
 
-/* The standard error of a candidate's variance estimate per channel, from the spread of its
- * PILOT_BLOCKS blocks (`blocks`, every `stride`-th pilot_sums), into total->variance_error. The
- * blocks hold disjoint runs of independent pixel samples, so they are a cluster sample: with
- * y_b the mean squared deviation from the overall mean in block b of n_b samples, the variance
- * estimate is sum n_b y_b / N and its variance sum n_b^2 (y_b - v)^2 / N^2 (Cochran 1977,
- * Sampling Techniques, ch. 9, the ratio estimate of a mean over clusters). A sample variance has
- * an error of its own that grows with the distribution's fourth moment, (m4 - v^2) / N: one
- * sample that makes a share s of the sum of squares gives an error near s v. In block order, so
- * the same for any thread count. */
-static void block_spread(pilot_sums *total, const pilot_sums *blocks, size_t stride)
+/* The standard error of a candidate's variance estimate per channel (the mean of its groups'
+ * variances), into total->variance_error: the groups are independent (a random pixel each, with
+ * scrambles and walks of its own) and alike, so it is the groups' standard deviation over the
+ * square root of their count. Their variances grow with the fourth moment of the samples: a group
+ * whose variance makes a share s of the sum gives an error near s times the estimate. */
+static void group_spread(pilot_sums *total)
 {
     for (int c = 0; c < 3; ++c) {
-        total->variance_error[c] = 0.0;
-        if (!(total->count > 1.0)) continue;
-        double mean = total->sum[c] / total->count, deviations = 0.0;
-        for (uint32_t b = 0; b < PILOT_BLOCKS; ++b) {
-            const pilot_sums *block = &blocks[b * stride];
-            deviations += block->sum_squares[c] - 2.0 * mean * block->sum[c] + mean * mean * block->count;
-        }
-        double variance = deviations / total->count, spread = 0.0;
-        for (uint32_t b = 0; b < PILOT_BLOCKS; ++b) {
-            const pilot_sums *block = &blocks[b * stride];
-            double own = block->sum_squares[c] - 2.0 * mean * block->sum[c] + mean * mean * block->count;
-            double off = own - variance * block->count; /* n_b (y_b - v) */
-            spread += off * off;
-        }
-        total->variance_error[c] = sqrt(spread) / total->count;
+        double n = total->groups, spread = 0.0;
+        if (n > 1.0) spread = fmax(total->variance_squares[c] - total->variance_sum[c] * total->variance_sum[c] / n, 0.0) / (n * (n - 1.0));
+        total->variance_error[c] = sqrt(spread);
     }
 }
 
@@ -360,15 +403,17 @@ static void merge_blocks(const pilot_run *run, pilot_sums *sums)
         for (size_t k = 0; k < per_block; ++k) {
             const pilot_sums *b = &run->block_sums[block * per_block + k];
             sums[k].count += b->count;
+            sums[k].groups += b->groups;
             for (int c = 0; c < 3; ++c) {
-                sums[k].sum[c] += b->sum[c];
                 sums[k].sum_squares[c] += b->sum_squares[c];
                 sums[k].largest[c] = fmax(sums[k].largest[c], b->largest[c]); /* in any order */
+                sums[k].variance_sum[c] += b->variance_sum[c];
+                sums[k].variance_squares[c] += b->variance_squares[c];
             }
             sums[k].cost += b->cost;
             for (int c = 0; c < 3; ++c) sums[k].channel_cost[c] += b->channel_cost[c];
         }
-    for (size_t k = 0; k < per_block; ++k) block_spread(&sums[k], run->block_sums + k, per_block);
+    for (size_t k = 0; k < per_block; ++k) group_spread(&sums[k]);
 }
 
 /* A candidate's variance x cost per sample that saw the mesh; the variance is the three channels'
@@ -388,9 +433,7 @@ static double candidate_work(const pilot_sums *p, const dwvb_material *material,
 {
     double variance[3], walk_cost[3], shared_cost = p->cost / p->count;
     for (int c = 0; c < 3; ++c) {
-        double mean = p->sum[c] / p->count;
-        variance[c] = fmax(fmax(p->sum_squares[c] / p->count - mean * mean, 0.0) * p->count / (p->count - 1.0) +
-                               confidence * p->variance_error[c], 0.0);
+        variance[c] = fmax(p->variance_sum[c] / p->groups + confidence * p->variance_error[c], 0.0);
         walk_cost[c] = p->channel_cost[c] / p->count;
         shared_cost -= walk_cost[c];
         counts[c] = 1u;
@@ -434,7 +477,7 @@ static double tail_share(const pilot_sums *p)
 
 /* The candidates still in the running after the first PILOT_FIRST_BLOCKS blocks (`sums`), kept in
  * their order in `candidates`; returns their count. A candidate drops out where, on every deciding
- * mesh the first blocks saw often enough (their share of PILOT_MESH_MIN), its variance x cost with
+ * mesh the first blocks saw often enough (PILOT_MESH_MIN_GROUPS), its variance x cost with
  * the variance PILOT_CONFIDENCE standard errors below its estimate is above the best candidate's
  * with the variance as many above (a confidence bound on each side: successive elimination, Even-Dar,
  * Mannor and Mansour 2006, "Action elimination and stopping conditions for the multi-armed bandit
@@ -448,8 +491,7 @@ static int pilot_survivors(const dwvb_bake *bake, const pilot_sums *sums, const 
     uint32_t meshes = scene->mesh_count;
     int keep[PILOT_CANDIDATES] = {0}, seen = 0;
     for (uint32_t m = 0; m < meshes; ++m) {
-        double seen_enough = PILOT_MESH_MIN * PILOT_FIRST_BLOCKS / PILOT_BLOCKS;
-        if (!bake->auto_choice[m] || sums[(size_t)candidates[0] * meshes + m].count < seen_enough) continue;
+        if (!bake->auto_choice[m] || sums[(size_t)candidates[0] * meshes + m].groups < PILOT_MESH_MIN_GROUPS) continue;
         const dwvb_material *material = &scene->shading[scene->meshes[m].material_id];
         double low[PILOT_CANDIDATES], best_high = INFINITY;
         int sheet = sheet_may_win(scene, m);
@@ -500,8 +542,12 @@ int dwvb_pilot_choose(dwvb_bake *bake)
     int *trial_walks = malloc(slots * sizeof *trial_walks);
     pilot_sums *sums = calloc(slots, sizeof *sums); /* [candidate][mesh] */
     int stopped = -1;
-    uint32_t blocks_run = PILOT_FIRST_BLOCKS; /* by every candidate left at the choice */
-    pilot_run run = {.bake = bake, .samples = n, .meshes = meshes, .block_sums = NULL};
+    /* Pixel groups of the bake's samples per pixel, at most PILOT_GROUP_MAX and a PILOT_MIN_GROUPS-th
+     * of the pilot's samples (at least 4, as n >= PILOT_MIN), even: two replicates. */
+    uint32_t group_size = bake->options.samples < PILOT_GROUP_MAX ? (uint32_t)bake->options.samples : PILOT_GROUP_MAX;
+    if (group_size > n / PILOT_MIN_GROUPS) group_size = n / PILOT_MIN_GROUPS;
+    group_size = group_size < 2u ? 2u : group_size & ~1u;
+    pilot_run run = {.bake = bake, .groups = n / group_size, .group_size = group_size, .meshes = meshes, .block_sums = NULL};
     if (!trial || !trial_channels || !trial_closest || !trial_walks || !sums) goto done;
     dwvb_shader shaders[PILOT_CANDIDATES];
     for (int k = 0; k < candidate_count; ++k) {
@@ -545,16 +591,13 @@ int dwvb_pilot_choose(dwvb_bake *bake)
          * disc_back at 48 px, 32 spp: auto 1.8x the time of its pick's forced bake, docs/speed.md). */
         if (candidate_count > 1) {
             stopped = run_blocks(&run, candidates, candidate_count, PILOT_FIRST_BLOCKS, PILOT_BLOCKS);
-            blocks_run = PILOT_BLOCKS;
         }
     }
     if (stopped == 0) {
         merge_blocks(&run, sums);
         for (uint32_t m = 0; m < meshes; ++m) {
             /* Every candidate traced the same camera rays, so each saw the mesh equally often. */
-            if (!bake->auto_choice[m] ||
-                sums[(size_t)candidates[0] * meshes + m].count < PILOT_MESH_MIN * blocks_run / PILOT_BLOCKS)
-                continue;
+            if (!bake->auto_choice[m] || sums[(size_t)candidates[0] * meshes + m].groups < PILOT_MESH_MIN_GROUPS) continue;
             /* variance x cost, per sample that saw the mesh; the variance is the three channels'
              * together, as the image's RMSE over RGB counts it: the luminance would hide the
              * colour noise of shared walks, whose channels' weights move against each other. */
