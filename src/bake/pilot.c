@@ -100,15 +100,20 @@
  * PILOT_GROUP_MAX; the group's variance per sample in the image is G / 4 (m0 - m1)^2 per channel,
  * m0 and m1 the replicates' means (their difference has twice a replicate mean's variance, the
  * pixel's mean half of it: as the bake's error estimate, pixel_sums.c), averaged over the groups.
- * Beyond PILOT_GROUP_MAX samples per pixel the pilot rates the variance at that many (a net's
- * variance falls further with more samples, alike for the candidates where the integrand is alike).
- * A group is at most a PILOT_MIN_GROUPS-th of the pilot's samples, so that the mean over groups
- * has some PILOT_MIN_GROUPS terms; and a mesh needs PILOT_MESH_MIN_GROUPS groups that saw it to be
- * decided (in the first blocks where one candidate is left after them, which then is the pick).
+ * Beyond PILOT_GROUP_MAX samples per pixel the pilot rates the variance at that many: a group's
+ * estimate has one degree of freedom per channel, so the mean over groups is as noisy as their
+ * count is small, and 8 samples (4 per replicate) caught most of what stratification moves in the
+ * benchmark's 32-spp images (docs/speed.md: the relative efficiencies of the candidates within
+ * about 0.1 of the images' on 11 scenes, where one sample per pixel had the shared walks 2x-4x too
+ * high on the torus and the heads), at a quarter of the noise of 32 (with 32, test_bake_auto's
+ * thin slab and wax sphere took their runner-up for seed 1). A group is at most a
+ * PILOT_MIN_GROUPS-th of the pilot's samples, so that the mean over groups has some
+ * PILOT_MIN_GROUPS terms; and a mesh needs PILOT_MESH_MIN_GROUPS groups that saw it to be decided
+ * (in the first blocks where one candidate is left after them, which then is the pick).
  * Unlike one sample per pixel, the groups' estimate holds no spread of the pixels' means across the
  * image (the picture itself, the same for every candidate, which pulled the pilot's ratios toward
  * 1). */
-#define PILOT_GROUP_MAX 32u
+#define PILOT_GROUP_MAX 8u
 #define PILOT_MIN_GROUPS 64u
 #define PILOT_MESH_MIN_GROUPS 16.0
 
