@@ -283,6 +283,13 @@ typedef struct pilot_run {
     int candidate_count;
     pilot_sums *block_sums;     /* [block][candidate][mesh] */
     uint32_t groups, group_size, meshes; /* pixel groups of group_size samples (even, <= PILOT_GROUP_MAX) */
+    /* Of the first blocks' groups (first_groups of them), each group's parts as kept for the
+     * paired comparison of pilot_survivors: their meshes [group][part] (UINT32_MAX past the last)
+     * and each candidate's variances [candidate][group][part][channel]; the parts are the same
+     * for every candidate (the same camera rays). */
+    uint32_t first_groups;
+    uint32_t *first_meshes;
+    double *first_variances;
     uint32_t end_block;         /* the blocks run: next_block's first value to end_block - 1 */
     atomic_uint next_block;
     atomic_int stopped;
@@ -364,7 +371,10 @@ static void *pilot_worker(void *arg)
                         double v = group_variance(&parts[j], run->group_size, c);
                         p->variance_sum[c] += v;
                         p->variance_squares[c] += v * v;
+                        if (g < run->first_groups)
+                            run->first_variances[(((size_t)candidate * run->first_groups + g) * run->group_size + j) * 3u + (size_t)c] = v;
                     }
+                    if (g < run->first_groups) run->first_meshes[(size_t)g * run->group_size + j] = parts[j].mesh;
                 }
             }
         }
@@ -470,6 +480,14 @@ static double candidate_work(const pilot_sums *p, const dwvb_material *material,
     return best;
 }
 
+/* A candidate's cost per sample that saw the mesh with `counts` walks per channel (candidate_work). */
+static double candidate_cost(const pilot_sums *p, const uint8_t counts[3])
+{
+    double t = p->cost / p->count;
+    for (int c = 0; c < 3; ++c) t += (counts[c] - 1.0) * p->channel_cost[c] / p->count;
+    return t;
+}
+
 /* The largest share one sample makes of a candidate's sum of squares, over the channels: near 1 /
  * count where every sample weighs alike, near 1 where one sample makes the variance estimate. */
 static double tail_share(const pilot_sums *p)
@@ -480,35 +498,62 @@ static double tail_share(const pilot_sums *p)
     return share;
 }
 
-/* The candidates still in the running after the first PILOT_FIRST_BLOCKS blocks (`sums`), kept in
- * their order in `candidates`; returns their count. A candidate drops out where, on every deciding
- * mesh the first blocks saw often enough (PILOT_MESH_MIN_GROUPS), its variance x cost with
- * the variance PILOT_CONFIDENCE standard errors below its estimate is above the best candidate's
- * with the variance as many above (a confidence bound on each side: successive elimination, Even-Dar,
- * Mannor and Mansour 2006, "Action elimination and stopping conditions for the multi-armed bandit
- * and reinforcement learning problems"). The rest of the pilot then runs only the candidates left:
- * on the benchmark's scenes the pilot had run all eight on as many samples, up to half the bake's
- * samples again at 32 spp (docs/speed.md). */
-static int pilot_survivors(const dwvb_bake *bake, const pilot_sums *sums, const int *trial_walks, int *candidates,
-                           int candidate_count)
+/* The candidates still in the running after the first PILOT_FIRST_BLOCKS blocks (`sums`, and the
+ * groups' own values in `run`), kept in their order in `candidates`; returns their count. A
+ * candidate drops out where, on every deciding mesh the first blocks saw in PILOT_MESH_MIN_GROUPS
+ * groups, its variance x cost is above the best candidate's by more than PILOT_CONFIDENCE standard
+ * errors of the difference (successive elimination, Even-Dar, Mannor and Mansour 2006, "Action
+ * elimination and stopping conditions for the multi-armed bandit and reinforcement learning
+ * problems"). The difference is paired: per group, the candidate's variance x cost less the best's
+ * on the same pixel's samples (the same camera rays, pixel positions and lights), so that what
+ * the pixels share (a silhouette's or a bright patch's noise, alike for every candidate) cancels;
+ * each candidate's variance is summed over the channels divided by its walks per channel and its
+ * cost taken at them (candidate_work's estimate, held fixed), and the groups are independent, so
+ * the standard error is the differences' spread over the square root of their count. Bounds on
+ * each candidate's own variance would not see that cancellation: with the groups' estimate they
+ * kept 4-8 of 8 candidates on the benchmark's scenes (docs/speed.md). The rest of the pilot then
+ * runs only the candidates left: on the benchmark's scenes the pilot had run all eight on as many
+ * samples, up to half the bake's samples again at 32 spp. */
+static int pilot_survivors(const dwvb_bake *bake, const pilot_run *run, const pilot_sums *sums, const int *trial_walks,
+                           int *candidates, int candidate_count)
 {
     const dwvb_scene *scene = bake->scene;
-    uint32_t meshes = scene->mesh_count;
+    uint32_t meshes = scene->mesh_count, size = run->group_size;
     int keep[PILOT_CANDIDATES] = {0}, seen = 0;
     for (uint32_t m = 0; m < meshes; ++m) {
         if (!bake->auto_choice[m] || sums[(size_t)candidates[0] * meshes + m].groups < PILOT_MESH_MIN_GROUPS) continue;
         const dwvb_material *material = &scene->shading[scene->meshes[m].material_id];
-        double low[PILOT_CANDIDATES], best_high = INFINITY;
-        int sheet = sheet_may_win(scene, m);
+        double work[PILOT_CANDIDATES], cost[PILOT_CANDIDATES];
+        uint8_t counts[PILOT_CANDIDATES][3];
+        int sheet = sheet_may_win(scene, m), best = -1;
         for (int k = 0; k < candidate_count; ++k) {
             size_t slot = (size_t)candidates[k] * meshes + m;
-            low[k] = INFINITY; /* a sheet candidate the mesh leaves out (sheet_may_win) keeps nothing here */
+            work[k] = INFINITY; /* a sheet candidate the mesh leaves out (sheet_may_win) keeps nothing here */
             if (candidates[k] % PILOT_TECHNIQUES == PILOT_SHEET && !sheet) continue;
-            uint8_t counts[3];
-            low[k] = candidate_work(&sums[slot], material, trial_walks[slot], -PILOT_CONFIDENCE, counts);
-            best_high = fmin(best_high, candidate_work(&sums[slot], material, trial_walks[slot], PILOT_CONFIDENCE, counts));
+            work[k] = candidate_work(&sums[slot], material, trial_walks[slot], 0.0, counts[k]);
+            cost[k] = candidate_cost(&sums[slot], counts[k]);
+            if (best < 0 || work[k] < work[best]) best = k;
         }
-        for (int k = 0; k < candidate_count; ++k) keep[k] |= !(low[k] > best_high);
+        if (best < 0) continue;
+        keep[best] = 1;
+        for (int k = 0; k < candidate_count; ++k) {
+            if (k == best || !(work[k] < INFINITY)) continue;
+            double n = 0.0, sum = 0.0, squares = 0.0;
+            for (uint32_t g = 0; g < run->first_groups; ++g)
+                for (uint32_t j = 0; j < size && run->first_meshes[(size_t)g * size + j] != UINT32_MAX; ++j) {
+                    if (run->first_meshes[(size_t)g * size + j] != m) continue;
+                    const double *own = &run->first_variances[(((size_t)candidates[k] * run->first_groups + g) * size + j) * 3u];
+                    const double *top = &run->first_variances[(((size_t)candidates[best] * run->first_groups + g) * size + j) * 3u];
+                    double difference = 0.0;
+                    for (int c = 0; c < 3; ++c)
+                        difference += cost[k] * own[c] / counts[k][c] - cost[best] * top[c] / counts[best][c];
+                    n += 1.0;
+                    sum += difference;
+                    squares += difference * difference;
+                }
+            double error = n > 1.0 ? sqrt(fmax(squares - sum * sum / n, 0.0) / (n * (n - 1.0))) : INFINITY;
+            keep[k] |= !(sum / n - PILOT_CONFIDENCE * error > 0.0);
+        }
         seen = 1;
     }
     if (!seen) return candidate_count; /* nothing to go by: all stay */
@@ -580,7 +625,11 @@ int dwvb_pilot_choose(dwvb_bake *bake)
     }
     run.shaders = shaders;
     run.block_sums = calloc(PILOT_BLOCKS * slots, sizeof(pilot_sums));
-    if (!run.block_sums) goto done;
+    run.first_groups = (uint32_t)((uint64_t)run.groups * PILOT_FIRST_BLOCKS / PILOT_BLOCKS);
+    run.first_meshes = malloc((size_t)run.first_groups * group_size * sizeof *run.first_meshes);
+    run.first_variances = malloc((size_t)PILOT_CANDIDATES * run.first_groups * group_size * 3u * sizeof *run.first_variances);
+    if (!run.block_sums || !run.first_meshes || !run.first_variances) goto done;
+    for (size_t k = 0; k < (size_t)run.first_groups * group_size; ++k) run.first_meshes[k] = UINT32_MAX;
     atomic_init(&run.next_block, 0u);
     atomic_init(&run.stopped, 0);
     /* First every candidate on PILOT_FIRST_BLOCKS of the blocks, then the rest of the blocks for
@@ -590,7 +639,7 @@ int dwvb_pilot_choose(dwvb_bake *bake)
         merge_blocks(&run, sums);
         for (int k = 0; k < candidate_count; ++k) ran[k] = candidates[k];
         ran_count = candidate_count;
-        candidate_count = pilot_survivors(bake, sums, trial_walks, candidates, candidate_count);
+        candidate_count = pilot_survivors(bake, &run, sums, trial_walks, candidates, candidate_count);
         /* A lone survivor is the pick: the rest of the blocks would only refine its walks per
          * channel, for up to three quarters of a candidate's pilot (the benchmark's head_point and
          * disc_back at 48 px, 32 spp: auto 1.8x the time of its pick's forced bake, docs/speed.md). */
@@ -642,6 +691,8 @@ int dwvb_pilot_choose(dwvb_bake *bake)
     }
 done:
     free(run.block_sums);
+    free(run.first_meshes);
+    free(run.first_variances);
     free(trial);
     free(trial_channels);
     free(trial_closest);
