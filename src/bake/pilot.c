@@ -299,15 +299,15 @@ typedef struct pilot_run {
  * that saw another mesh or none add 0 to it: the mesh's part of the pixel's mean). */
 typedef struct group_part {
     uint32_t mesh;
-    double replicate_sum[REPLICATES][3];
+    double replicate_sum[3][REPLICATES]; /* [channel][replicate] */
 } group_part;
 
-/* The variance per sample in the image of a group of `size` samples (two replicates of size / 2)
- * whose replicate sums are `part`'s, for channel c: size x the variance of the pixel's mean,
- * estimated by (m0 - m1)^2 / 4 (E (m0 - m1)^2 = 2 Var m_r, and the mean of both has half Var m_r). */
-static double group_variance(const group_part *part, uint32_t size, int c)
+/* pilot.h. size x the variance of the pixel's mean, estimated by (m0 - m1)^2 / 4 with m0, m1 the
+ * replicates' means: they are independent with the same mean, so E (m0 - m1)^2 = 2 Var m_r, and
+ * the mean of both has half Var m_r. */
+double dwvb_pilot_group_variance(const double replicate_sums[REPLICATES], uint32_t size)
 {
-    double replicate = 0.5 * size, difference = (part->replicate_sum[0][c] - part->replicate_sum[1][c]) / replicate;
+    double replicate = 0.5 * size, difference = (replicate_sums[0] - replicate_sums[1]) / replicate;
     return 0.25 * size * difference * difference;
 }
 
@@ -350,7 +350,7 @@ static void *pilot_worker(void *arg)
                     pilot_sums *p = &sums[(size_t)candidate * run->meshes + mesh];
                     p->count += 1.0;
                     for (int c = 0; c < 3; ++c) {
-                        parts[j].replicate_sum[s % REPLICATES][c] += rgb[c];
+                        parts[j].replicate_sum[c][s % REPLICATES] += rgb[c];
                         p->sum_squares[c] += rgb[c] * rgb[c];
                         p->largest[c] = fmax(p->largest[c], fabs(rgb[c]));
                     }
@@ -368,7 +368,7 @@ static void *pilot_worker(void *arg)
                     pilot_sums *p = &sums[(size_t)candidate * run->meshes + parts[j].mesh];
                     p->groups += 1.0;
                     for (int c = 0; c < 3; ++c) {
-                        double v = group_variance(&parts[j], run->group_size, c);
+                        double v = dwvb_pilot_group_variance(parts[j].replicate_sum[c], run->group_size);
                         p->variance_sum[c] += v;
                         p->variance_squares[c] += v * v;
                         if (g < run->first_groups)
