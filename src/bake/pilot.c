@@ -507,15 +507,15 @@ static double tail_share(const pilot_sums *p)
  * problems"). The difference is paired: per group, the candidate's variance x cost less the best's
  * on the same pixel's samples (the same camera rays, pixel positions and lights), so that what
  * the pixels share (a silhouette's or a bright patch's noise, alike for every candidate) cancels;
- * each candidate's variance is summed over the channels divided by its walks per channel and its
- * cost taken at them (candidate_work's estimate, held fixed), and the groups are independent, so
- * the standard error is the differences' spread over the square root of their count. Bounds on
+ * each candidate's variance is summed over the channels, with one walk per channel as the choice
+ * ranks them, and its cost per sample held fixed; the groups are independent, so the standard
+ * error is the differences' spread over the square root of their count. Bounds on
  * each candidate's own variance would not see that cancellation: with the groups' estimate they
  * kept 4-8 of 8 candidates on the benchmark's scenes (docs/speed.md). The rest of the pilot then
  * runs only the candidates left: on the benchmark's scenes the pilot had run all eight on as many
  * samples, up to half the bake's samples again at 32 spp. */
-static int pilot_survivors(const dwvb_bake *bake, const pilot_run *run, const pilot_sums *sums, const int *trial_walks,
-                           int *candidates, int candidate_count)
+static int pilot_survivors(const dwvb_bake *bake, const pilot_run *run, const pilot_sums *sums, int *candidates,
+                           int candidate_count)
 {
     const dwvb_scene *scene = bake->scene;
     uint32_t meshes = scene->mesh_count, size = run->group_size;
@@ -530,7 +530,7 @@ static int pilot_survivors(const dwvb_bake *bake, const pilot_run *run, const pi
             size_t slot = (size_t)candidates[k] * meshes + m;
             work[k] = INFINITY; /* a sheet candidate the mesh leaves out (sheet_may_win) keeps nothing here */
             if (candidates[k] % PILOT_TECHNIQUES == PILOT_SHEET && !sheet) continue;
-            work[k] = candidate_work(&sums[slot], material, trial_walks[slot], 0.0, counts[k]);
+            work[k] = candidate_work(&sums[slot], material, 0, 0.0, counts[k]); /* one walk per channel: see the choice */
             cost[k] = candidate_cost(&sums[slot], counts[k]);
             if (best < 0 || work[k] < work[best]) best = k;
         }
@@ -639,7 +639,7 @@ int dwvb_pilot_choose(dwvb_bake *bake)
         merge_blocks(&run, sums);
         for (int k = 0; k < candidate_count; ++k) ran[k] = candidates[k];
         ran_count = candidate_count;
-        candidate_count = pilot_survivors(bake, &run, sums, trial_walks, candidates, candidate_count);
+        candidate_count = pilot_survivors(bake, &run, sums, candidates, candidate_count);
         /* A lone survivor is the pick: the rest of the blocks would only refine its walks per
          * channel, for up to three quarters of a candidate's pilot (the benchmark's head_point and
          * disc_back at 48 px, 32 spp: auto 1.8x the time of its pick's forced bake, docs/speed.md). */
@@ -670,7 +670,15 @@ int dwvb_pilot_choose(dwvb_bake *bake)
                 if (candidates[k] % PILOT_TECHNIQUES == PILOT_SHEET && !sheet) continue; /* ran for another mesh */
                 const pilot_sums *p = &sums[(size_t)candidates[k] * meshes + m];
                 uint8_t counts[3];
-                double work = candidate_work(p, material, trial_walks[(size_t)candidates[k] * meshes + m], 0.0, counts);
+                /* Ranked as measured, with one walk per channel; the winner then gets the walks per
+                 * channel that suit it (below). The pilot's samples never walk a channel twice, so
+                 * what more walks save is the model's v_c / n_c, which assumes all of a channel's
+                 * variance is its walk's: with it in the ranking, backward with channel walks took
+                 * the benchmark's bowl in 5 of 8 seeds on a promised 1.6x (forced, with one walk
+                 * per channel, 0.58 of incident shared's efficiency), and the leaf's sheet walk
+                 * with channel walks in half the seeds (0.70 of the shared sheet walk's):
+                 * docs/speed.md. */
+                double work = candidate_work(p, material, 0, 0.0, counts);
                 double share = tail_share(p);
                 int tailed = candidates[k] % PILOT_TECHNIQUES != PILOT_CLASSICAL && share > PILOT_TAIL_SHARE &&
                              share > PILOT_TAIL_RATIO * classical_share;
@@ -680,8 +688,9 @@ int dwvb_pilot_choose(dwvb_bake *bake)
                     for (int c = 0; c < 3; ++c) best_counts[c] = counts[c];
                 }
             }
-            for (int c = 0; c < 3; ++c) bake->channel_counts[3u * m + (uint32_t)c] = best_counts[c];
             size_t slot = (size_t)best * meshes + m;
+            if (best_work < INFINITY) candidate_work(&sums[slot], material, trial_walks[slot], 0.0, best_counts);
+            for (int c = 0; c < 3; ++c) bake->channel_counts[3u * m + (uint32_t)c] = best_counts[c];
             bake->guides[m] = trial[slot];
             for (int c = 0; c < 3; ++c) bake->channel_guides[3u * m + (uint32_t)c] = trial_channels[3u * slot + (size_t)c];
             bake->channel_walks[m] = trial_walks[slot];
