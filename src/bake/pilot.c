@@ -148,10 +148,10 @@ enum { PILOT_CLASSICAL = 0, PILOT_ENTRY = 1, PILOT_GUIDED = 2, PILOT_SHEET = 3 }
 #define PILOT_TAIL_SHARE 0.25
 #define PILOT_TAIL_RATIO 10.0
 
-/* The standard errors of a variance estimate (group_spread) either side of it that bound it in
- * pilot_survivors. The choice among the candidates left takes the estimate itself: taking its upper
- * bound instead (2 standard errors) changed no pick on the benchmark's scenes at 48 x 48 pixels,
- * 32 spp, seeds 1-4 (docs/speed.md). */
+/* The standard errors of a candidate's difference from the best (pilot_survivors) that drop it. The
+ * choice among the candidates left takes the estimates themselves: taking an upper bound on each
+ * variance instead (2 standard errors) changed no pick on the benchmark's scenes at 48 x 48 pixels,
+ * 32 spp, seeds 1-4, with the one-sample pilot (docs/speed.md). */
 #define PILOT_CONFIDENCE 2.0
 /* Of the PILOT_BLOCKS blocks, the first that every candidate runs (pilot_survivors). */
 #define PILOT_FIRST_BLOCKS 16u
@@ -257,9 +257,8 @@ typedef struct pilot_sums {
     double count, sum_squares[3], largest[3], cost; /* over the samples that saw the mesh */
     double channel_cost[3]; /* of the cost, the channel walks' own, by channel */
     /* Over the pixel groups that saw the mesh: their count, and per channel the sum of their
-     * variances per sample (group_variance) and of those squared. */
-    double groups, variance_sum[3], variance_squares[3];
-    double variance_error[3]; /* the standard error of the channel's variance estimate (group_spread) */
+     * variances per sample (dwvb_pilot_group_variance). */
+    double groups, variance_sum[3];
 } pilot_sums;
 
 static uint64_t active_pixels(const dwvb_bake *bake)
@@ -370,7 +369,6 @@ static void *pilot_worker(void *arg)
                     for (int c = 0; c < 3; ++c) {
                         double v = dwvb_pilot_group_variance(parts[j].replicate_sum[c], run->group_size);
                         p->variance_sum[c] += v;
-                        p->variance_squares[c] += v * v;
                         if (g < run->first_groups)
                             run->first_variances[(((size_t)candidate * run->first_groups + g) * run->group_size + j) * 3u + (size_t)c] = v;
                     }
@@ -380,20 +378,6 @@ static void *pilot_worker(void *arg)
         }
     }
     return NULL;
-}
-
-/* The standard error of a candidate's variance estimate per channel (the mean of its groups'
- * variances), into total->variance_error: the groups are independent (a random pixel each, with
- * scrambles and walks of its own) and alike, so it is the groups' standard deviation over the
- * square root of their count. Their variances grow with the fourth moment of the samples: a group
- * whose variance makes a share s of the sum gives an error near s times the estimate. */
-static void group_spread(pilot_sums *total)
-{
-    for (int c = 0; c < 3; ++c) {
-        double n = total->groups, spread = 0.0;
-        if (n > 1.0) spread = fmax(total->variance_squares[c] - total->variance_sum[c] * total->variance_sum[c] / n, 0.0) / (n * (n - 1.0));
-        total->variance_error[c] = sqrt(spread);
-    }
 }
 
 /* Runs blocks first_block to end_block - 1 of the pilot for `candidates` on the bake's threads,
@@ -423,12 +407,10 @@ static void merge_blocks(const pilot_run *run, pilot_sums *sums)
                 sums[k].sum_squares[c] += b->sum_squares[c];
                 sums[k].largest[c] = fmax(sums[k].largest[c], b->largest[c]); /* in any order */
                 sums[k].variance_sum[c] += b->variance_sum[c];
-                sums[k].variance_squares[c] += b->variance_squares[c];
             }
             sums[k].cost += b->cost;
             for (int c = 0; c < 3; ++c) sums[k].channel_cost[c] += b->channel_cost[c];
         }
-    for (size_t k = 0; k < per_block; ++k) group_spread(&sums[k]);
 }
 
 /* A candidate's variance x cost per sample that saw the mesh; the variance is the three channels'
@@ -441,14 +423,12 @@ static void merge_blocks(const pilot_run *run, pilot_sums *sums)
  * its walks' cost t_c by n; the rest of a sample's cost is shared. A channel whose walks are cheap
  * and noisy gets more of them: the back-lit slab's red, 1.3 mean free paths thick, against its
  * blue, 5 (docs/speed.md). Fewer than one walk per sample would cost the channel's squared mean
- * on top of its variance, more than it saves. Each channel's variance is taken `confidence`
- * standard errors (variance_error) above its estimate (below, if negative; at least 0). */
-static double candidate_work(const pilot_sums *p, const dwvb_material *material, int channel_walks, double confidence,
-                             uint8_t counts[3])
+ * on top of its variance, more than it saves. */
+static double candidate_work(const pilot_sums *p, const dwvb_material *material, int channel_walks, uint8_t counts[3])
 {
     double variance[3], walk_cost[3], shared_cost = p->cost / p->count;
     for (int c = 0; c < 3; ++c) {
-        variance[c] = fmax(p->variance_sum[c] / p->groups + confidence * p->variance_error[c], 0.0);
+        variance[c] = p->variance_sum[c] / p->groups;
         walk_cost[c] = p->channel_cost[c] / p->count;
         shared_cost -= walk_cost[c];
         counts[c] = 1u;
@@ -478,14 +458,6 @@ static double candidate_work(const pilot_sums *p, const dwvb_material *material,
                 for (int c = 0; c < 3; ++c) counts[c] = (uint8_t)n[c];
             }
     return best;
-}
-
-/* A candidate's cost per sample that saw the mesh with `counts` walks per channel (candidate_work). */
-static double candidate_cost(const pilot_sums *p, const uint8_t counts[3])
-{
-    double t = p->cost / p->count;
-    for (int c = 0; c < 3; ++c) t += (counts[c] - 1.0) * p->channel_cost[c] / p->count;
-    return t;
 }
 
 /* The largest share one sample makes of a candidate's sum of squares, over the channels: near 1 /
@@ -524,14 +496,14 @@ static int pilot_survivors(const dwvb_bake *bake, const pilot_run *run, const pi
         if (!bake->auto_choice[m] || sums[(size_t)candidates[0] * meshes + m].groups < PILOT_MESH_MIN_GROUPS) continue;
         const dwvb_material *material = &scene->shading[scene->meshes[m].material_id];
         double work[PILOT_CANDIDATES], cost[PILOT_CANDIDATES];
-        uint8_t counts[PILOT_CANDIDATES][3];
+        uint8_t counts[3];
         int sheet = sheet_may_win(scene, m), best = -1;
         for (int k = 0; k < candidate_count; ++k) {
             size_t slot = (size_t)candidates[k] * meshes + m;
             work[k] = INFINITY; /* a sheet candidate the mesh leaves out (sheet_may_win) keeps nothing here */
             if (candidates[k] % PILOT_TECHNIQUES == PILOT_SHEET && !sheet) continue;
-            work[k] = candidate_work(&sums[slot], material, 0, 0.0, counts[k]); /* one walk per channel: see the choice */
-            cost[k] = candidate_cost(&sums[slot], counts[k]);
+            work[k] = candidate_work(&sums[slot], material, 0, counts); /* one walk per channel: see the choice */
+            cost[k] = sums[slot].cost / sums[slot].count;
             if (best < 0 || work[k] < work[best]) best = k;
         }
         if (best < 0) continue;
@@ -546,7 +518,7 @@ static int pilot_survivors(const dwvb_bake *bake, const pilot_run *run, const pi
                     const double *top = &run->first_variances[(((size_t)candidates[best] * run->first_groups + g) * size + j) * 3u];
                     double difference = 0.0;
                     for (int c = 0; c < 3; ++c)
-                        difference += cost[k] * own[c] / counts[k][c] - cost[best] * top[c] / counts[best][c];
+                        difference += cost[k] * own[c] - cost[best] * top[c];
                     n += 1.0;
                     sum += difference;
                     squares += difference * difference;
@@ -678,7 +650,7 @@ int dwvb_pilot_choose(dwvb_bake *bake)
                  * per channel, 0.58 of incident shared's efficiency), and the leaf's sheet walk
                  * with channel walks in half the seeds (0.70 of the shared sheet walk's):
                  * docs/speed.md. */
-                double work = candidate_work(p, material, 0, 0.0, counts);
+                double work = candidate_work(p, material, 0, counts);
                 double share = tail_share(p);
                 int tailed = candidates[k] % PILOT_TECHNIQUES != PILOT_CLASSICAL && share > PILOT_TAIL_SHARE &&
                              share > PILOT_TAIL_RATIO * classical_share;
@@ -689,7 +661,7 @@ int dwvb_pilot_choose(dwvb_bake *bake)
                 }
             }
             size_t slot = (size_t)best * meshes + m;
-            if (best_work < INFINITY) candidate_work(&sums[slot], material, trial_walks[slot], 0.0, best_counts);
+            if (best_work < INFINITY) candidate_work(&sums[slot], material, trial_walks[slot], best_counts);
             for (int c = 0; c < 3; ++c) bake->channel_counts[3u * m + (uint32_t)c] = best_counts[c];
             bake->guides[m] = trial[slot];
             for (int c = 0; c < 3; ++c) bake->channel_guides[3u * m + (uint32_t)c] = trial_channels[3u * slot + (size_t)c];
