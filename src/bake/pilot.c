@@ -35,8 +35,9 @@
  *   image's variance per sample was 10x lower with one backward walk per channel, for 1.6x the
  *   time per sample (docs/speed.md); on the leaf (one extinction, albedos apart) it was not worth
  *   its cost. The pilot's variance is the three channels' together, as the image's RMSE over RGB
- *   counts it: the luminance hides the colour noise of shared walks. A channel-walk candidate
- *   also gets the walks per sample of each channel that suit it (candidate_work).
+ *   counts it: the luminance hides the colour noise of shared walks. Candidates are ranked with
+ *   one walk per channel; a channel-walk winner then gets the walks per sample of each channel
+ *   that suit it (candidate_work).
  * Auto's mixture itself (the guided part plus a classical share of 1% or less) is no candidate:
  * its variance was that of the guided part alone within the pilot's noise and its cost above it,
  * so it won none of the pilots on the report's sphere, slab, leaf and default scene (both meshes)
