@@ -35,8 +35,9 @@
  *   image's variance per sample was 10x lower with one backward walk per channel, for 1.6x the
  *   time per sample (docs/speed.md); on the leaf (one extinction, albedos apart) it was not worth
  *   its cost. The pilot's variance is the three channels' together, as the image's RMSE over RGB
- *   counts it: the luminance hides the colour noise of shared walks. A channel-walk candidate
- *   also gets the walks per sample of each channel that suit it (candidate_work).
+ *   counts it: the luminance hides the colour noise of shared walks. Candidates are ranked with
+ *   one walk per channel; a channel-walk winner then gets the walks per sample of each channel
+ *   that suit it (candidate_work).
  * Auto's mixture itself (the guided part plus a classical share of 1% or less) is no candidate:
  * its variance was that of the guided part alone within the pilot's noise and its cost above it,
  * so it won none of the pilots on the report's sphere, slab, leaf and default scene (both meshes)
@@ -85,12 +86,37 @@
 #define PILOT_COST_PATH_RAY 7900.0
 /* Pilot samples per candidate: a sixteenth of the bake's samples, at most PILOT_MAX (the first
  * quarter of them for every candidate, the rest for those not clearly worse: pilot_survivors); below
- * PILOT_MIN the estimate is too noisy to act on and auto keeps its mixture. A mesh needs
- * PILOT_MESH_MIN of them to be decided (of the blocks run: a quarter of it where one candidate is
- * left after the first blocks, which then is the pick). */
+ * PILOT_MIN the estimate is too noisy to act on and auto keeps its mixture. */
 #define PILOT_MAX 4096u
 #define PILOT_MIN 256u
-#define PILOT_MESH_MIN 64.0
+
+/* The pilot's variance is the image's: that of a pixel's mean over its stratified samples, not
+ * that of one sample. A pixel's samples are stratified (dwvb_bake_sample, kernel/sampler.h: pixel
+ * position, entry, lights and the walk's first events), and stratification removes more variance
+ * from some candidates than from others: on the benchmark's bowl, one sample per random pixel (the
+ * pilot before) gave backward with channel walks 0.76x incident shared's variance, the 32-spp
+ * images 1.10x, and auto took the wrong one (docs/speed.md). So the pilot shades pixel groups: a
+ * random pixel's first G samples as the bake takes them (two stratified replicates, even and odd
+ * samples, of G / 2 each, in a stream of the group's own), G the bake's samples per pixel up to
+ * PILOT_GROUP_MAX; the group's variance per sample in the image is G / 4 (m0 - m1)^2 per channel,
+ * m0 and m1 the replicates' means (their difference has twice a replicate mean's variance, the
+ * pixel's mean half of it: as the bake's error estimate, pixel_sums.c), averaged over the groups.
+ * Beyond PILOT_GROUP_MAX samples per pixel the pilot rates the variance at that many: a group's
+ * estimate has one degree of freedom per channel, so the mean over groups is as noisy as their
+ * count is small, and 8 samples (4 per replicate) caught most of what stratification moves in the
+ * benchmark's 32-spp images (docs/speed.md: the relative efficiencies of the candidates within
+ * about 0.1 of the images' on 11 scenes, where one sample per pixel had the shared walks 2x-4x too
+ * high on the torus and the heads), at a quarter of the noise of 32 (with 32, test_bake_auto's
+ * thin slab and wax sphere took their runner-up for seed 1). A group is at most a
+ * PILOT_MIN_GROUPS-th of the pilot's samples, so that the mean over groups has some
+ * PILOT_MIN_GROUPS terms; and a mesh needs PILOT_MESH_MIN_GROUPS groups that saw it to be decided
+ * (in the first blocks where one candidate is left after them, which then is the pick).
+ * Unlike one sample per pixel, the groups' estimate holds no spread of the pixels' means across the
+ * image (the picture itself, the same for every candidate, which pulled the pilot's ratios toward
+ * 1). */
+#define PILOT_GROUP_MAX 8u
+#define PILOT_MIN_GROUPS 64u
+#define PILOT_MESH_MIN_GROUPS 16.0
 
 /* The candidates, in the order of the pilot (a tie keeps the earlier, cheaper one): the four
  * techniques with the channels walked together, then the same with one walk per channel. */
@@ -123,10 +149,10 @@ enum { PILOT_CLASSICAL = 0, PILOT_ENTRY = 1, PILOT_GUIDED = 2, PILOT_SHEET = 3 }
 #define PILOT_TAIL_SHARE 0.25
 #define PILOT_TAIL_RATIO 10.0
 
-/* The standard errors of a variance estimate (block_spread) either side of it that bound it in
- * pilot_survivors. The choice among the candidates left takes the estimate itself: taking its upper
- * bound instead (2 standard errors) changed no pick on the benchmark's scenes at 48 x 48 pixels,
- * 32 spp, seeds 1-4 (docs/speed.md). */
+/* The standard errors of a candidate's difference from the best (pilot_survivors) that drop it. The
+ * choice among the candidates left takes the estimates themselves: taking an upper bound on each
+ * variance instead (2 standard errors) changed no pick on the benchmark's scenes at 48 x 48 pixels,
+ * 32 spp, seeds 1-4, with the one-sample pilot (docs/speed.md). */
 #define PILOT_CONFIDENCE 2.0
 /* Of the PILOT_BLOCKS blocks, the first that every candidate runs (pilot_survivors). */
 #define PILOT_FIRST_BLOCKS 16u
@@ -229,9 +255,11 @@ static int sheet_may_win(const dwvb_scene *scene, uint32_t m)
 }
 
 typedef struct pilot_sums {
-    double count, sum[3], sum_squares[3], largest[3], cost;
+    double count, sum_squares[3], largest[3], cost; /* over the samples that saw the mesh */
     double channel_cost[3]; /* of the cost, the channel walks' own, by channel */
-    double variance_error[3]; /* the standard error of the channel's variance estimate (block_spread) */
+    /* Over the pixel groups that saw the mesh: their count, and per channel the sum of their
+     * variances per sample (dwvb_pilot_group_variance). */
+    double groups, variance_sum[3];
 } pilot_sums;
 
 static uint64_t active_pixels(const dwvb_bake *bake)
@@ -241,10 +269,11 @@ static uint64_t active_pixels(const dwvb_bake *bake)
     return active;
 }
 
-/* The pilot's samples are cut into PILOT_BLOCKS fixed blocks that the bake's threads share; each
- * block sums its samples in order and the blocks are added in block order, so the sums, the choice
- * and the image are the same for any thread count. On one thread the pilot would be serial work
- * beside the passes (a few percent of a short bake: Amdahl's law on the 1 -> 2 thread speed-up). */
+/* The pilot's pixel groups are cut into PILOT_BLOCKS fixed blocks that the bake's threads share;
+ * each block sums its groups in order and the blocks are added in block order, so the sums, the
+ * choice and the image are the same for any thread count. On one thread the pilot would be serial
+ * work beside the passes (a few percent of a short bake: Amdahl's law on the 1 -> 2 thread
+ * speed-up). */
 #define PILOT_BLOCKS 64u
 
 typedef struct pilot_run {
@@ -253,89 +282,103 @@ typedef struct pilot_run {
     const int *candidates;      /* the candidates run (PILOT_*), candidate_count of them */
     int candidate_count;
     pilot_sums *block_sums;     /* [block][candidate][mesh] */
-    uint32_t samples, meshes;
+    uint32_t groups, group_size, meshes; /* pixel groups of group_size samples (even, <= PILOT_GROUP_MAX) */
+    /* Of the first blocks' groups (first_groups of them), each group's parts as kept for the
+     * paired comparison of pilot_survivors: their meshes [group][part] (UINT32_MAX past the last)
+     * and each candidate's variances [candidate][group][part][channel]; the parts are the same
+     * for every candidate (the same camera rays). */
+    uint32_t first_groups;
+    uint32_t *first_meshes;
+    double *first_variances;
     uint32_t end_block;         /* the blocks run: next_block's first value to end_block - 1 */
     atomic_uint next_block;
     atomic_int stopped;
 } pilot_run;
+
+/* A mesh's share of one pixel group: the sums of its samples' values in each replicate (samples
+ * that saw another mesh or none add 0 to it: the mesh's part of the pixel's mean). */
+typedef struct group_part {
+    uint32_t mesh;
+    double replicate_sum[3][REPLICATES]; /* [channel][replicate] */
+} group_part;
+
+/* pilot.h. size x the variance of the pixel's mean, estimated by (m0 - m1)^2 / 4 with m0, m1 the
+ * replicates' means: they are independent with the same mean, so E (m0 - m1)^2 = 2 Var m_r, and
+ * the mean of both has half Var m_r. */
+double dwvb_pilot_group_variance(const double replicate_sums[REPLICATES], uint32_t size)
+{
+    double replicate = 0.5 * size, difference = (replicate_sums[0] - replicate_sums[1]) / replicate;
+    return 0.25 * size * difference * difference;
+}
 
 static void *pilot_worker(void *arg)
 {
     pilot_run *run = arg;
     dwvb_bake *bake = run->bake;
     uint64_t pixels = (uint64_t)bake->width * bake->height;
+    group_part parts[PILOT_GROUP_MAX]; /* of one group, one per mesh its samples saw, in the order seen */
     for (;;) {
         uint32_t block = atomic_fetch_add(&run->next_block, 1u);
         if (block >= run->end_block || atomic_load(&run->stopped)) break;
-        uint32_t first = (uint32_t)((uint64_t)run->samples * block / PILOT_BLOCKS);
-        uint32_t end = (uint32_t)((uint64_t)run->samples * (block + 1u) / PILOT_BLOCKS);
+        uint32_t first = (uint32_t)((uint64_t)run->groups * block / PILOT_BLOCKS);
+        uint32_t end = (uint32_t)((uint64_t)run->groups * (block + 1u) / PILOT_BLOCKS);
         pilot_sums *sums = &run->block_sums[(size_t)block * PILOT_CANDIDATES * run->meshes];
         /* The same pixel samples for every candidate. */
         for (int k = 0; k < run->candidate_count; ++k) {
             int candidate = run->candidates[k];
-            for (uint32_t i = first; i < end; ++i) {
-                if (dwvb_bake_must_stop(bake)) {
-                    atomic_store(&run->stopped, 1);
-                    return NULL;
-                }
-                uint32_t index = (uint32_t)(dwvk_rng_u64(dwvk_rng_key(bake->options.seed, PILOT_STREAM, i), 0u) % pixels);
+            for (uint32_t g = first; g < end; ++g) {
+                uint32_t index = (uint32_t)(dwvk_rng_u64(dwvk_rng_key(bake->options.seed, PILOT_STREAM, g), 0u) % pixels);
                 if (!dwvb_bake_pixel_active(bake, index)) continue;
-                double rgb[3], alpha;
-                dwvb_shade_parts parts;
-                uint32_t mesh;
-                dwvb_tally tally = {0};
-                dwvb_bake_sample(bake, &run->shaders[candidate], PILOT_STREAM, index, i, &parts, rgb, &alpha, &mesh, &tally);
-                if (mesh == UINT32_MAX || !bake->auto_choice[mesh]) continue;
-                pilot_sums *p = &sums[(size_t)candidate * run->meshes + mesh];
-                p->count += 1.0;
-                for (int c = 0; c < 3; ++c) {
-                    p->sum[c] += rgb[c];
-                    p->sum_squares[c] += rgb[c] * rgb[c];
-                    p->largest[c] = fmax(p->largest[c], fabs(rgb[c]));
+                /* A stream per group: a pixel drawn twice gets independent scrambles and walks.
+                 * Bits 32-60, clear of the pixel index and the stream bits (g < PILOT_MAX). */
+                uint64_t stream = PILOT_STREAM | (uint64_t)g << 32;
+                uint32_t part_count = 0;
+                for (uint32_t s = 0; s < run->group_size; ++s) {
+                    if (dwvb_bake_must_stop(bake)) {
+                        atomic_store(&run->stopped, 1);
+                        return NULL;
+                    }
+                    double rgb[3], alpha;
+                    dwvb_shade_parts shade_parts;
+                    uint32_t mesh;
+                    dwvb_tally tally = {0};
+                    dwvb_bake_sample(bake, &run->shaders[candidate], stream, index, s, &shade_parts, rgb, &alpha, &mesh, &tally);
+                    if (mesh == UINT32_MAX || !bake->auto_choice[mesh]) continue;
+                    uint32_t j = 0;
+                    while (j < part_count && parts[j].mesh != mesh) ++j;
+                    if (j == part_count) parts[part_count++] = (group_part){.mesh = mesh};
+                    pilot_sums *p = &sums[(size_t)candidate * run->meshes + mesh];
+                    p->count += 1.0;
+                    for (int c = 0; c < 3; ++c) {
+                        parts[j].replicate_sum[c][s % REPLICATES] += rgb[c];
+                        p->sum_squares[c] += rgb[c] * rgb[c];
+                        p->largest[c] = fmax(p->largest[c], fabs(rgb[c]));
+                    }
+                    double event_cost = PILOT_COST_EVENT + (candidate % PILOT_TECHNIQUES == PILOT_CLASSICAL ? 0.0 : PILOT_COST_GUIDED_EVENT);
+                    p->cost += PILOT_COST_SAMPLE + PILOT_COST_WALK * (double)tally.walks + event_cost * (double)tally.events +
+                               PILOT_COST_RAY * (double)tally.rays +
+                               PILOT_COST_QUERY * (double)tally.point_queries + PILOT_COST_TERM * (double)tally.mixture_terms +
+                               PILOT_COST_PATH_RAY * (double)tally.path_rays;
+                    for (int c = 0; c < 3; ++c)
+                        p->channel_cost[c] += PILOT_COST_WALK * (double)tally.channel_walks[c] +
+                                              event_cost * (double)tally.channel_events[c] +
+                                              PILOT_COST_TERM * (double)tally.channel_terms[c];
                 }
-                double event_cost = PILOT_COST_EVENT + (candidate % PILOT_TECHNIQUES == PILOT_CLASSICAL ? 0.0 : PILOT_COST_GUIDED_EVENT);
-                p->cost += PILOT_COST_SAMPLE + PILOT_COST_WALK * (double)tally.walks + event_cost * (double)tally.events +
-                           PILOT_COST_RAY * (double)tally.rays +
-                           PILOT_COST_QUERY * (double)tally.point_queries + PILOT_COST_TERM * (double)tally.mixture_terms +
-                           PILOT_COST_PATH_RAY * (double)tally.path_rays;
-                for (int c = 0; c < 3; ++c)
-                    p->channel_cost[c] += PILOT_COST_WALK * (double)tally.channel_walks[c] +
-                                          event_cost * (double)tally.channel_events[c] +
-                                          PILOT_COST_TERM * (double)tally.channel_terms[c];
+                for (uint32_t j = 0; j < part_count; ++j) {
+                    pilot_sums *p = &sums[(size_t)candidate * run->meshes + parts[j].mesh];
+                    p->groups += 1.0;
+                    for (int c = 0; c < 3; ++c) {
+                        double v = dwvb_pilot_group_variance(parts[j].replicate_sum[c], run->group_size);
+                        p->variance_sum[c] += v;
+                        if (g < run->first_groups)
+                            run->first_variances[(((size_t)candidate * run->first_groups + g) * run->group_size + j) * 3u + (size_t)c] = v;
+                    }
+                    if (g < run->first_groups) run->first_meshes[(size_t)g * run->group_size + j] = parts[j].mesh;
+                }
             }
         }
     }
     return NULL;
-}
-
-/* The standard error of a candidate's variance estimate per channel, from the spread of its
- * PILOT_BLOCKS blocks (`blocks`, every `stride`-th pilot_sums), into total->variance_error. The
- * blocks hold disjoint runs of independent pixel samples, so they are a cluster sample: with
- * y_b the mean squared deviation from the overall mean in block b of n_b samples, the variance
- * estimate is sum n_b y_b / N and its variance sum n_b^2 (y_b - v)^2 / N^2 (Cochran 1977,
- * Sampling Techniques, ch. 9, the ratio estimate of a mean over clusters). A sample variance has
- * an error of its own that grows with the distribution's fourth moment, (m4 - v^2) / N: one
- * sample that makes a share s of the sum of squares gives an error near s v. In block order, so
- * the same for any thread count. */
-static void block_spread(pilot_sums *total, const pilot_sums *blocks, size_t stride)
-{
-    for (int c = 0; c < 3; ++c) {
-        total->variance_error[c] = 0.0;
-        if (!(total->count > 1.0)) continue;
-        double mean = total->sum[c] / total->count, deviations = 0.0;
-        for (uint32_t b = 0; b < PILOT_BLOCKS; ++b) {
-            const pilot_sums *block = &blocks[b * stride];
-            deviations += block->sum_squares[c] - 2.0 * mean * block->sum[c] + mean * mean * block->count;
-        }
-        double variance = deviations / total->count, spread = 0.0;
-        for (uint32_t b = 0; b < PILOT_BLOCKS; ++b) {
-            const pilot_sums *block = &blocks[b * stride];
-            double own = block->sum_squares[c] - 2.0 * mean * block->sum[c] + mean * mean * block->count;
-            double off = own - variance * block->count; /* n_b (y_b - v) */
-            spread += off * off;
-        }
-        total->variance_error[c] = sqrt(spread) / total->count;
-    }
 }
 
 /* Runs blocks first_block to end_block - 1 of the pilot for `candidates` on the bake's threads,
@@ -360,15 +403,15 @@ static void merge_blocks(const pilot_run *run, pilot_sums *sums)
         for (size_t k = 0; k < per_block; ++k) {
             const pilot_sums *b = &run->block_sums[block * per_block + k];
             sums[k].count += b->count;
+            sums[k].groups += b->groups;
             for (int c = 0; c < 3; ++c) {
-                sums[k].sum[c] += b->sum[c];
                 sums[k].sum_squares[c] += b->sum_squares[c];
                 sums[k].largest[c] = fmax(sums[k].largest[c], b->largest[c]); /* in any order */
+                sums[k].variance_sum[c] += b->variance_sum[c];
             }
             sums[k].cost += b->cost;
             for (int c = 0; c < 3; ++c) sums[k].channel_cost[c] += b->channel_cost[c];
         }
-    for (size_t k = 0; k < per_block; ++k) block_spread(&sums[k], run->block_sums + k, per_block);
 }
 
 /* A candidate's variance x cost per sample that saw the mesh; the variance is the three channels'
@@ -381,16 +424,12 @@ static void merge_blocks(const pilot_run *run, pilot_sums *sums)
  * its walks' cost t_c by n; the rest of a sample's cost is shared. A channel whose walks are cheap
  * and noisy gets more of them: the back-lit slab's red, 1.3 mean free paths thick, against its
  * blue, 5 (docs/speed.md). Fewer than one walk per sample would cost the channel's squared mean
- * on top of its variance, more than it saves. Each channel's variance is taken `confidence`
- * standard errors (variance_error) above its estimate (below, if negative; at least 0). */
-static double candidate_work(const pilot_sums *p, const dwvb_material *material, int channel_walks, double confidence,
-                             uint8_t counts[3])
+ * on top of its variance, more than it saves. */
+static double candidate_work(const pilot_sums *p, const dwvb_material *material, int channel_walks, uint8_t counts[3])
 {
     double variance[3], walk_cost[3], shared_cost = p->cost / p->count;
     for (int c = 0; c < 3; ++c) {
-        double mean = p->sum[c] / p->count;
-        variance[c] = fmax(fmax(p->sum_squares[c] / p->count - mean * mean, 0.0) * p->count / (p->count - 1.0) +
-                               confidence * p->variance_error[c], 0.0);
+        variance[c] = p->variance_sum[c] / p->groups;
         walk_cost[c] = p->channel_cost[c] / p->count;
         shared_cost -= walk_cost[c];
         counts[c] = 1u;
@@ -432,36 +471,62 @@ static double tail_share(const pilot_sums *p)
     return share;
 }
 
-/* The candidates still in the running after the first PILOT_FIRST_BLOCKS blocks (`sums`), kept in
- * their order in `candidates`; returns their count. A candidate drops out where, on every deciding
- * mesh the first blocks saw often enough (their share of PILOT_MESH_MIN), its variance x cost with
- * the variance PILOT_CONFIDENCE standard errors below its estimate is above the best candidate's
- * with the variance as many above (a confidence bound on each side: successive elimination, Even-Dar,
- * Mannor and Mansour 2006, "Action elimination and stopping conditions for the multi-armed bandit
- * and reinforcement learning problems"). The rest of the pilot then runs only the candidates left:
- * on the benchmark's scenes the pilot had run all eight on as many samples, up to half the bake's
- * samples again at 32 spp (docs/speed.md). */
-static int pilot_survivors(const dwvb_bake *bake, const pilot_sums *sums, const int *trial_walks, int *candidates,
+/* The candidates still in the running after the first PILOT_FIRST_BLOCKS blocks (`sums`, and the
+ * groups' own values in `run`), kept in their order in `candidates`; returns their count. A
+ * candidate drops out where, on every deciding mesh the first blocks saw in PILOT_MESH_MIN_GROUPS
+ * groups, its variance x cost is above the best candidate's by more than PILOT_CONFIDENCE standard
+ * errors of the difference (successive elimination, Even-Dar, Mannor and Mansour 2006, "Action
+ * elimination and stopping conditions for the multi-armed bandit and reinforcement learning
+ * problems"). The difference is paired: per group, the candidate's variance x cost less the best's
+ * on the same pixel's samples (the same camera rays, pixel positions and lights), so that what
+ * the pixels share (a silhouette's or a bright patch's noise, alike for every candidate) cancels;
+ * each candidate's variance is summed over the channels, with one walk per channel as the choice
+ * ranks them, and its cost per sample held fixed; the groups are independent, so the standard
+ * error is the differences' spread over the square root of their count. Bounds on
+ * each candidate's own variance would not see that cancellation: with the groups' estimate they
+ * kept 4-8 of 8 candidates on the benchmark's scenes (docs/speed.md). The rest of the pilot then
+ * runs only the candidates left: on the benchmark's scenes the pilot had run all eight on as many
+ * samples, up to half the bake's samples again at 32 spp. */
+static int pilot_survivors(const dwvb_bake *bake, const pilot_run *run, const pilot_sums *sums, int *candidates,
                            int candidate_count)
 {
     const dwvb_scene *scene = bake->scene;
-    uint32_t meshes = scene->mesh_count;
+    uint32_t meshes = scene->mesh_count, size = run->group_size;
     int keep[PILOT_CANDIDATES] = {0}, seen = 0;
     for (uint32_t m = 0; m < meshes; ++m) {
-        double seen_enough = PILOT_MESH_MIN * PILOT_FIRST_BLOCKS / PILOT_BLOCKS;
-        if (!bake->auto_choice[m] || sums[(size_t)candidates[0] * meshes + m].count < seen_enough) continue;
+        if (!bake->auto_choice[m] || sums[(size_t)candidates[0] * meshes + m].groups < PILOT_MESH_MIN_GROUPS) continue;
         const dwvb_material *material = &scene->shading[scene->meshes[m].material_id];
-        double low[PILOT_CANDIDATES], best_high = INFINITY;
-        int sheet = sheet_may_win(scene, m);
+        double work[PILOT_CANDIDATES], cost[PILOT_CANDIDATES];
+        uint8_t counts[3];
+        int sheet = sheet_may_win(scene, m), best = -1;
         for (int k = 0; k < candidate_count; ++k) {
             size_t slot = (size_t)candidates[k] * meshes + m;
-            low[k] = INFINITY; /* a sheet candidate the mesh leaves out (sheet_may_win) keeps nothing here */
+            work[k] = INFINITY; /* a sheet candidate the mesh leaves out (sheet_may_win) keeps nothing here */
             if (candidates[k] % PILOT_TECHNIQUES == PILOT_SHEET && !sheet) continue;
-            uint8_t counts[3];
-            low[k] = candidate_work(&sums[slot], material, trial_walks[slot], -PILOT_CONFIDENCE, counts);
-            best_high = fmin(best_high, candidate_work(&sums[slot], material, trial_walks[slot], PILOT_CONFIDENCE, counts));
+            work[k] = candidate_work(&sums[slot], material, 0, counts); /* one walk per channel: see the choice */
+            cost[k] = sums[slot].cost / sums[slot].count;
+            if (best < 0 || work[k] < work[best]) best = k;
         }
-        for (int k = 0; k < candidate_count; ++k) keep[k] |= !(low[k] > best_high);
+        if (best < 0) continue;
+        keep[best] = 1;
+        for (int k = 0; k < candidate_count; ++k) {
+            if (k == best || !(work[k] < INFINITY)) continue;
+            double n = 0.0, sum = 0.0, squares = 0.0;
+            for (uint32_t g = 0; g < run->first_groups; ++g)
+                for (uint32_t j = 0; j < size && run->first_meshes[(size_t)g * size + j] != UINT32_MAX; ++j) {
+                    if (run->first_meshes[(size_t)g * size + j] != m) continue;
+                    const double *own = &run->first_variances[(((size_t)candidates[k] * run->first_groups + g) * size + j) * 3u];
+                    const double *top = &run->first_variances[(((size_t)candidates[best] * run->first_groups + g) * size + j) * 3u];
+                    double difference = 0.0;
+                    for (int c = 0; c < 3; ++c)
+                        difference += cost[k] * own[c] - cost[best] * top[c];
+                    n += 1.0;
+                    sum += difference;
+                    squares += difference * difference;
+                }
+            double error = n > 1.0 ? sqrt(fmax(squares - sum * sum / n, 0.0) / (n * (n - 1.0))) : INFINITY;
+            keep[k] |= !(sum / n - PILOT_CONFIDENCE * error > 0.0);
+        }
         seen = 1;
     }
     if (!seen) return candidate_count; /* nothing to go by: all stay */
@@ -500,8 +565,12 @@ int dwvb_pilot_choose(dwvb_bake *bake)
     int *trial_walks = malloc(slots * sizeof *trial_walks);
     pilot_sums *sums = calloc(slots, sizeof *sums); /* [candidate][mesh] */
     int stopped = -1;
-    uint32_t blocks_run = PILOT_FIRST_BLOCKS; /* by every candidate left at the choice */
-    pilot_run run = {.bake = bake, .samples = n, .meshes = meshes, .block_sums = NULL};
+    /* Pixel groups of the bake's samples per pixel, at most PILOT_GROUP_MAX and a PILOT_MIN_GROUPS-th
+     * of the pilot's samples (at least 4, as n >= PILOT_MIN), even: two replicates. */
+    uint32_t group_size = bake->options.samples < PILOT_GROUP_MAX ? (uint32_t)bake->options.samples : PILOT_GROUP_MAX;
+    if (group_size > n / PILOT_MIN_GROUPS) group_size = n / PILOT_MIN_GROUPS;
+    group_size = group_size < 2u ? 2u : group_size & ~1u;
+    pilot_run run = {.bake = bake, .groups = n / group_size, .group_size = group_size, .meshes = meshes, .block_sums = NULL};
     if (!trial || !trial_channels || !trial_closest || !trial_walks || !sums) goto done;
     dwvb_shader shaders[PILOT_CANDIDATES];
     for (int k = 0; k < candidate_count; ++k) {
@@ -529,7 +598,11 @@ int dwvb_pilot_choose(dwvb_bake *bake)
     }
     run.shaders = shaders;
     run.block_sums = calloc(PILOT_BLOCKS * slots, sizeof(pilot_sums));
-    if (!run.block_sums) goto done;
+    run.first_groups = (uint32_t)((uint64_t)run.groups * PILOT_FIRST_BLOCKS / PILOT_BLOCKS);
+    run.first_meshes = malloc((size_t)run.first_groups * group_size * sizeof *run.first_meshes);
+    run.first_variances = malloc((size_t)PILOT_CANDIDATES * run.first_groups * group_size * 3u * sizeof *run.first_variances);
+    if (!run.block_sums || !run.first_meshes || !run.first_variances) goto done;
+    for (size_t k = 0; k < (size_t)run.first_groups * group_size; ++k) run.first_meshes[k] = UINT32_MAX;
     atomic_init(&run.next_block, 0u);
     atomic_init(&run.stopped, 0);
     /* First every candidate on PILOT_FIRST_BLOCKS of the blocks, then the rest of the blocks for
@@ -539,22 +612,19 @@ int dwvb_pilot_choose(dwvb_bake *bake)
         merge_blocks(&run, sums);
         for (int k = 0; k < candidate_count; ++k) ran[k] = candidates[k];
         ran_count = candidate_count;
-        candidate_count = pilot_survivors(bake, sums, trial_walks, candidates, candidate_count);
+        candidate_count = pilot_survivors(bake, &run, sums, candidates, candidate_count);
         /* A lone survivor is the pick: the rest of the blocks would only refine its walks per
          * channel, for up to three quarters of a candidate's pilot (the benchmark's head_point and
          * disc_back at 48 px, 32 spp: auto 1.8x the time of its pick's forced bake, docs/speed.md). */
         if (candidate_count > 1) {
             stopped = run_blocks(&run, candidates, candidate_count, PILOT_FIRST_BLOCKS, PILOT_BLOCKS);
-            blocks_run = PILOT_BLOCKS;
         }
     }
     if (stopped == 0) {
         merge_blocks(&run, sums);
         for (uint32_t m = 0; m < meshes; ++m) {
             /* Every candidate traced the same camera rays, so each saw the mesh equally often. */
-            if (!bake->auto_choice[m] ||
-                sums[(size_t)candidates[0] * meshes + m].count < PILOT_MESH_MIN * blocks_run / PILOT_BLOCKS)
-                continue;
+            if (!bake->auto_choice[m] || sums[(size_t)candidates[0] * meshes + m].groups < PILOT_MESH_MIN_GROUPS) continue;
             /* variance x cost, per sample that saw the mesh; the variance is the three channels'
              * together, as the image's RMSE over RGB counts it: the luminance would hide the
              * colour noise of shared walks, whose channels' weights move against each other. */
@@ -573,7 +643,15 @@ int dwvb_pilot_choose(dwvb_bake *bake)
                 if (candidates[k] % PILOT_TECHNIQUES == PILOT_SHEET && !sheet) continue; /* ran for another mesh */
                 const pilot_sums *p = &sums[(size_t)candidates[k] * meshes + m];
                 uint8_t counts[3];
-                double work = candidate_work(p, material, trial_walks[(size_t)candidates[k] * meshes + m], 0.0, counts);
+                /* Ranked as measured, with one walk per channel; the winner then gets the walks per
+                 * channel that suit it (below). The pilot's samples never walk a channel twice, so
+                 * what more walks save is the model's v_c / n_c, which assumes all of a channel's
+                 * variance is its walk's: with it in the ranking, backward with channel walks took
+                 * the benchmark's bowl in 5 of 8 seeds on a promised 1.6x (forced, with one walk
+                 * per channel, 0.58 of incident shared's efficiency), and the leaf's sheet walk
+                 * with channel walks in half the seeds (0.70 of the shared sheet walk's):
+                 * docs/speed.md. */
+                double work = candidate_work(p, material, 0, counts);
                 double share = tail_share(p);
                 int tailed = candidates[k] % PILOT_TECHNIQUES != PILOT_CLASSICAL && share > PILOT_TAIL_SHARE &&
                              share > PILOT_TAIL_RATIO * classical_share;
@@ -583,8 +661,9 @@ int dwvb_pilot_choose(dwvb_bake *bake)
                     for (int c = 0; c < 3; ++c) best_counts[c] = counts[c];
                 }
             }
-            for (int c = 0; c < 3; ++c) bake->channel_counts[3u * m + (uint32_t)c] = best_counts[c];
             size_t slot = (size_t)best * meshes + m;
+            if (best_work < INFINITY) candidate_work(&sums[slot], material, trial_walks[slot], best_counts);
+            for (int c = 0; c < 3; ++c) bake->channel_counts[3u * m + (uint32_t)c] = best_counts[c];
             bake->guides[m] = trial[slot];
             for (int c = 0; c < 3; ++c) bake->channel_guides[3u * m + (uint32_t)c] = trial_channels[3u * slot + (size_t)c];
             bake->channel_walks[m] = trial_walks[slot];
@@ -594,6 +673,8 @@ int dwvb_pilot_choose(dwvb_bake *bake)
     }
 done:
     free(run.block_sums);
+    free(run.first_meshes);
+    free(run.first_variances);
     free(trial);
     free(trial_channels);
     free(trial_closest);

@@ -14,4 +14,10 @@ int dwvb_pilot_choose(dwvb_bake *bake);
  * be trusted (open, inward-facing, non-finite): pilot.c says why the pilot asks. */
 double dwvb_mesh_mean_chord(const dwvg_mesh *mesh);
 
+/* The variance per sample in the image of a pixel group of the pilot (pilot.c): `size` (even)
+ * samples of one pixel as a bake takes them, in REPLICATES = 2 independent stratified replicates
+ * (even and odd samples, dwvb_bake_sample) whose sums of one channel are replicate_sums; an
+ * unbiased estimate of size x the variance of the pixel's mean over its `size` samples. */
+double dwvb_pilot_group_variance(const double replicate_sums[REPLICATES], uint32_t size);
+
 #endif
