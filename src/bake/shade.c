@@ -783,6 +783,10 @@ static void shade_point(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec
     /* The walk's first events take the pairs after the exit's lights (walk.h, DWVW_PAIR_*). */
     uint32_t walk_pair = pair + DWVB_SHADE_PAIRS + 2u * light_pairs;
     uint32_t exit_pair = pair + DWVB_SHADE_PAIRS + light_pairs;
+    /* The exits' path rays: at the camera from the pixel's stratified pairs after all walks' (shade.h,
+     * beside DWVB_MAX_CHANNEL_WALKS), away from it from the vertex's `onward` pairs (ONWARD_PAIRS). */
+    uint32_t exit_ray_pair = walk_pair + DWVW_PAIRS_PER_EVENT * DWVB_STRATIFIED_EVENTS * DWVB_MAX_CHANNEL_WALKS;
+    const dwvk_sampler *exit_rays = camera ? sampler : onward;
     dwvw_walk walk;
     dwvg_hit exit = {0};
     exit_point point;
@@ -816,8 +820,10 @@ static void shade_point(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec
                 /* This channel's walk sends a path on in its channel alone. */
                 double weight[3] = {0.0, 0.0, 0.0};
                 weight[c] = walk.weight[0] * share;
-                uint32_t exit_pairs = onward_pair + ONWARD_PAIRS * (1u + (uint32_t)c + 3u * j);
-                if (go_on && exit_path_ray(shader, &point, weight, onward, exit_pairs, &rays[*ray_count])) ++*ray_count;
+                uint32_t exit_pairs = camera ? exit_ray_pair + 1u + (uint32_t)c + 3u * j
+                                             : onward_pair + ONWARD_PAIRS * (1u + (uint32_t)c + 3u * j);
+                if (go_on && exit_path_ray(shader, &point, weight, exit_rays, exit_pairs, &rays[*ray_count]))
+                    ++*ray_count;
             }
             tally->channel_walks[c] += tally->walks - walks;
             tally->channel_events[c] += tally->events - events;
@@ -837,7 +843,8 @@ static void shade_point(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec
         weight[c] = keep[c] * layer * walk.weight[grey ? 0 : c] * material->walk_scale[c];
         rgb[c] += weight[c] * direct[c];
     }
-    if (go_on && exit_path_ray(shader, &point, weight, onward, onward_pair + ONWARD_PAIRS, &rays[*ray_count])) ++*ray_count;
+    uint32_t exit_pairs = camera ? exit_ray_pair + 1u : onward_pair + ONWARD_PAIRS;
+    if (go_on && exit_path_ray(shader, &point, weight, exit_rays, exit_pairs, &rays[*ray_count])) ++*ray_count;
 }
 
 /* Salts of the counter-based keys of the paths after the camera vertex: the vertex's sampler,
