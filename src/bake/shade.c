@@ -755,8 +755,15 @@ static void shade_point(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec
     /* The surface's lobes send a path on (the same BRDF as their direct light above); past the
      * limits only a mirror's reflection is kept (its other draws end there, which keeps the
      * estimate of the emission it finds unbiased). */
+    /* The camera vertex's path rays from the pixel's stratified pairs past its walks' (shade.h,
+     * beside DWVB_MAX_CHANNEL_WALKS): its exits' at 1 + c + 3 j, its surface's the two after those;
+     * away from the camera from the vertex's `onward` pairs. */
+    uint32_t camera_rays = pair + DWVB_SHADE_PAIRS + 2u * light_pairs +
+                           DWVW_PAIRS_PER_EVENT * DWVB_STRATIFIED_EVENTS * DWVB_MAX_CHANNEL_WALKS;
+    const dwvk_sampler *ray_sampler = camera ? sampler : onward;
+    uint32_t surface_pair = camera ? camera_rays + 1u + 3u * DWVB_MAX_CHANNEL_WALKS : onward_pair;
     if ((go_on || dwvb_specular_singular(material)) &&
-        surface_path_ray(shader, &lobes, x, ng, top, onward, onward_pair, &rays[*ray_count]) &&
+        surface_path_ray(shader, &lobes, x, ng, top, ray_sampler, surface_pair, &rays[*ray_count]) &&
         (go_on || rays[*ray_count].singular))
         ++*ray_count;
     if (!walks_left) return;
@@ -783,10 +790,6 @@ static void shade_point(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec
     /* The walk's first events take the pairs after the exit's lights (walk.h, DWVW_PAIR_*). */
     uint32_t walk_pair = pair + DWVB_SHADE_PAIRS + 2u * light_pairs;
     uint32_t exit_pair = pair + DWVB_SHADE_PAIRS + light_pairs;
-    /* The exits' path rays: at the camera from the pixel's stratified pairs after all walks' (shade.h,
-     * beside DWVB_MAX_CHANNEL_WALKS), away from it from the vertex's `onward` pairs (ONWARD_PAIRS). */
-    uint32_t exit_ray_pair = walk_pair + DWVW_PAIRS_PER_EVENT * DWVB_STRATIFIED_EVENTS * DWVB_MAX_CHANNEL_WALKS;
-    const dwvk_sampler *exit_rays = camera ? sampler : onward;
     dwvw_walk walk;
     dwvg_hit exit = {0};
     exit_point point;
@@ -820,9 +823,9 @@ static void shade_point(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec
                 /* This channel's walk sends a path on in its channel alone. */
                 double weight[3] = {0.0, 0.0, 0.0};
                 weight[c] = walk.weight[0] * share;
-                uint32_t exit_pairs = camera ? exit_ray_pair + 1u + (uint32_t)c + 3u * j
+                uint32_t exit_pairs = camera ? camera_rays + 1u + (uint32_t)c + 3u * j
                                              : onward_pair + ONWARD_PAIRS * (1u + (uint32_t)c + 3u * j);
-                if (go_on && exit_path_ray(shader, &point, weight, exit_rays, exit_pairs, &rays[*ray_count]))
+                if (go_on && exit_path_ray(shader, &point, weight, ray_sampler, exit_pairs, &rays[*ray_count]))
                     ++*ray_count;
             }
             tally->channel_walks[c] += tally->walks - walks;
@@ -843,8 +846,8 @@ static void shade_point(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec
         weight[c] = keep[c] * layer * walk.weight[grey ? 0 : c] * material->walk_scale[c];
         rgb[c] += weight[c] * direct[c];
     }
-    uint32_t exit_pairs = camera ? exit_ray_pair + 1u : onward_pair + ONWARD_PAIRS;
-    if (go_on && exit_path_ray(shader, &point, weight, exit_rays, exit_pairs, &rays[*ray_count])) ++*ray_count;
+    uint32_t exit_pairs = camera ? camera_rays + 1u : onward_pair + ONWARD_PAIRS;
+    if (go_on && exit_path_ray(shader, &point, weight, ray_sampler, exit_pairs, &rays[*ray_count])) ++*ray_count;
 }
 
 /* Salts of the counter-based keys of the paths after the camera vertex: the vertex's sampler,
