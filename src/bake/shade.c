@@ -592,7 +592,8 @@ static void lambert_after_diffuse(const dwvb_material *material, dwvb_material *
     }
 }
 
-/* The pairs a point's paths going on take in its `onward` sampler: two per ray, at fixed places
+/* The pairs a point's paths going on take in its `onward` sampler away from the camera (the
+ * camera vertex's come from the pixel's stratified pairs, shade.h): two per ray, at fixed places
  * (the surface's first, then walk j of channel c's at 1 + c + 3 j, the one walk's at 1), so that
  * whether one ray was made never moves another's numbers. */
 #define ONWARD_PAIRS 2u
@@ -752,16 +753,16 @@ static void shade_point(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec
         dwvl_direct(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, direct);
         for (int c = 0; c < 3; ++c) rgb[c] += layer * diffuse_albedo[c] * direct[c];
     }
-    /* The surface's lobes send a path on (the same BRDF as their direct light above); past the
-     * limits only a mirror's reflection is kept (its other draws end there, which keeps the
-     * estimate of the emission it finds unbiased). */
     /* The camera vertex's path rays from the pixel's stratified pairs past its walks' (shade.h,
      * beside DWVB_MAX_CHANNEL_WALKS): its exits' at 1 + c + 3 j, its surface's the two after those;
-     * away from the camera from the vertex's `onward` pairs. */
+     * away from the camera from the vertex's `onward` pairs (ONWARD_PAIRS). */
     uint32_t camera_rays = pair + DWVB_SHADE_PAIRS + 2u * light_pairs +
                            DWVW_PAIRS_PER_EVENT * DWVB_STRATIFIED_EVENTS * DWVB_MAX_CHANNEL_WALKS;
     const dwvk_sampler *ray_sampler = camera ? sampler : onward;
     uint32_t surface_pair = camera ? camera_rays + 1u + 3u * DWVB_MAX_CHANNEL_WALKS : onward_pair;
+    /* The surface's lobes send a path on (the same BRDF as their direct light above); past the
+     * limits only a mirror's reflection is kept (its other draws end there, which keeps the
+     * estimate of the emission it finds unbiased). */
     if ((go_on || dwvb_specular_singular(material)) &&
         surface_path_ray(shader, &lobes, x, ng, top, ray_sampler, surface_pair, &rays[*ray_count]) &&
         (go_on || rays[*ray_count].singular))
