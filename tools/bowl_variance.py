@@ -4,7 +4,8 @@ for each technique, its bakes at seeds 1-4 with the DiffDir / DiffInd / DiffCol 
 
 - the variance per sample of the combined image, of its direct part (the walks' exits' and the
   surface's next-event estimates, DiffDir x DiffCol) and of its indirect part (the paths after
-  the exits and the surface, DiffInd x DiffCol), per region of the image (inside the bowl, its
+  the exits and the surface, DiffInd x DiffCol; the specular layer's glossy light, under 1% of the
+  bowl's, is in the combined image only), per region of the image (inside the bowl, its
   outside, the rim; the background left out): the mean over pixels and RGB of (a - b)^2 / 2
   between seeds 1 and 2 and between 3 and 4, times the samples per pixel (unbiased estimators
   with independent seeds: no reference needed);
