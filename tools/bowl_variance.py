@@ -80,17 +80,19 @@ def regions(size: int) -> List[str]:
     return out
 
 
+def rgb_of(image) -> List[float]:
+    """An image's RGB values (its alpha left out), pixel by pixel."""
+    return [v for k, v in enumerate(image.pixels()) if k % 4 != 3]
+
+
 def bake(scene, size: int, samples: int, seed: int, technique: str, walks: str, paths: Dict) -> Dict:
     image = dwivedi.bake(scene, width=size, height=size, samples=samples, threads=2, seed=seed, technique=technique,
                          channel_walks=walks, passes=("DiffDir", "DiffInd", "DiffCol"), **paths)
-    combined = [v for k, v in enumerate(image.pixels()) if k % 4 != 3]
-    color = [v for k, v in enumerate(image.pass_image("DiffCol").pixels()) if k % 4 != 3]
-    direct = [v * c for k, (v, c) in enumerate(zip((v for k, v in enumerate(image.pass_image("DiffDir").pixels())
-                                                    if k % 4 != 3), color))]
-    indirect = [v * c for v, c in zip((v for k, v in enumerate(image.pass_image("DiffInd").pixels()) if k % 4 != 3),
-                                      color)]
+    color = rgb_of(image.pass_image("DiffCol"))
+    direct = [v * c for v, c in zip(rgb_of(image.pass_image("DiffDir")), color)]
+    indirect = [v * c for v, c in zip(rgb_of(image.pass_image("DiffInd")), color)]
     s = image.stats
-    return {"combined": combined, "color": color, "direct": direct, "indirect": indirect, "seconds": s.seconds,
+    return {"combined": rgb_of(image), "color": color, "direct": direct, "indirect": indirect, "seconds": s.seconds,
             "walks": s.walks, "events": s.events, "path_rays": s.path_rays, "samples": s.samples}
 
 
