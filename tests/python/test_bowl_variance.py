@@ -13,8 +13,8 @@ import os
 import sys
 import unittest
 
-sys.path.insert(0, os.path.join(os.environ.get("DWIVEDI_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", "..")),
-                                "tools"))
+SOURCE = os.environ.get("DWIVEDI_SOURCE_DIR", os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
+sys.path.insert(0, os.path.join(SOURCE, "tools"))
 import bowl_variance  # noqa: E402
 
 
