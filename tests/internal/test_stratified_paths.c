@@ -32,28 +32,9 @@
 
 static dwv_scene_t *sphere_by_wall(void)
 {
-    dwv_scene_t *scene;
-    dwv_scene_create(&scene);
-    dwv_material_t wax = DWV_MATERIAL_INIT;
-    test_mesh sphere = test_sphere(0.0, 0.0, 0.0, 1.0, 16, 32);
-    test_add(scene, &sphere, &wax);
-    test_mesh_free(&sphere);
-    dwv_material_t white = DWV_MATERIAL_INIT;
-    white.kind = DWV_MATERIAL_DIFFUSE;
-    test_mesh wall = test_box(1.3, -3.0, -3.0, 1.8, 3.0, 3.0);
-    test_add(scene, &wall, &white);
-    test_mesh_free(&wall);
-    dwv_light_desc_t sun = DWV_LIGHT_DESC_INIT; /* from the upper left: lights the wall's face */
-    sun.strength = 3.0;
-    sun.direction[0] = 1.0;
-    sun.direction[2] = -1.0;
-    dwv_scene_add_light(scene, &sun);
-    double world[3] = {0.02, 0.02, 0.02};
-    dwv_scene_set_world(scene, world, 1.0);
-    dwv_camera_t camera = test_ortho_camera(0.0, 0.0, 6.0, 4.0);
-    dwv_scene_set_camera(scene, &camera);
-    CHECK(dwv_scene_commit(scene) == DWV_SUCCESS, "commit: %s", dwv_last_error_message());
-    return scene;
+    /* The sun from the upper left lights the wall's face toward the sphere. */
+    const double wall[6] = {1.3, -3.0, -3.0, 1.8, 3.0, 3.0}, sun[3] = {1.0, 0.0, -1.0}, world[3] = {0.02, 0.02, 0.02};
+    return test_wax_and_white_box(0.0, 0.0, 0.0, 1.0, wall, sun, world);
 }
 
 typedef struct estimate {
