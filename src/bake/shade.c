@@ -592,7 +592,8 @@ static void lambert_after_diffuse(const dwvb_material *material, dwvb_material *
     }
 }
 
-/* The pairs a point's paths going on take in its `onward` sampler: two per ray, at fixed places
+/* The pairs a point's paths going on take in its `onward` sampler away from the camera (the
+ * camera vertex's come from the pixel's stratified pairs, shade.h): two per ray, at fixed places
  * (the surface's first, then walk j of channel c's at 1 + c + 3 j, the one walk's at 1), so that
  * whether one ray was made never moves another's numbers. */
 #define ONWARD_PAIRS 2u
@@ -752,11 +753,18 @@ static void shade_point(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec
         dwvl_direct(&shader->env, x, n, ng, smooth, top, sampler, pair + DWVB_SHADE_PAIRS, direct);
         for (int c = 0; c < 3; ++c) rgb[c] += layer * diffuse_albedo[c] * direct[c];
     }
+    /* The camera vertex's path rays from the pixel's stratified pairs past its walks' (shade.h,
+     * beside DWVB_MAX_CHANNEL_WALKS): its exits' at 1 + c + 3 j, its surface's the two after those;
+     * away from the camera from the vertex's `onward` pairs (ONWARD_PAIRS). */
+    uint32_t camera_rays = pair + DWVB_SHADE_PAIRS + 2u * light_pairs +
+                           DWVW_PAIRS_PER_EVENT * DWVB_STRATIFIED_EVENTS * DWVB_MAX_CHANNEL_WALKS;
+    const dwvk_sampler *ray_sampler = camera ? sampler : onward;
+    uint32_t surface_pair = camera ? camera_rays + 1u + 3u * DWVB_MAX_CHANNEL_WALKS : onward_pair;
     /* The surface's lobes send a path on (the same BRDF as their direct light above); past the
      * limits only a mirror's reflection is kept (its other draws end there, which keeps the
      * estimate of the emission it finds unbiased). */
     if ((go_on || dwvb_specular_singular(material)) &&
-        surface_path_ray(shader, &lobes, x, ng, top, onward, onward_pair, &rays[*ray_count]) &&
+        surface_path_ray(shader, &lobes, x, ng, top, ray_sampler, surface_pair, &rays[*ray_count]) &&
         (go_on || rays[*ray_count].singular))
         ++*ray_count;
     if (!walks_left) return;
@@ -816,8 +824,10 @@ static void shade_point(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec
                 /* This channel's walk sends a path on in its channel alone. */
                 double weight[3] = {0.0, 0.0, 0.0};
                 weight[c] = walk.weight[0] * share;
-                uint32_t exit_pairs = onward_pair + ONWARD_PAIRS * (1u + (uint32_t)c + 3u * j);
-                if (go_on && exit_path_ray(shader, &point, weight, onward, exit_pairs, &rays[*ray_count])) ++*ray_count;
+                uint32_t exit_pairs = camera ? camera_rays + 1u + (uint32_t)c + 3u * j
+                                             : onward_pair + ONWARD_PAIRS * (1u + (uint32_t)c + 3u * j);
+                if (go_on && exit_path_ray(shader, &point, weight, ray_sampler, exit_pairs, &rays[*ray_count]))
+                    ++*ray_count;
             }
             tally->channel_walks[c] += tally->walks - walks;
             tally->channel_events[c] += tally->events - events;
@@ -837,7 +847,8 @@ static void shade_point(const dwvb_shader *shader, const dwvg_hit *hit, dwvu_vec
         weight[c] = keep[c] * layer * walk.weight[grey ? 0 : c] * material->walk_scale[c];
         rgb[c] += weight[c] * direct[c];
     }
-    if (go_on && exit_path_ray(shader, &point, weight, onward, onward_pair + ONWARD_PAIRS, &rays[*ray_count])) ++*ray_count;
+    uint32_t exit_pairs = camera ? camera_rays + 1u : onward_pair + ONWARD_PAIRS;
+    if (go_on && exit_path_ray(shader, &point, weight, ray_sampler, exit_pairs, &rays[*ray_count])) ++*ray_count;
 }
 
 /* Salts of the counter-based keys of the paths after the camera vertex: the vertex's sampler,

@@ -132,6 +132,12 @@ typedef struct dwvb_tally {
 /* Walks per sample of one channel at most (channel_counts); walk j of a channel takes the sampler
  * pairs DWVW_PAIRS_PER_EVENT x DWVB_STRATIFIED_EVENTS x j after the first's. */
 #define DWVB_MAX_CHANNEL_WALKS 3u
+/* The camera vertex's path rays draw their directions from the pixel's stratified sampler, past
+ * the pairs of all DWVB_MAX_CHANNEL_WALKS walks: its walks' exits' at pair 1 + c + 3 j there
+ * (walk j of channel c; the one walk's 1), its surface lobes' the two after those. Over a pixel's
+ * samples those directions cover the hemisphere evenly, so that the share of them that meets the
+ * rest of a concave object (where its indirect light comes from) varies less than with
+ * independent draws (docs/speed.md, "The bowl's variance: indirect light from its exits"). */
 
 /* The mixture a surface point's path rays are drawn from (Cycles picks a closure by its sample
  * weight and weighs the direction by MIS over all closures), each lobe about its own normal: the

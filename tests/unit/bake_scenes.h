@@ -133,6 +133,37 @@ static inline dwv_camera_t test_ortho_camera(double x, double y, double z, doubl
     return camera;
 }
 
+/* A wax sphere (the default subsurface material, 16 x 32 quads) of `radius` about (cx, cy, cz) and a
+ * white diffuse box `box` (x0, y0, z0, x1, y1, z1), under a sun of 3 along `sun` and a world of
+ * colour `world`, seen by test_ortho_camera(0, 0, 6, 4); committed (exits the test on failure). */
+static inline dwv_scene_t *test_wax_and_white_box(double cx, double cy, double cz, double radius, const double box[6],
+                                                  const double sun[3], const double world[3])
+{
+    dwv_scene_t *scene;
+    dwv_scene_create(&scene);
+    dwv_material_t wax = DWV_MATERIAL_INIT;
+    test_mesh sphere = test_sphere(cx, cy, cz, radius, 16, 32);
+    test_add(scene, &sphere, &wax);
+    test_mesh_free(&sphere);
+    dwv_material_t white = DWV_MATERIAL_INIT;
+    white.kind = DWV_MATERIAL_DIFFUSE;
+    test_mesh block = test_box(box[0], box[1], box[2], box[3], box[4], box[5]);
+    test_add(scene, &block, &white);
+    test_mesh_free(&block);
+    dwv_light_desc_t light = DWV_LIGHT_DESC_INIT;
+    light.strength = 3.0;
+    for (int k = 0; k < 3; ++k) light.direction[k] = sun[k];
+    dwv_scene_add_light(scene, &light);
+    dwv_scene_set_world(scene, world, 1.0);
+    dwv_camera_t camera = test_ortho_camera(0.0, 0.0, 6.0, 4.0);
+    dwv_scene_set_camera(scene, &camera);
+    if (dwv_scene_commit(scene) != DWV_SUCCESS) {
+        fprintf(stderr, "test scene: %s\n", dwv_last_error_message());
+        exit(2);
+    }
+    return scene;
+}
+
 /* The report's wax sphere, committed: unit radius (rings x segments), subsurface radius (0.5,
  * 0.25, 0.1) and colour (0.9, 0.6, 0.4) (extinctions 2x and 5x apart), lit by a sun of 2 from the
  * camera's side, seen from +z (orthographic, 2.4 across). A zero radius in `flat_channel` (0..2)

@@ -61,28 +61,8 @@ static baked bake(dwv_scene_t *scene, const dwv_bake_options_t *o)
  * above and a dim world, seen from above at an angle: ground and sphere light each other. */
 static dwv_scene_t *sphere_on_ground(void)
 {
-    dwv_scene_t *scene;
-    dwv_scene_create(&scene);
-    dwv_material_t wax = DWV_MATERIAL_INIT;
-    test_mesh sphere = test_sphere(0.0, 0.0, 1.0, 1.0, 16, 32);
-    test_add(scene, &sphere, &wax);
-    test_mesh_free(&sphere);
-    dwv_material_t ground = DWV_MATERIAL_INIT;
-    ground.kind = DWV_MATERIAL_DIFFUSE;
-    test_mesh floor = test_box(-4.0, -4.0, -0.5, 4.0, 4.0, 0.0);
-    test_add(scene, &floor, &ground);
-    test_mesh_free(&floor);
-    dwv_light_desc_t sun = DWV_LIGHT_DESC_INIT;
-    sun.strength = 3.0;
-    sun.direction[0] = 0.5;
-    sun.direction[2] = -1.0;
-    dwv_scene_add_light(scene, &sun);
-    double world[3] = {0.05, 0.06, 0.08};
-    dwv_scene_set_world(scene, world, 1.0);
-    dwv_camera_t camera = test_ortho_camera(0.0, 0.0, 6.0, 4.0);
-    dwv_scene_set_camera(scene, &camera);
-    CHECK(dwv_scene_commit(scene) == DWV_SUCCESS, "commit: %s", dwv_last_error_message());
-    return scene;
+    const double ground[6] = {-4.0, -4.0, -0.5, 4.0, 4.0, 0.0}, sun[3] = {0.5, 0.0, -1.0}, world[3] = {0.05, 0.06, 0.08};
+    return test_wax_and_white_box(0.0, 0.0, 1.0, 1.0, ground, sun, world);
 }
 
 static dwv_bake_options_t small_options(void)
