@@ -94,6 +94,26 @@ static DWVW_ALWAYS_INLINE void lanes_log_rows_permute(const lane_log_columns *co
     }
 }
 
+/* The exponential's table entries (exp_table.h, 64 of them held as eight vectors) at 16 lanes'
+ * indices (their low 6 bits): four two-source permutes, then the one of the four by bits 4 and 5. */
+_Static_assert(DWVK_EXP_TABLE_SIZE == 64, "the permuted exp lookup holds 64 entries in eight 8-entry vectors");
+
+static DWVW_ALWAYS_INLINE void lanes_exp_entries_permute(const uint64_t *k, uint64_t *entry)
+{
+    lane_v8l table[8];
+    memcpy(table, DWVK_EXP_TABLE, sizeof table);
+    for (int h = 0; h < DWVW_LANES; h += 8) {
+        lane_v8l index;
+        memcpy(&index, k + h, sizeof index);
+        lane_v8l bit4 = -((index >> 4) & 1), bit5 = -((index >> 5) & 1);
+        lane_v8l q0 = __builtin_shuffle(table[0], table[1], index), q1 = __builtin_shuffle(table[2], table[3], index);
+        lane_v8l q2 = __builtin_shuffle(table[4], table[5], index), q3 = __builtin_shuffle(table[6], table[7], index);
+        lane_v8l low = (q0 & ~bit4) | (q1 & bit4), high = (q2 & ~bit4) | (q3 & bit4);
+        lane_v8l picked = (low & ~bit5) | (high & bit5);
+        memcpy(entry + h, &picked, sizeof picked);
+    }
+}
+
 static int lanes_can_permute(void)
 {
     return __builtin_cpu_supports("x86-64-v4") != 0;
@@ -115,6 +135,7 @@ typedef struct lane_state {
     double px[DWVW_LANES], py[DWVW_LANES], pz[DWVW_LANES];
     double dx[DWVW_LANES], dy[DWVW_LANES], dz[DWVW_LANES];
     double log_constants[DWVW_LANES], exponent[DWVW_LANES], log_weight[DWVW_LANES], stretch[DWVW_LANES];
+    double exp_log_weight[DWVW_LANES]; /* exp(log_weight) where |log_weight| <= 708.39 (lane_exp_log_weight) */
     double first_constant[DWVW_LANES]; /* the first step's log(alpha / s0) */
     double entry_x[DWVW_LANES], entry_y[DWVW_LANES], entry_z[DWVW_LANES]; /* the entry direction */
     uint64_t key[DWVW_LANES], counter[DWVW_LANES];
@@ -150,29 +171,41 @@ static lane_template lane_template_for(const dwvw_estimate_setup *setup, const d
     return t;
 }
 
-/* Puts walk `index` into lane l at its entry, as guided_walk_in starts it. */
+/* What a fixed incidence makes the same for every walk, put into every lane once per run: the
+ * entry direction and the first step's constant (lane_begin then leaves them; the steps only read
+ * them). */
+static void lanes_fill_template(lane_state *L, const lane_template *t)
+{
+    for (int l = 0; l < DWVW_LANES; ++l) {
+        L->entry_x[l] = t->direction.x;
+        L->entry_y[l] = t->direction.y;
+        L->entry_z[l] = t->direction.z;
+        L->first_constant[l] = t->first_constant;
+    }
+}
+
+/* Puts walk `index` into lane l at its entry, as guided_walk_in starts it. Only what a step reads
+ * before it writes it: a step forms the direction (the entry one at events = 0) and the log weight
+ * itself, and a fixed incidence's entry is in every lane already (lanes_fill_template). */
 static void lane_begin(lane_state *L, int l, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan,
                        const lane_template *t, uint64_t index)
 {
     uint64_t key = dwvk_rng_key_from_base(t->seed_base, index, 0); /* = dwvk_rng_key(seed, index, 0) */
-    dwvu_vec3 direction = t->same_entry ? t->direction : dwvw_entry_direction(setup, key);
     L->key[l] = key;
     L->counter[l] = key + t->counter_offset; /* dwvk_rng_counter: the same sum mod 2^64 */
     L->px[l] = DWVW_ENTRY_POINT.x;
     L->py[l] = DWVW_ENTRY_POINT.y;
     L->pz[l] = DWVW_ENTRY_POINT.z;
-    L->dx[l] = L->entry_x[l] = direction.x;
-    L->dy[l] = L->entry_y[l] = direction.y;
-    L->dz[l] = L->entry_z[l] = direction.z;
     L->events[l] = 0;
-    L->log_constants[l] = L->exponent[l] = L->log_weight[l] = 0.0;
+    L->log_constants[l] = L->exponent[l] = 0.0;
     L->weight[l] = 1.0;
-    if (plan->first_known) {
-        L->first_constant[l] = t->first_constant;
-    } else {
-        double stretch = dwvk_dwivedi_stretch_d(&setup->medium.dwivedi, dwvw_aligned_cosine(plan, direction));
-        L->first_constant[l] = log(setup->medium.albedo[0] / stretch);
-    }
+    if (t->same_entry) return; /* plan->first_known too: both say the incidence is fixed */
+    dwvu_vec3 direction = dwvw_entry_direction(setup, key);
+    L->entry_x[l] = direction.x;
+    L->entry_y[l] = direction.y;
+    L->entry_z[l] = direction.z;
+    double stretch = dwvk_dwivedi_stretch_d(&setup->medium.dwivedi, dwvw_aligned_cosine(plan, direction));
+    L->first_constant[l] = log(setup->medium.albedo[0] / stretch);
 }
 
 /* The lanes' unit free flights dwvk_free_flight(u) = -log(1 - u), bit for bit, in three loops: the
@@ -198,6 +231,26 @@ static inline void lanes_unit_flights(const lane_state *L, const float *u, doubl
         }
     }
     for (int l = 0; l < DWVW_LANES; ++l) unit_flight[l] = -dwvk_log_fast_join(k[l], z[l], invc[l], logc[l]);
+}
+
+/* exp(log_weight) of every lane, dwvk_exp_fast's value where |log_weight| <= 708.39 (the others'
+ * are formed again by lane_exp_log_weight), in loops as lanes_unit_flights': the select apart
+ * (GCC vectorises neither loop with it inside), the table lookups apart. */
+static inline void lanes_exp_log_weights(lane_state *L)
+{
+    double x[DWVW_LANES], p[DWVW_LANES];
+    uint64_t k[DWVW_LANES], entry[DWVW_LANES];
+    for (int l = 0; l < DWVW_LANES; ++l) x[l] = fabs(L->log_weight[l]) <= 708.39 ? L->log_weight[l] : 0.0;
+    for (int l = 0; l < DWVW_LANES; ++l) k[l] = dwvk_exp_fast_split(x[l], &p[l]);
+#if DWVW_LANE_PERMUTE
+    if (L->permute) {
+        lanes_exp_entries_permute(k, entry);
+    } else
+#endif
+    {
+        for (int l = 0; l < DWVW_LANES; ++l) entry[l] = DWVK_EXP_TABLE[k[l] % DWVK_EXP_TABLE_SIZE];
+    }
+    for (int l = 0; l < DWVW_LANES; ++l) L->exp_log_weight[l] = dwvk_exp_fast_join(k[l], entry[l], p[l]);
 }
 
 /* The distance along w from p to a plane face, as dwvw_shape_exit_inline gives it, with every
@@ -303,6 +356,9 @@ static DWVW_ALWAYS_INLINE int guided_lanes_step_in(lane_state *L, const dwvw_est
         L->flagged[l] = flagged;
         any |= flagged;
     }
+    /* The weights of the flagged lanes' ends and roulettes, in every lane at once (vector loops
+     * here, where one lane at a time was a quarter of lanes_run_in's time). */
+    if (any) lanes_exp_log_weights(L);
     return any;
 }
 
@@ -325,12 +381,20 @@ DWVW_LANE_CLONES static int guided_lanes_step_sphere(lane_state *L, const dwvw_e
     return guided_lanes_step_in(L, setup, plan, DWVW_SPHERE);
 }
 
+/* exp(log_weight) of lane l after its step, dwvk_exp_fast's value: the step's vector one in its
+ * normal range. */
+static inline double lane_exp_log_weight(const lane_state *L, int l)
+{
+    double x = L->log_weight[l];
+    return fabs(x) <= 708.39 ? L->exp_log_weight[l] : dwvk_exp_fast(x);
+}
+
 /* The branches of guided_walk_in after a flagged step of lane l: 1 and *end filled if its walk
  * ended, else 0 (the walk goes on, its weight perhaps raised by the roulette). */
 static int guided_lane_end(lane_state *L, int l, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan,
                     dwvw_shape_kind kind, dwvw_walk_end *end)
 {
-    double last_factor = 1.0;
+    double last_factor = 1.0, weight = lane_exp_log_weight(L, l); /* exp(log weight) */
     uint32_t events = L->events[l];
     end->exit_normal = dwvu_v(0.0, 0.0, 0.0);
     if (L->exited[l]) {
@@ -343,7 +407,7 @@ static int guided_lane_end(lane_state *L, int l, const dwvw_estimate_setup *setu
     } else {
         if (L->log_weight[l] < DWVW_LOG_ROULETTE_THRESHOLD) {
             double log_weight = L->log_weight[l];
-            int fate = dwvw_guided_roulette(L->key[l], events, &log_weight);
+            int fate = dwvw_guided_roulette_at(L->key[l], events, weight, &log_weight);
             if (fate == 0) {
                 end->status = DWVW_ABSORBED;
                 goto done;
@@ -351,13 +415,14 @@ static int guided_lane_end(lane_state *L, int l, const dwvw_estimate_setup *setu
             if (fate == 2) {
                 L->log_weight[l] = log_weight;
                 L->log_constants[l] = dwvw_guided_constants_for(log_weight, setup->medium.sigma_t[0], L->exponent[l]);
+                weight = dwvk_exp_fast(log_weight); /* the walk's new weight, if the cap ends it now */
             }
         }
         if (events < setup->max_events) return 0;
         end->status = DWVW_TRUNCATED;
     }
 done:
-    dwvw_guided_end(end, events, L->log_weight[l], last_factor);
+    dwvw_guided_end_at(end, events, weight, last_factor);
     return 1;
 }
 
@@ -478,9 +543,9 @@ static DWVW_ALWAYS_INLINE int mixture_lanes_step_in(lane_state *L, const dwvw_es
     }
     for (int l = 0; l < DWVW_LANES; ++l) {
         if (L->events[l] == 0) { /* the first step keeps the entry direction */
-            wx[l] = L->dx[l];
-            wy[l] = L->dy[l];
-            wz[l] = L->dz[l];
+            wx[l] = L->entry_x[l];
+            wy[l] = L->entry_y[l];
+            wz[l] = L->entry_z[l];
         } else if (!guided[l]) {
             dwvk_uniform_pair_f u = {ua[l], ub[l]};
             dwvu_vec3 w = dwvw_classical_direction(dwvu_v(L->dx[l], L->dy[l], L->dz[l]), 0.0f, u);
@@ -611,6 +676,7 @@ static inline void lanes_run_in(const dwvw_estimate_setup *setup, const dwvw_fas
     lane_log_columns_fill(&L.log_columns);
     L.permute = lanes_can_permute();
     const lane_template start = lane_template_for(setup, plan);
+    if (start.same_entry) lanes_fill_template(&L, &start);
     uint64_t sequence[DWVW_LANES];
     /* Bit l: lane l holds a walk. Masks, visited lowest lane first (the order of a scan over the
      * lanes), instead of a branch per lane: a lane's end is a coin toss, and per-lane tests were
