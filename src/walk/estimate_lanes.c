@@ -67,6 +67,7 @@ static void lane_log_columns_fill(lane_log_columns *columns)
 #define DWVW_LANE_PERMUTE 1
 typedef double lane_v8d __attribute__((vector_size(64)));
 typedef int64_t lane_v8l __attribute__((vector_size(64)));
+typedef int32_t lane_v8i __attribute__((vector_size(32)));
 
 /* Entry `index` (0 .. 31) of 8 lanes from a 32-entry column held as four vectors: the lower or
  * upper 16 by bit 4 of the index (the permute reads bits 0-3). Written to memory, not returned (a
@@ -87,8 +88,9 @@ static DWVW_ALWAYS_INLINE void lanes_log_rows_permute(const lane_log_columns *co
     memcpy(invc_column, columns->invc, sizeof invc_column);
     memcpy(logc_column, columns->logc, sizeof logc_column);
     for (int h = 0; h < DWVW_LANES; h += 8) {
-        lane_v8l lanes_index;
-        for (int j = 0; j < 8; ++j) lanes_index[j] = index[h + j];
+        lane_v8i narrow; /* widened by one conversion (an element at a time, it took ~20 shuffles) */
+        memcpy(&narrow, index + h, sizeof narrow);
+        lane_v8l lanes_index = __builtin_convertvector(narrow, lane_v8l);
         lane_permute32(invc_column, lanes_index, invc + h);
         lane_permute32(logc_column, lanes_index, logc + h);
     }
@@ -140,7 +142,7 @@ typedef struct lane_state {
     double entry_x[DWVW_LANES], entry_y[DWVW_LANES], entry_z[DWVW_LANES]; /* the entry direction */
     uint64_t key[DWVW_LANES], counter[DWVW_LANES];
     uint32_t events[DWVW_LANES];
-    int exited[DWVW_LANES], flagged[DWVW_LANES];
+    int exited[DWVW_LANES];
     double weight[DWVW_LANES];         /* the mixture's throughput (mixture_lanes_step_in) */
     lane_log_columns log_columns;      /* the log table by columns, and whether to permute it */
     int permute;                       /*   (lanes_unit_flights) */
@@ -269,7 +271,8 @@ static inline double lane_slab_exit(double thickness, double pz, double wz)
 }
 
 /* One event of every lane (lanes whose walk ended compute on without effect until refilled).
- * Sets flagged[l] where guided_walk_in would take a branch after the step: the walk exited, its
+ * Returns the flagged lanes (bit l: lane l), those where guided_walk_in would take a branch after
+ * the step: the walk exited, its
  * weight fell below the roulette threshold, or it reached the event cap. Each stage is a loop
  * over the lanes without branches, for the compiler to vectorise. The plan's frame is the one
  * about a z axis (make_plan): direction (c, sz d, sz mu) for azimuth (c, d) turned by its quarter
@@ -277,7 +280,7 @@ static inline double lane_slab_exit(double thickness, double pz, double wz)
 /* Each shape's step gets its own copy of the loops, with its exit test (GCC and Clang otherwise
  * judge the function too large to inline three times). */
 
-static DWVW_ALWAYS_INLINE int guided_lanes_step_in(lane_state *L, const dwvw_estimate_setup *setup,
+static DWVW_ALWAYS_INLINE uint32_t guided_lanes_step_in(lane_state *L, const dwvw_estimate_setup *setup,
                                                    const dwvw_fast_plan *plan, dwvw_shape_kind kind)
 {
     const dwvw_medium *m = &setup->medium;
@@ -317,7 +320,7 @@ static DWVW_ALWAYS_INLINE int guided_lanes_step_in(lane_state *L, const dwvw_est
         L->dy[l] = fresh ? ey : wy * scale;
         L->dz[l] = fresh ? ez : wz * scale;
     }
-    int any = 0;
+    uint32_t flagged_lanes = 0;
     for (int l = 0; l < DWVW_LANES; ++l) {
         double px = L->px[l], py = L->py[l], pz = L->pz[l], wx = L->dx[l], wy = L->dy[l], wz = L->dz[l];
         double mu = dwvw_clamp_cosine(axis_sign * wz);
@@ -352,30 +355,29 @@ static DWVW_ALWAYS_INLINE int guided_lanes_step_in(lane_state *L, const dwvw_est
         L->stretch[l] = stretch;
         L->events[l] = events;
         L->exited[l] = exited;
-        int flagged = exited | (log_weight < DWVW_LOG_ROULETTE_THRESHOLD) | (events >= max_events);
-        L->flagged[l] = flagged;
-        any |= flagged;
+        uint32_t flagged = (uint32_t)(exited | (log_weight < DWVW_LOG_ROULETTE_THRESHOLD) | (events >= max_events));
+        flagged_lanes |= flagged << l;
     }
     /* The weights of the flagged lanes' ends and roulettes, in every lane at once (vector loops
      * here, where one lane at a time was a quarter of lanes_run_in's time). */
-    if (any) lanes_exp_log_weights(L);
-    return any;
+    if (flagged_lanes) lanes_exp_log_weights(L);
+    return flagged_lanes;
 }
 
 /* guided_lanes_step_in for each shape, its exit test written out. */
-DWVW_LANE_CLONES static int guided_lanes_step_halfspace(lane_state *L, const dwvw_estimate_setup *setup,
+DWVW_LANE_CLONES static uint32_t guided_lanes_step_halfspace(lane_state *L, const dwvw_estimate_setup *setup,
                                                         const dwvw_fast_plan *plan)
 {
     return guided_lanes_step_in(L, setup, plan, DWVW_HALFSPACE);
 }
 
-DWVW_LANE_CLONES static int guided_lanes_step_slab(lane_state *L, const dwvw_estimate_setup *setup,
+DWVW_LANE_CLONES static uint32_t guided_lanes_step_slab(lane_state *L, const dwvw_estimate_setup *setup,
                                                    const dwvw_fast_plan *plan)
 {
     return guided_lanes_step_in(L, setup, plan, DWVW_SLAB);
 }
 
-DWVW_LANE_CLONES static int guided_lanes_step_sphere(lane_state *L, const dwvw_estimate_setup *setup,
+DWVW_LANE_CLONES static uint32_t guided_lanes_step_sphere(lane_state *L, const dwvw_estimate_setup *setup,
                                                      const dwvw_fast_plan *plan)
 {
     return guided_lanes_step_in(L, setup, plan, DWVW_SPHERE);
@@ -503,7 +505,7 @@ static void feed_done(lane_feed *feed, const dwvw_estimate_setup *setup, uint64_
  * that picked the classical component (a share q0 of 0.01 or less for auto) have theirs replaced
  * one by one. The weight is a product of ratios, as there: the mixture's denominator does not
  * cancel, so each event keeps its exponential. */
-static DWVW_ALWAYS_INLINE int mixture_lanes_step_in(lane_state *L, const dwvw_estimate_setup *setup,
+static DWVW_ALWAYS_INLINE uint32_t mixture_lanes_step_in(lane_state *L, const dwvw_estimate_setup *setup,
                                                     const dwvw_fast_plan *plan, dwvw_shape_kind kind)
 {
     const dwvw_medium *m = &setup->medium;
@@ -580,7 +582,7 @@ static DWVW_ALWAYS_INLINE int mixture_lanes_step_in(lane_state *L, const dwvw_es
     }
     for (int l = 0; l < DWVW_LANES; ++l)
         decay_of[l] = dwvw_grey_decay(sigma, stretch_of[l], t_of[l]);
-    int any = 0;
+    uint32_t flagged_lanes = 0;
     for (int l = 0; l < DWVW_LANES; ++l) {
         double px = L->px[l], py = L->py[l], pz = L->pz[l], x = wx[l], y = wy[l], z = wz[l];
         int first = L->events[l] == 0, exited = exited_of[l];
@@ -602,26 +604,25 @@ static DWVW_ALWAYS_INLINE int mixture_lanes_step_in(lane_state *L, const dwvw_es
         L->weight[l] = weight;
         L->events[l] = events;
         L->exited[l] = exited;
-        int flagged = exited | !(weight >= DWVW_ROULETTE_THRESHOLD) | (events >= max_events);
-        L->flagged[l] = flagged;
-        any |= flagged;
+        uint32_t flagged = (uint32_t)(exited | !(weight >= DWVW_ROULETTE_THRESHOLD) | (events >= max_events));
+        flagged_lanes |= flagged << l;
     }
-    return any;
+    return flagged_lanes;
 }
 
-DWVW_LANE_CLONES static int mixture_lanes_step_halfspace(lane_state *L, const dwvw_estimate_setup *setup,
+DWVW_LANE_CLONES static uint32_t mixture_lanes_step_halfspace(lane_state *L, const dwvw_estimate_setup *setup,
                                                          const dwvw_fast_plan *plan)
 {
     return mixture_lanes_step_in(L, setup, plan, DWVW_HALFSPACE);
 }
 
-DWVW_LANE_CLONES static int mixture_lanes_step_slab(lane_state *L, const dwvw_estimate_setup *setup,
+DWVW_LANE_CLONES static uint32_t mixture_lanes_step_slab(lane_state *L, const dwvw_estimate_setup *setup,
                                                     const dwvw_fast_plan *plan)
 {
     return mixture_lanes_step_in(L, setup, plan, DWVW_SLAB);
 }
 
-DWVW_LANE_CLONES static int mixture_lanes_step_sphere(lane_state *L, const dwvw_estimate_setup *setup,
+DWVW_LANE_CLONES static uint32_t mixture_lanes_step_sphere(lane_state *L, const dwvw_estimate_setup *setup,
                                                       const dwvw_fast_plan *plan)
 {
     return mixture_lanes_step_in(L, setup, plan, DWVW_SPHERE);
@@ -650,8 +651,8 @@ static int mixture_lane_end(lane_state *L, int l, const dwvw_estimate_setup *set
     return 1;
 }
 
-static inline int lanes_step(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan,
-                             dwvw_shape_kind kind)
+static inline uint32_t lanes_step(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan,
+                                  dwvw_shape_kind kind)
 {
     if (plan->walker == DWVW_WALKER_MIXTURE) {
         switch (kind) {
@@ -690,10 +691,9 @@ static inline void lanes_run_in(const dwvw_estimate_setup *setup, const dwvw_fas
         live |= (uint32_t)begun << l;
     }
     while (live) {
-        if (!lanes_step(&L, setup, plan, kind)) continue;
         /* The live flagged lanes: about half the steps flag a lane, seldom the same one. */
-        uint32_t flagged = 0;
-        for (int l = 0; l < DWVW_LANES; ++l) flagged |= (uint32_t)L.flagged[l] << l;
+        uint32_t flagged = lanes_step(&L, setup, plan, kind);
+        if (!flagged) continue;
         uint32_t freed = 0;
         for (uint32_t pending = flagged & live; pending; pending &= pending - 1u) {
             int l = __builtin_ctz(pending);
