@@ -186,11 +186,24 @@ static void lanes_fill_template(lane_state *L, const lane_template *t)
     }
 }
 
+/* The entry of a walk in lane l where the incidence is diffuse (each walk its own, from its key). */
+static void lane_begin_entry(lane_state *L, int l, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan,
+                             uint64_t key)
+{
+    dwvu_vec3 direction = dwvw_entry_direction(setup, key);
+    L->entry_x[l] = direction.x;
+    L->entry_y[l] = direction.y;
+    L->entry_z[l] = direction.z;
+    double stretch = dwvk_dwivedi_stretch_d(&setup->medium.dwivedi, dwvw_aligned_cosine(plan, direction));
+    L->first_constant[l] = log(setup->medium.albedo[0] / stretch);
+}
+
 /* Puts walk `index` into lane l at its entry, as guided_walk_in starts it. Only what a step reads
  * before it writes it: a step forms the direction (the entry one at events = 0) and the log weight
- * itself, and a fixed incidence's entry is in every lane already (lanes_fill_template). */
-static void lane_begin(lane_state *L, int l, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan,
-                       const lane_template *t, uint64_t index)
+ * itself, and a fixed incidence's entry is in every lane already (lanes_fill_template). Inlined
+ * into the refill, as feed_next is (the two calls took 5% of the time for poe on the half-space). */
+static DWVW_ALWAYS_INLINE void lane_begin(lane_state *L, int l, const dwvw_estimate_setup *setup,
+                                          const dwvw_fast_plan *plan, const lane_template *t, uint64_t index)
 {
     uint64_t key = dwvk_rng_key_from_base(t->seed_base, index, 0); /* = dwvk_rng_key(seed, index, 0) */
     L->key[l] = key;
@@ -201,13 +214,7 @@ static void lane_begin(lane_state *L, int l, const dwvw_estimate_setup *setup, c
     L->events[l] = 0;
     L->log_constants[l] = L->exponent[l] = 0.0;
     L->weight[l] = 1.0;
-    if (t->same_entry) return; /* plan->first_known too: both say the incidence is fixed */
-    dwvu_vec3 direction = dwvw_entry_direction(setup, key);
-    L->entry_x[l] = direction.x;
-    L->entry_y[l] = direction.y;
-    L->entry_z[l] = direction.z;
-    double stretch = dwvk_dwivedi_stretch_d(&setup->medium.dwivedi, dwvw_aligned_cosine(plan, direction));
-    L->first_constant[l] = log(setup->medium.albedo[0] / stretch);
+    if (!t->same_entry) lane_begin_entry(L, l, setup, plan, key); /* same_entry = plan->first_known */
 }
 
 /* The lanes' unit free flights dwvk_free_flight(u) = -log(1 - u), bit for bit, in three loops: the
@@ -235,25 +242,22 @@ static inline void lanes_unit_flights(const lane_state *L, const float *u, doubl
     for (int l = 0; l < DWVW_LANES; ++l) unit_flight[l] = -dwvk_log_fast_join(k[l], z[l], invc[l], logc[l]);
 }
 
+#if DWVW_LANE_PERMUTE
 /* exp(log_weight) of every lane, dwvk_exp_fast's value where |log_weight| <= 708.39 (the others'
  * are formed again by lane_exp_log_weight), in loops as lanes_unit_flights': the select apart
- * (GCC vectorises neither loop with it inside), the table lookups apart. */
+ * (GCC vectorises neither loop with it inside), the table lookups apart. Only where the table is
+ * permuted: the AVX2 copy has no packed double -> int64 conversion and makes these loops scalar
+ * (callgrind: the step's fastmath.h instructions 2x), slower than an exp per walk. */
 static inline void lanes_exp_log_weights(lane_state *L)
 {
     double x[DWVW_LANES], p[DWVW_LANES];
     uint64_t k[DWVW_LANES], entry[DWVW_LANES];
     for (int l = 0; l < DWVW_LANES; ++l) x[l] = fabs(L->log_weight[l]) <= 708.39 ? L->log_weight[l] : 0.0;
     for (int l = 0; l < DWVW_LANES; ++l) k[l] = dwvk_exp_fast_split(x[l], &p[l]);
-#if DWVW_LANE_PERMUTE
-    if (L->permute) {
-        lanes_exp_entries_permute(k, entry);
-    } else
-#endif
-    {
-        for (int l = 0; l < DWVW_LANES; ++l) entry[l] = DWVK_EXP_TABLE[k[l] % DWVK_EXP_TABLE_SIZE];
-    }
+    lanes_exp_entries_permute(k, entry);
     for (int l = 0; l < DWVW_LANES; ++l) L->exp_log_weight[l] = dwvk_exp_fast_join(k[l], entry[l], p[l]);
 }
+#endif
 
 /* The distance along w from p to a plane face, as dwvw_shape_exit_inline gives it, with every
  * operation done whatever the sign (a lane's select, not a branch: the division's unused results
@@ -360,7 +364,9 @@ static DWVW_ALWAYS_INLINE uint32_t guided_lanes_step_in(lane_state *L, const dwv
     }
     /* The weights of the flagged lanes' ends and roulettes, in every lane at once (vector loops
      * here, where one lane at a time was a quarter of lanes_run_in's time). */
-    if (flagged_lanes) lanes_exp_log_weights(L);
+#if DWVW_LANE_PERMUTE
+    if (flagged_lanes && L->permute) lanes_exp_log_weights(L);
+#endif
     return flagged_lanes;
 }
 
@@ -384,11 +390,11 @@ DWVW_LANE_CLONES static uint32_t guided_lanes_step_sphere(lane_state *L, const d
 }
 
 /* exp(log_weight) of lane l after its step, dwvk_exp_fast's value: the step's vector one in its
- * normal range. */
+ * normal range where the steps form it (lanes_exp_log_weights). */
 static inline double lane_exp_log_weight(const lane_state *L, int l)
 {
     double x = L->log_weight[l];
-    return fabs(x) <= 708.39 ? L->exp_log_weight[l] : dwvk_exp_fast(x);
+    return L->permute && fabs(x) <= 708.39 ? L->exp_log_weight[l] : dwvk_exp_fast(x);
 }
 
 /* The branches of guided_walk_in after a flagged step of lane l: 1 and *end filled if its walk
@@ -468,7 +474,7 @@ static int claim_block(lane_feed *feed)
 
 /* The next walk for a lane: its index and sequence number; 0 if there is none (for now: in a run,
  * the ring may be full until an earlier walk ends). */
-static int feed_next(lane_feed *feed, uint64_t *index, uint64_t *sequence)
+static DWVW_ALWAYS_INLINE int feed_next(lane_feed *feed, uint64_t *index, uint64_t *sequence)
 {
     if (!feed->state) {
         if (feed->next >= feed->stop) return 0;
