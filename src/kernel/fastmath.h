@@ -91,43 +91,23 @@ static inline double dwvk_exp_fast_edges(double x)
  * series to r^12 on |r| <= ln2/2, the form it replaces (6e-16). For |x| <= 708.39 the power of
  * two is a normal double and goes into the table entry's exponent; the rest takes
  * dwvk_exp_fast_edges. The walk's weights and the estimator's fast path use this same function,
- * so their weights agree to the last bit. Here its arithmetic for |x| <= 708.39 alone, without the
- * test, in two parts for loops over lanes that vectorise them and read the table in a loop of their
- * own (as dwvk_log_fast_split and _join below; each lane's x held in that range, the rest take
- * dwvk_exp_fast itself): k + 2^17 (the table index its low bits) with the polynomial p, then the
- * result from p and k's table entry. */
-static inline uint64_t dwvk_exp_fast_split(double x, double *p)
-{
-    const double shift = 0x1.8p52;
-    double kd = (x * DWVK_EXP_N_OVER_LN2 + shift) - shift; /* |k| <= 65408 */
-    double r = (x - kd * DWVK_EXP_LN2_N_HI) - kd * DWVK_EXP_LN2_N_LO;
-    *p = 1.0 + r * (1.0 + r * (0.5 + r * (1.6666666666666666e-1 + r * (4.1666666666666664e-2 +
-         r * 8.3333333333333332e-3))));
-    /* k + 2^17 >= 0, so that floor(k / 64) is a shift of an unsigned number */
-    return (uint64_t)((int64_t)kd + ((int64_t)1 << 17));
-}
-
-static inline double dwvk_exp_fast_join(uint64_t k, uint64_t entry, double p)
-{
-    int64_t e = (int64_t)(k >> DWVK_EXP_TABLE_BITS) - ((int64_t)1 << (17 - DWVK_EXP_TABLE_BITS)); /* in [-1022, 1022] */
-    /* the table entry is in [1, 2): adding e to its exponent field multiplies it by 2^e (mod 2^64) */
-    uint64_t bits = entry + ((uint64_t)e << 52);
-    double scale;
-    memcpy(&scale, &bits, sizeof scale);
-    return p * scale;
-}
-
-static inline double dwvk_exp_fast_normal(double x)
-{
-    double p;
-    uint64_t k = dwvk_exp_fast_split(x, &p);
-    return dwvk_exp_fast_join(k, DWVK_EXP_TABLE[k % DWVK_EXP_TABLE_SIZE], p);
-}
-
+ * so their weights agree to the last bit. */
 static inline double dwvk_exp_fast(double x)
 {
     if (!(fabs(x) <= 708.39)) return dwvk_exp_fast_edges(x);
-    return dwvk_exp_fast_normal(x);
+    const double shift = 0x1.8p52;
+    double kd = (x * DWVK_EXP_N_OVER_LN2 + shift) - shift; /* |k| <= 65408 */
+    double r = (x - kd * DWVK_EXP_LN2_N_HI) - kd * DWVK_EXP_LN2_N_LO;
+    double p = 1.0 + r * (1.0 + r * (0.5 + r * (1.6666666666666666e-1 + r * (4.1666666666666664e-2 +
+               r * 8.3333333333333332e-3))));
+    /* k + 2^17 >= 0, so that floor(k / 64) is a shift of an unsigned number */
+    uint64_t k = (uint64_t)((int64_t)kd + ((int64_t)1 << 17));
+    int64_t e = (int64_t)(k >> DWVK_EXP_TABLE_BITS) - ((int64_t)1 << (17 - DWVK_EXP_TABLE_BITS)); /* in [-1022, 1022] */
+    /* the table entry is in [1, 2): adding e to its exponent field multiplies it by 2^e (mod 2^64) */
+    uint64_t bits = DWVK_EXP_TABLE[k & (DWVK_EXP_TABLE_SIZE - 1)] + ((uint64_t)e << 52);
+    double scale;
+    memcpy(&scale, &bits, sizeof scale);
+    return p * scale;
 }
 
 /* dwvk_log_fast (below) in two parts, for loops over lanes that vectorise its arithmetic and read

@@ -96,26 +96,6 @@ static DWVW_ALWAYS_INLINE void lanes_log_rows_permute(const lane_log_columns *co
     }
 }
 
-/* The exponential's table entries (exp_table.h, 64 of them held as eight vectors) at 16 lanes'
- * indices (their low 6 bits): four two-source permutes, then the one of the four by bits 4 and 5. */
-_Static_assert(DWVK_EXP_TABLE_SIZE == 64, "the permuted exp lookup holds 64 entries in eight 8-entry vectors");
-
-static DWVW_ALWAYS_INLINE void lanes_exp_entries_permute(const uint64_t *k, uint64_t *entry)
-{
-    lane_v8l table[8];
-    memcpy(table, DWVK_EXP_TABLE, sizeof table);
-    for (int h = 0; h < DWVW_LANES; h += 8) {
-        lane_v8l index;
-        memcpy(&index, k + h, sizeof index);
-        lane_v8l bit4 = -((index >> 4) & 1), bit5 = -((index >> 5) & 1);
-        lane_v8l q0 = __builtin_shuffle(table[0], table[1], index), q1 = __builtin_shuffle(table[2], table[3], index);
-        lane_v8l q2 = __builtin_shuffle(table[4], table[5], index), q3 = __builtin_shuffle(table[6], table[7], index);
-        lane_v8l low = (q0 & ~bit4) | (q1 & bit4), high = (q2 & ~bit4) | (q3 & bit4);
-        lane_v8l picked = (low & ~bit5) | (high & bit5);
-        memcpy(entry + h, &picked, sizeof picked);
-    }
-}
-
 static int lanes_can_permute(void)
 {
     return __builtin_cpu_supports("x86-64-v4") != 0;
@@ -137,7 +117,6 @@ typedef struct lane_state {
     double px[DWVW_LANES], py[DWVW_LANES], pz[DWVW_LANES];
     double dx[DWVW_LANES], dy[DWVW_LANES], dz[DWVW_LANES];
     double log_constants[DWVW_LANES], exponent[DWVW_LANES], log_weight[DWVW_LANES], stretch[DWVW_LANES];
-    double exp_log_weight[DWVW_LANES]; /* exp(log_weight) where |log_weight| <= 708.39 (lane_exp_log_weight) */
     double first_constant[DWVW_LANES]; /* the first step's log(alpha / s0) */
     double entry_x[DWVW_LANES], entry_y[DWVW_LANES], entry_z[DWVW_LANES]; /* the entry direction */
     uint64_t key[DWVW_LANES], counter[DWVW_LANES];
@@ -242,23 +221,6 @@ static inline void lanes_unit_flights(const lane_state *L, const float *u, doubl
     for (int l = 0; l < DWVW_LANES; ++l) unit_flight[l] = -dwvk_log_fast_join(k[l], z[l], invc[l], logc[l]);
 }
 
-#if DWVW_LANE_PERMUTE
-/* exp(log_weight) of every lane, dwvk_exp_fast's value where |log_weight| <= 708.39 (the others'
- * are formed again by lane_exp_log_weight), in loops as lanes_unit_flights': the select apart
- * (GCC vectorises neither loop with it inside), the table lookups apart. Only where the table is
- * permuted: the AVX2 copy has no packed double -> int64 conversion and makes these loops scalar
- * (callgrind: the step's fastmath.h instructions 2x), slower than an exp per walk. */
-static inline void lanes_exp_log_weights(lane_state *L)
-{
-    double x[DWVW_LANES], p[DWVW_LANES];
-    uint64_t k[DWVW_LANES], entry[DWVW_LANES];
-    for (int l = 0; l < DWVW_LANES; ++l) x[l] = fabs(L->log_weight[l]) <= 708.39 ? L->log_weight[l] : 0.0;
-    for (int l = 0; l < DWVW_LANES; ++l) k[l] = dwvk_exp_fast_split(x[l], &p[l]);
-    lanes_exp_entries_permute(k, entry);
-    for (int l = 0; l < DWVW_LANES; ++l) L->exp_log_weight[l] = dwvk_exp_fast_join(k[l], entry[l], p[l]);
-}
-#endif
-
 /* The distance along w from p to a plane face, as dwvw_shape_exit_inline gives it, with every
  * operation done whatever the sign (a lane's select, not a branch: the division's unused results
  * are discarded). */
@@ -276,16 +238,16 @@ static inline double lane_slab_exit(double thickness, double pz, double wz)
 
 /* One event of every lane (lanes whose walk ended compute on without effect until refilled).
  * Returns the flagged lanes (bit l: lane l), those where guided_walk_in would take a branch after
- * the step: the walk exited, its
- * weight fell below the roulette threshold, or it reached the event cap. Each stage is a loop
- * over the lanes without branches, for the compiler to vectorise. The plan's frame is the one
+ * the step: the walk exited, its weight fell below the roulette threshold, or it reached the event
+ * cap (a mask formed in the vector loop: lanes_run_in read an array of flags back one by one).
+ * Each stage is a loop over the lanes without branches, for the compiler to vectorise. The plan's frame is the one
  * about a z axis (make_plan): direction (c, sz d, sz mu) for azimuth (c, d) turned by its quarter
  * turns (the same products as aligned_guided_direction's turned frame, signs exact). */
 /* Each shape's step gets its own copy of the loops, with its exit test (GCC and Clang otherwise
  * judge the function too large to inline three times). */
 
 static DWVW_ALWAYS_INLINE uint32_t guided_lanes_step_in(lane_state *L, const dwvw_estimate_setup *setup,
-                                                   const dwvw_fast_plan *plan, dwvw_shape_kind kind)
+                                                        const dwvw_fast_plan *plan, dwvw_shape_kind kind)
 {
     const dwvw_medium *m = &setup->medium;
     const dwvk_dwivedi_event_f *d = &m->dwivedi_event;
@@ -362,39 +324,26 @@ static DWVW_ALWAYS_INLINE uint32_t guided_lanes_step_in(lane_state *L, const dwv
         uint32_t flagged = (uint32_t)(exited | (log_weight < DWVW_LOG_ROULETTE_THRESHOLD) | (events >= max_events));
         flagged_lanes |= flagged << l;
     }
-    /* The weights of the flagged lanes' ends and roulettes, in every lane at once (vector loops
-     * here, where one lane at a time was a quarter of lanes_run_in's time). */
-#if DWVW_LANE_PERMUTE
-    if (flagged_lanes && L->permute) lanes_exp_log_weights(L);
-#endif
     return flagged_lanes;
 }
 
 /* guided_lanes_step_in for each shape, its exit test written out. */
 DWVW_LANE_CLONES static uint32_t guided_lanes_step_halfspace(lane_state *L, const dwvw_estimate_setup *setup,
-                                                        const dwvw_fast_plan *plan)
+                                                             const dwvw_fast_plan *plan)
 {
     return guided_lanes_step_in(L, setup, plan, DWVW_HALFSPACE);
 }
 
 DWVW_LANE_CLONES static uint32_t guided_lanes_step_slab(lane_state *L, const dwvw_estimate_setup *setup,
-                                                   const dwvw_fast_plan *plan)
+                                                        const dwvw_fast_plan *plan)
 {
     return guided_lanes_step_in(L, setup, plan, DWVW_SLAB);
 }
 
 DWVW_LANE_CLONES static uint32_t guided_lanes_step_sphere(lane_state *L, const dwvw_estimate_setup *setup,
-                                                     const dwvw_fast_plan *plan)
+                                                          const dwvw_fast_plan *plan)
 {
     return guided_lanes_step_in(L, setup, plan, DWVW_SPHERE);
-}
-
-/* exp(log_weight) of lane l after its step, dwvk_exp_fast's value: the step's vector one in its
- * normal range where the steps form it (lanes_exp_log_weights). */
-static inline double lane_exp_log_weight(const lane_state *L, int l)
-{
-    double x = L->log_weight[l];
-    return L->permute && fabs(x) <= 708.39 ? L->exp_log_weight[l] : dwvk_exp_fast(x);
 }
 
 /* The branches of guided_walk_in after a flagged step of lane l: 1 and *end filled if its walk
@@ -402,7 +351,7 @@ static inline double lane_exp_log_weight(const lane_state *L, int l)
 static int guided_lane_end(lane_state *L, int l, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan,
                     dwvw_shape_kind kind, dwvw_walk_end *end)
 {
-    double last_factor = 1.0, weight = lane_exp_log_weight(L, l); /* exp(log weight) */
+    double last_factor = 1.0;
     uint32_t events = L->events[l];
     end->exit_normal = dwvu_v(0.0, 0.0, 0.0);
     if (L->exited[l]) {
@@ -415,7 +364,7 @@ static int guided_lane_end(lane_state *L, int l, const dwvw_estimate_setup *setu
     } else {
         if (L->log_weight[l] < DWVW_LOG_ROULETTE_THRESHOLD) {
             double log_weight = L->log_weight[l];
-            int fate = dwvw_guided_roulette_at(L->key[l], events, weight, &log_weight);
+            int fate = dwvw_guided_roulette(L->key[l], events, &log_weight);
             if (fate == 0) {
                 end->status = DWVW_ABSORBED;
                 goto done;
@@ -423,14 +372,13 @@ static int guided_lane_end(lane_state *L, int l, const dwvw_estimate_setup *setu
             if (fate == 2) {
                 L->log_weight[l] = log_weight;
                 L->log_constants[l] = dwvw_guided_constants_for(log_weight, setup->medium.sigma_t[0], L->exponent[l]);
-                weight = dwvk_exp_fast(log_weight); /* the walk's new weight, if the cap ends it now */
             }
         }
         if (events < setup->max_events) return 0;
         end->status = DWVW_TRUNCATED;
     }
 done:
-    dwvw_guided_end_at(end, events, weight, last_factor);
+    dwvw_guided_end(end, events, L->log_weight[l], last_factor);
     return 1;
 }
 
@@ -512,7 +460,7 @@ static void feed_done(lane_feed *feed, const dwvw_estimate_setup *setup, uint64_
  * one by one. The weight is a product of ratios, as there: the mixture's denominator does not
  * cancel, so each event keeps its exponential. */
 static DWVW_ALWAYS_INLINE uint32_t mixture_lanes_step_in(lane_state *L, const dwvw_estimate_setup *setup,
-                                                    const dwvw_fast_plan *plan, dwvw_shape_kind kind)
+                                                         const dwvw_fast_plan *plan, dwvw_shape_kind kind)
 {
     const dwvw_medium *m = &setup->medium;
     const dwvk_dwivedi_event_f *d = &m->dwivedi_event;
@@ -617,19 +565,19 @@ static DWVW_ALWAYS_INLINE uint32_t mixture_lanes_step_in(lane_state *L, const dw
 }
 
 DWVW_LANE_CLONES static uint32_t mixture_lanes_step_halfspace(lane_state *L, const dwvw_estimate_setup *setup,
-                                                         const dwvw_fast_plan *plan)
+                                                              const dwvw_fast_plan *plan)
 {
     return mixture_lanes_step_in(L, setup, plan, DWVW_HALFSPACE);
 }
 
 DWVW_LANE_CLONES static uint32_t mixture_lanes_step_slab(lane_state *L, const dwvw_estimate_setup *setup,
-                                                    const dwvw_fast_plan *plan)
+                                                         const dwvw_fast_plan *plan)
 {
     return mixture_lanes_step_in(L, setup, plan, DWVW_SLAB);
 }
 
 DWVW_LANE_CLONES static uint32_t mixture_lanes_step_sphere(lane_state *L, const dwvw_estimate_setup *setup,
-                                                      const dwvw_fast_plan *plan)
+                                                           const dwvw_fast_plan *plan)
 {
     return mixture_lanes_step_in(L, setup, plan, DWVW_SPHERE);
 }

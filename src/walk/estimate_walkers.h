@@ -66,22 +66,15 @@ static inline double dwvw_aligned_cosine(const dwvw_fast_plan *plan, dwvu_vec3 d
 /* ---- the guided walker's weight, in logs (estimate_fast.c, "the fast paths") ---------------- */
 
 /* The Russian roulette of dwvw_walk_complete (dwvw_roulette_survives) on a weight
- * `weight` = exp(*log_weight) after `events` events: 0 if the walk ends (absorbed), 1 if it goes on
+ * exp(log_weight) after `events` events: 0 if the walk ends (absorbed), 1 if it goes on
  * unchanged, 2 if it goes on with its weight raised to the threshold (*log_weight = its log). */
-static inline int dwvw_guided_roulette_at(uint64_t key, uint32_t events, double weight, double *log_weight)
-{
-    double survive;
-    if (!(*log_weight < DWVW_LOG_ROULETTE_THRESHOLD)) return 1;
-    if (!(weight > 0.0) || !dwvw_roulette_survives(key, events, weight, &survive)) return 0;
-    *log_weight = DWVW_LOG_ROULETTE_THRESHOLD; /* log(weight / survive) */
-    return 2;
-}
-
-/* ... the weight formed here (the lanes form it in a vector and give it, estimate_lanes.c). */
 static inline int dwvw_guided_roulette(uint64_t key, uint32_t events, double *log_weight)
 {
     if (!(*log_weight < DWVW_LOG_ROULETTE_THRESHOLD)) return 1;
-    return dwvw_guided_roulette_at(key, events, dwvk_exp_fast(*log_weight), log_weight);
+    double weight = dwvk_exp_fast(*log_weight), survive;
+    if (!(weight > 0.0) || !dwvw_roulette_survives(key, events, weight, &survive)) return 0;
+    *log_weight = DWVW_LOG_ROULETTE_THRESHOLD; /* log(weight / survive) */
+    return 2;
 }
 
 /* A guided walk's weight is exp(log constants - sigma x exponent) with exponent the sum over its
@@ -114,18 +107,12 @@ static inline double dwvw_guided_exit_factor(const dwvw_fast_plan *plan, uint32_
  * absorbed, or if the weight is not finite). The exponentials here and in dwvw_guided_roulette are
  * fastmath.h's (5e-16 relative, as the general walk's weights use): once per walk and per
  * roulette, libm's took 6% of the lanes' time for poe on the half-space. */
-static inline void dwvw_guided_end_at(dwvw_walk_end *end, uint32_t events, double exp_log_weight,
-                                      double last_factor)
+static inline void dwvw_guided_end(dwvw_walk_end *end, uint32_t events, double log_weight, double last_factor)
 {
-    double weight = end->status == DWVW_ABSORBED ? 0.0 : exp_log_weight * last_factor;
+    double weight = end->status == DWVW_ABSORBED ? 0.0 : dwvk_exp_fast(log_weight) * last_factor;
     end->events = events;
     end->weight[0] = isfinite(weight) ? weight : 0.0;
     end->weight[1] = end->weight[2] = 0.0;
-}
-
-static inline void dwvw_guided_end(dwvw_walk_end *end, uint32_t events, double log_weight, double last_factor)
-{
-    dwvw_guided_end_at(end, events, dwvk_exp_fast(log_weight), last_factor);
 }
 
 /* A classical or mixture walk's end: its weight in its one channel (0 if it was absorbed). */
