@@ -110,9 +110,9 @@ static int lanes_can_permute(void)
 
 _Static_assert(DWVW_LANES % 8 == 0, "the permuted lookup takes the lanes 8 at a time");
 
-/* The lanes' state. p: position; d: the direction of the step being taken (for a lane at
- * events = 0, its entry direction). log_constants and exponent as in guided_walk_in, weight as in
- * mixture_walk_in. */
+/* The lanes' state. p: position; d: the direction of the last step (a step forms its own; at
+ * events = 0 it is the entry direction, entry_*). log_constants and exponent as in guided_walk_in,
+ * weight as in mixture_walk_in. */
 typedef struct lane_state {
     double px[DWVW_LANES], py[DWVW_LANES], pz[DWVW_LANES];
     double dx[DWVW_LANES], dy[DWVW_LANES], dz[DWVW_LANES];
@@ -240,9 +240,10 @@ static inline double lane_slab_exit(double thickness, double pz, double wz)
  * Returns the flagged lanes (bit l: lane l), those where guided_walk_in would take a branch after
  * the step: the walk exited, its weight fell below the roulette threshold, or it reached the event
  * cap (a mask formed in the vector loop: lanes_run_in read an array of flags back one by one).
- * Each stage is a loop over the lanes without branches, for the compiler to vectorise. The plan's frame is the one
- * about a z axis (make_plan): direction (c, sz d, sz mu) for azimuth (c, d) turned by its quarter
- * turns (the same products as aligned_guided_direction's turned frame, signs exact). */
+ * Each stage is a loop over the lanes without branches, for the compiler to vectorise. The plan's
+ * frame is the one about a z axis (make_plan): direction (c, sz d, sz mu) for azimuth (c, d)
+ * turned by its quarter turns (the same products as aligned_guided_direction's turned frame, signs
+ * exact). */
 /* Each shape's step gets its own copy of the loops, with its exit test (GCC and Clang otherwise
  * judge the function too large to inline three times). */
 
