@@ -67,6 +67,7 @@ static void lane_log_columns_fill(lane_log_columns *columns)
 #define DWVW_LANE_PERMUTE 1
 typedef double lane_v8d __attribute__((vector_size(64)));
 typedef int64_t lane_v8l __attribute__((vector_size(64)));
+typedef int32_t lane_v8i __attribute__((vector_size(32)));
 
 /* Entry `index` (0 .. 31) of 8 lanes from a 32-entry column held as four vectors: the lower or
  * upper 16 by bit 4 of the index (the permute reads bits 0-3). Written to memory, not returned (a
@@ -87,8 +88,9 @@ static DWVW_ALWAYS_INLINE void lanes_log_rows_permute(const lane_log_columns *co
     memcpy(invc_column, columns->invc, sizeof invc_column);
     memcpy(logc_column, columns->logc, sizeof logc_column);
     for (int h = 0; h < DWVW_LANES; h += 8) {
-        lane_v8l lanes_index;
-        for (int j = 0; j < 8; ++j) lanes_index[j] = index[h + j];
+        lane_v8i narrow; /* widened by one conversion (an element at a time, it took ~20 shuffles) */
+        memcpy(&narrow, index + h, sizeof narrow);
+        lane_v8l lanes_index = __builtin_convertvector(narrow, lane_v8l);
         lane_permute32(invc_column, lanes_index, invc + h);
         lane_permute32(logc_column, lanes_index, logc + h);
     }
@@ -108,9 +110,9 @@ static int lanes_can_permute(void)
 
 _Static_assert(DWVW_LANES % 8 == 0, "the permuted lookup takes the lanes 8 at a time");
 
-/* The lanes' state. p: position; d: the direction of the step being taken (for a lane at
- * events = 0, its entry direction). log_constants and exponent as in guided_walk_in, weight as in
- * mixture_walk_in. */
+/* The lanes' state. p: position; d: the direction of the last step (a step forms its own; at
+ * events = 0 it is the entry direction, entry_*). log_constants and exponent as in guided_walk_in,
+ * weight as in mixture_walk_in. */
 typedef struct lane_state {
     double px[DWVW_LANES], py[DWVW_LANES], pz[DWVW_LANES];
     double dx[DWVW_LANES], dy[DWVW_LANES], dz[DWVW_LANES];
@@ -119,7 +121,7 @@ typedef struct lane_state {
     double entry_x[DWVW_LANES], entry_y[DWVW_LANES], entry_z[DWVW_LANES]; /* the entry direction */
     uint64_t key[DWVW_LANES], counter[DWVW_LANES];
     uint32_t events[DWVW_LANES];
-    int exited[DWVW_LANES], flagged[DWVW_LANES];
+    int exited[DWVW_LANES];
     double weight[DWVW_LANES];         /* the mixture's throughput (mixture_lanes_step_in) */
     lane_log_columns log_columns;      /* the log table by columns, and whether to permute it */
     int permute;                       /*   (lanes_unit_flights) */
@@ -150,29 +152,48 @@ static lane_template lane_template_for(const dwvw_estimate_setup *setup, const d
     return t;
 }
 
-/* Puts walk `index` into lane l at its entry, as guided_walk_in starts it. */
-static void lane_begin(lane_state *L, int l, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan,
-                       const lane_template *t, uint64_t index)
+/* What a fixed incidence makes the same for every walk, put into every lane once per run: the
+ * entry direction and the first step's constant (lane_begin then leaves them; the steps only read
+ * them). */
+static void lanes_fill_template(lane_state *L, const lane_template *t)
+{
+    for (int l = 0; l < DWVW_LANES; ++l) {
+        L->entry_x[l] = t->direction.x;
+        L->entry_y[l] = t->direction.y;
+        L->entry_z[l] = t->direction.z;
+        L->first_constant[l] = t->first_constant;
+    }
+}
+
+/* The entry of a walk in lane l where the incidence is diffuse (each walk its own, from its key). */
+static void lane_begin_entry(lane_state *L, int l, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan,
+                             uint64_t key)
+{
+    dwvu_vec3 direction = dwvw_entry_direction(setup, key);
+    L->entry_x[l] = direction.x;
+    L->entry_y[l] = direction.y;
+    L->entry_z[l] = direction.z;
+    double stretch = dwvk_dwivedi_stretch_d(&setup->medium.dwivedi, dwvw_aligned_cosine(plan, direction));
+    L->first_constant[l] = log(setup->medium.albedo[0] / stretch);
+}
+
+/* Puts walk `index` into lane l at its entry, as guided_walk_in starts it. Only what a step reads
+ * before it writes it: a step forms the direction (the entry one at events = 0) and the log weight
+ * itself, and a fixed incidence's entry is in every lane already (lanes_fill_template). Inlined
+ * into the refill, as feed_next is (the two calls took 5% of the time for poe on the half-space). */
+static DWVW_ALWAYS_INLINE void lane_begin(lane_state *L, int l, const dwvw_estimate_setup *setup,
+                                          const dwvw_fast_plan *plan, const lane_template *t, uint64_t index)
 {
     uint64_t key = dwvk_rng_key_from_base(t->seed_base, index, 0); /* = dwvk_rng_key(seed, index, 0) */
-    dwvu_vec3 direction = t->same_entry ? t->direction : dwvw_entry_direction(setup, key);
     L->key[l] = key;
     L->counter[l] = key + t->counter_offset; /* dwvk_rng_counter: the same sum mod 2^64 */
     L->px[l] = DWVW_ENTRY_POINT.x;
     L->py[l] = DWVW_ENTRY_POINT.y;
     L->pz[l] = DWVW_ENTRY_POINT.z;
-    L->dx[l] = L->entry_x[l] = direction.x;
-    L->dy[l] = L->entry_y[l] = direction.y;
-    L->dz[l] = L->entry_z[l] = direction.z;
     L->events[l] = 0;
-    L->log_constants[l] = L->exponent[l] = L->log_weight[l] = 0.0;
+    L->log_constants[l] = L->exponent[l] = 0.0;
     L->weight[l] = 1.0;
-    if (plan->first_known) {
-        L->first_constant[l] = t->first_constant;
-    } else {
-        double stretch = dwvk_dwivedi_stretch_d(&setup->medium.dwivedi, dwvw_aligned_cosine(plan, direction));
-        L->first_constant[l] = log(setup->medium.albedo[0] / stretch);
-    }
+    if (!t->same_entry) lane_begin_entry(L, l, setup, plan, key); /* same_entry = plan->first_known */
 }
 
 /* The lanes' unit free flights dwvk_free_flight(u) = -log(1 - u), bit for bit, in three loops: the
@@ -216,16 +237,18 @@ static inline double lane_slab_exit(double thickness, double pz, double wz)
 }
 
 /* One event of every lane (lanes whose walk ended compute on without effect until refilled).
- * Sets flagged[l] where guided_walk_in would take a branch after the step: the walk exited, its
- * weight fell below the roulette threshold, or it reached the event cap. Each stage is a loop
- * over the lanes without branches, for the compiler to vectorise. The plan's frame is the one
- * about a z axis (make_plan): direction (c, sz d, sz mu) for azimuth (c, d) turned by its quarter
- * turns (the same products as aligned_guided_direction's turned frame, signs exact). */
+ * Returns the flagged lanes (bit l: lane l), those where guided_walk_in would take a branch after
+ * the step: the walk exited, its weight fell below the roulette threshold, or it reached the event
+ * cap (a mask formed in the vector loop: lanes_run_in read an array of flags back one by one).
+ * Each stage is a loop over the lanes without branches, for the compiler to vectorise. The plan's
+ * frame is the one about a z axis (make_plan): direction (c, sz d, sz mu) for azimuth (c, d)
+ * turned by its quarter turns (the same products as aligned_guided_direction's turned frame, signs
+ * exact). */
 /* Each shape's step gets its own copy of the loops, with its exit test (GCC and Clang otherwise
  * judge the function too large to inline three times). */
 
-static DWVW_ALWAYS_INLINE int guided_lanes_step_in(lane_state *L, const dwvw_estimate_setup *setup,
-                                                   const dwvw_fast_plan *plan, dwvw_shape_kind kind)
+static DWVW_ALWAYS_INLINE uint32_t guided_lanes_step_in(lane_state *L, const dwvw_estimate_setup *setup,
+                                                        const dwvw_fast_plan *plan, dwvw_shape_kind kind)
 {
     const dwvw_medium *m = &setup->medium;
     const dwvk_dwivedi_event_f *d = &m->dwivedi_event;
@@ -264,7 +287,7 @@ static DWVW_ALWAYS_INLINE int guided_lanes_step_in(lane_state *L, const dwvw_est
         L->dy[l] = fresh ? ey : wy * scale;
         L->dz[l] = fresh ? ez : wz * scale;
     }
-    int any = 0;
+    uint32_t flagged_lanes = 0;
     for (int l = 0; l < DWVW_LANES; ++l) {
         double px = L->px[l], py = L->py[l], pz = L->pz[l], wx = L->dx[l], wy = L->dy[l], wz = L->dz[l];
         double mu = dwvw_clamp_cosine(axis_sign * wz);
@@ -299,28 +322,27 @@ static DWVW_ALWAYS_INLINE int guided_lanes_step_in(lane_state *L, const dwvw_est
         L->stretch[l] = stretch;
         L->events[l] = events;
         L->exited[l] = exited;
-        int flagged = exited | (log_weight < DWVW_LOG_ROULETTE_THRESHOLD) | (events >= max_events);
-        L->flagged[l] = flagged;
-        any |= flagged;
+        uint32_t flagged = (uint32_t)(exited | (log_weight < DWVW_LOG_ROULETTE_THRESHOLD) | (events >= max_events));
+        flagged_lanes |= flagged << l;
     }
-    return any;
+    return flagged_lanes;
 }
 
 /* guided_lanes_step_in for each shape, its exit test written out. */
-DWVW_LANE_CLONES static int guided_lanes_step_halfspace(lane_state *L, const dwvw_estimate_setup *setup,
-                                                        const dwvw_fast_plan *plan)
+DWVW_LANE_CLONES static uint32_t guided_lanes_step_halfspace(lane_state *L, const dwvw_estimate_setup *setup,
+                                                             const dwvw_fast_plan *plan)
 {
     return guided_lanes_step_in(L, setup, plan, DWVW_HALFSPACE);
 }
 
-DWVW_LANE_CLONES static int guided_lanes_step_slab(lane_state *L, const dwvw_estimate_setup *setup,
-                                                   const dwvw_fast_plan *plan)
+DWVW_LANE_CLONES static uint32_t guided_lanes_step_slab(lane_state *L, const dwvw_estimate_setup *setup,
+                                                        const dwvw_fast_plan *plan)
 {
     return guided_lanes_step_in(L, setup, plan, DWVW_SLAB);
 }
 
-DWVW_LANE_CLONES static int guided_lanes_step_sphere(lane_state *L, const dwvw_estimate_setup *setup,
-                                                     const dwvw_fast_plan *plan)
+DWVW_LANE_CLONES static uint32_t guided_lanes_step_sphere(lane_state *L, const dwvw_estimate_setup *setup,
+                                                          const dwvw_fast_plan *plan)
 {
     return guided_lanes_step_in(L, setup, plan, DWVW_SPHERE);
 }
@@ -401,7 +423,7 @@ static int claim_block(lane_feed *feed)
 
 /* The next walk for a lane: its index and sequence number; 0 if there is none (for now: in a run,
  * the ring may be full until an earlier walk ends). */
-static int feed_next(lane_feed *feed, uint64_t *index, uint64_t *sequence)
+static DWVW_ALWAYS_INLINE int feed_next(lane_feed *feed, uint64_t *index, uint64_t *sequence)
 {
     if (!feed->state) {
         if (feed->next >= feed->stop) return 0;
@@ -438,8 +460,8 @@ static void feed_done(lane_feed *feed, const dwvw_estimate_setup *setup, uint64_
  * that picked the classical component (a share q0 of 0.01 or less for auto) have theirs replaced
  * one by one. The weight is a product of ratios, as there: the mixture's denominator does not
  * cancel, so each event keeps its exponential. */
-static DWVW_ALWAYS_INLINE int mixture_lanes_step_in(lane_state *L, const dwvw_estimate_setup *setup,
-                                                    const dwvw_fast_plan *plan, dwvw_shape_kind kind)
+static DWVW_ALWAYS_INLINE uint32_t mixture_lanes_step_in(lane_state *L, const dwvw_estimate_setup *setup,
+                                                         const dwvw_fast_plan *plan, dwvw_shape_kind kind)
 {
     const dwvw_medium *m = &setup->medium;
     const dwvk_dwivedi_event_f *d = &m->dwivedi_event;
@@ -478,9 +500,9 @@ static DWVW_ALWAYS_INLINE int mixture_lanes_step_in(lane_state *L, const dwvw_es
     }
     for (int l = 0; l < DWVW_LANES; ++l) {
         if (L->events[l] == 0) { /* the first step keeps the entry direction */
-            wx[l] = L->dx[l];
-            wy[l] = L->dy[l];
-            wz[l] = L->dz[l];
+            wx[l] = L->entry_x[l];
+            wy[l] = L->entry_y[l];
+            wz[l] = L->entry_z[l];
         } else if (!guided[l]) {
             dwvk_uniform_pair_f u = {ua[l], ub[l]};
             dwvu_vec3 w = dwvw_classical_direction(dwvu_v(L->dx[l], L->dy[l], L->dz[l]), 0.0f, u);
@@ -515,7 +537,7 @@ static DWVW_ALWAYS_INLINE int mixture_lanes_step_in(lane_state *L, const dwvw_es
     }
     for (int l = 0; l < DWVW_LANES; ++l)
         decay_of[l] = dwvw_grey_decay(sigma, stretch_of[l], t_of[l]);
-    int any = 0;
+    uint32_t flagged_lanes = 0;
     for (int l = 0; l < DWVW_LANES; ++l) {
         double px = L->px[l], py = L->py[l], pz = L->pz[l], x = wx[l], y = wy[l], z = wz[l];
         int first = L->events[l] == 0, exited = exited_of[l];
@@ -537,27 +559,26 @@ static DWVW_ALWAYS_INLINE int mixture_lanes_step_in(lane_state *L, const dwvw_es
         L->weight[l] = weight;
         L->events[l] = events;
         L->exited[l] = exited;
-        int flagged = exited | !(weight >= DWVW_ROULETTE_THRESHOLD) | (events >= max_events);
-        L->flagged[l] = flagged;
-        any |= flagged;
+        uint32_t flagged = (uint32_t)(exited | !(weight >= DWVW_ROULETTE_THRESHOLD) | (events >= max_events));
+        flagged_lanes |= flagged << l;
     }
-    return any;
+    return flagged_lanes;
 }
 
-DWVW_LANE_CLONES static int mixture_lanes_step_halfspace(lane_state *L, const dwvw_estimate_setup *setup,
-                                                         const dwvw_fast_plan *plan)
+DWVW_LANE_CLONES static uint32_t mixture_lanes_step_halfspace(lane_state *L, const dwvw_estimate_setup *setup,
+                                                              const dwvw_fast_plan *plan)
 {
     return mixture_lanes_step_in(L, setup, plan, DWVW_HALFSPACE);
 }
 
-DWVW_LANE_CLONES static int mixture_lanes_step_slab(lane_state *L, const dwvw_estimate_setup *setup,
-                                                    const dwvw_fast_plan *plan)
+DWVW_LANE_CLONES static uint32_t mixture_lanes_step_slab(lane_state *L, const dwvw_estimate_setup *setup,
+                                                         const dwvw_fast_plan *plan)
 {
     return mixture_lanes_step_in(L, setup, plan, DWVW_SLAB);
 }
 
-DWVW_LANE_CLONES static int mixture_lanes_step_sphere(lane_state *L, const dwvw_estimate_setup *setup,
-                                                      const dwvw_fast_plan *plan)
+DWVW_LANE_CLONES static uint32_t mixture_lanes_step_sphere(lane_state *L, const dwvw_estimate_setup *setup,
+                                                           const dwvw_fast_plan *plan)
 {
     return mixture_lanes_step_in(L, setup, plan, DWVW_SPHERE);
 }
@@ -585,8 +606,8 @@ static int mixture_lane_end(lane_state *L, int l, const dwvw_estimate_setup *set
     return 1;
 }
 
-static inline int lanes_step(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan,
-                             dwvw_shape_kind kind)
+static inline uint32_t lanes_step(lane_state *L, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan,
+                                  dwvw_shape_kind kind)
 {
     if (plan->walker == DWVW_WALKER_MIXTURE) {
         switch (kind) {
@@ -611,6 +632,7 @@ static inline void lanes_run_in(const dwvw_estimate_setup *setup, const dwvw_fas
     lane_log_columns_fill(&L.log_columns);
     L.permute = lanes_can_permute();
     const lane_template start = lane_template_for(setup, plan);
+    if (start.same_entry) lanes_fill_template(&L, &start);
     uint64_t sequence[DWVW_LANES];
     /* Bit l: lane l holds a walk. Masks, visited lowest lane first (the order of a scan over the
      * lanes), instead of a branch per lane: a lane's end is a coin toss, and per-lane tests were
@@ -624,10 +646,9 @@ static inline void lanes_run_in(const dwvw_estimate_setup *setup, const dwvw_fas
         live |= (uint32_t)begun << l;
     }
     while (live) {
-        if (!lanes_step(&L, setup, plan, kind)) continue;
         /* The live flagged lanes: about half the steps flag a lane, seldom the same one. */
-        uint32_t flagged = 0;
-        for (int l = 0; l < DWVW_LANES; ++l) flagged |= (uint32_t)L.flagged[l] << l;
+        uint32_t flagged = lanes_step(&L, setup, plan, kind);
+        if (!flagged) continue;
         uint32_t freed = 0;
         for (uint32_t pending = flagged & live; pending; pending &= pending - 1u) {
             int l = __builtin_ctz(pending);
