@@ -959,6 +959,17 @@ typedef enum dwv_subsurface_after_diffuse_t {
     DWV_SUBSURFACE_AFTER_DIFFUSE_WALK = 2      /* Cycles 5.0+ */
 } dwv_subsurface_after_diffuse_t;
 
+/* Cycles' pixel filters (film.cpp's filter table): a camera sample's offset from its pixel's
+ * centre is drawn on each axis with density proportional to the filter, every sample of weight 1
+ * (filter importance sampling, as Cycles' camera rays), so an image is the filter's convolution of
+ * the radiance. With w the filter width in pixels and x the offset:
+ *   box: uniform on |x| <= w / 2;
+ *   Gaussian: exp(-8 x^2 / w^2) on |x| <= 1.5 w;
+ *   Blackman-Harris (Blender's default, w = 1.5): 0.35875 - 0.48829 cos t + 0.14128 cos 2t
+ *   - 0.01168 cos 3t, t = 2 pi (x / (2 w) + 1/2), on |x| <= w. */
+typedef int32_t dwv_pixel_filter_t;
+enum { DWV_PIXEL_FILTER_BOX = 0, DWV_PIXEL_FILTER_GAUSSIAN = 1, DWV_PIXEL_FILTER_BLACKMAN_HARRIS = 2 };
+
 typedef struct dwv_bake_options_t {
     uint32_t struct_size;     /* sizeof(dwv_bake_options_t): set by DWV_BAKE_OPTIONS_INIT */
     dwv_bake_target_t target;
@@ -1020,13 +1031,22 @@ typedef struct dwv_bake_options_t {
      * max(alpha, 0.5 sqrt(1 - p / blur_glossy)) where p / blur_glossy < 1 (a mirror-sharp layer
      * turns GGX), for its direct light and its path ray alike. 0: none. */
     double blur_glossy;
+    /* Added after 0.3 (issue 18; a caller whose struct_size ends before them gets 0, 0: the box
+     * of one pixel, the image it always got). Cycles' pixel filter of camera bakes (Blender's
+     * scene.cycles.pixel_filter_type and filter_width; UV bakes jitter over their texel as
+     * Cycles' bake does, whatever the filter): DWV_PIXEL_FILTER_*, and its width in pixels, 0
+     * (one pixel) or in [0.01, 10] (Blender's range). */
+    dwv_pixel_filter_t pixel_filter;
+    uint32_t reserved3;       /* 0 */
+    double filter_width;
 } dwv_bake_options_t;
 /* Blender's default Light Paths (12 total, 4 diffuse, 4 glossy, 12 transmission, min 0; Filter
- * Glossy 1). */
+ * Glossy 1); the box filter of one pixel (Blender's default is Blackman-Harris of 1.5 pixels: the
+ * add-on passes the scene's). */
 #define DWV_BAKE_OPTIONS_INIT                                                                       \
     {sizeof(dwv_bake_options_t), DWV_BAKE_CAMERA, 256u, 256u, 0u, 16u, DWV_TECHNIQUE_AUTO, 64u, 0.0,  \
      0.0, 0u, 0u, 0u, 0u, 0u, NULL, NULL, 0u, 0u, 0, 0u, 0u, 0u, 12u, 4u, 4u, 12u, 0u,                \
-     DWV_SUBSURFACE_AFTER_DIFFUSE_BY_MODEL, 1.0}
+     DWV_SUBSURFACE_AFTER_DIFFUSE_BY_MODEL, 1.0, DWV_PIXEL_FILTER_BOX, 0u, 1.0}
 
 /* Bake passes as Cycles' (Blender's render passes and its bake types' pass filter). Direct:
  * light from the lights and the world at the first scattering, the one at the camera ray's hit

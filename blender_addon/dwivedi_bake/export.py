@@ -877,6 +877,24 @@ def light_paths(scene: Any, version: Optional[Tuple[int, ...]] = None) -> Dict[s
     return out
 
 
+# Blender's Film > Pixel Filter types (scene.cycles.pixel_filter_type) as the library names them.
+_PIXEL_FILTERS = {"BOX": "box", "GAUSSIAN": "gaussian", "BLACKMAN_HARRIS": "blackman_harris"}
+
+
+def pixel_filter(scene: Any) -> Dict[str, Any]:
+    """Cycles' pixel filter of the scene (Film > Pixel Filter: type and width in pixels; Blender's
+    default Blackman-Harris of 1.5) as dwivedi.BakeSettings keys: camera bakes draw each sample's
+    place in its pixel by it, as Cycles' camera rays do (UV bakes jitter over their texel either way)."""
+    cycles = getattr(scene, "cycles", None)
+    kind = str(getattr(cycles, "pixel_filter_type", "BLACKMAN_HARRIS")) if cycles is not None else "BLACKMAN_HARRIS"
+    width = float(getattr(cycles, "filter_width", 1.5)) if cycles is not None else 1.5
+    if kind not in _PIXEL_FILTERS:
+        raise ExportError(f"the scene's pixel filter '{kind}' is not one dwivedi bakes (Box, Gaussian or Blackman-Harris)")
+    if not (math.isfinite(width) and 0.01 <= width <= 10.0):
+        raise ExportError(f"the scene's pixel filter width {width} px is outside Blender's range, 0.01 to 10")
+    return {"pixel_filter": _PIXEL_FILTERS[kind], "filter_width": width}
+
+
 def render_size(scene: Any) -> Tuple[int, int]:
     """The render resolution times its percentage, as Blender renders it."""
     r = scene.render

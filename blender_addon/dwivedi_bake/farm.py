@@ -135,7 +135,7 @@ class DWIVEDI_OT_farm_export(_FarmOperator, bpy.types.Operator):
             "target": "camera", "width": exported.width, "height": exported.height, "samples": bake.samples,
             "technique": bake.technique.lower(), "channel_walks": bake.channel_walks.lower(), "seed": bake.seed,
             "max_events": bake.walk_event_cap, "transparent_background": bool(context.scene.render.film_transparent),
-            **export.light_paths(context.scene)})
+            **export.light_paths(context.scene), **export.pixel_filter(context.scene)})
         dwivedi.Scene.load(scene_path).close()  # the library reads it back, or says why here, not on the farm
         bake_args = ["--threads", str(bake.threads)] if bake.threads > 0 else []
         made = farm.plan(scene_path, bake.samples, farm_settings.chunks, folder, name=output_name(context.scene),

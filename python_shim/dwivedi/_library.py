@@ -309,6 +309,9 @@ class BakeOptions(_SizedStructure):
         ("min_light_bounces", ctypes.c_uint32),
         ("subsurface_after_diffuse", ctypes.c_int32),
         ("blur_glossy", ctypes.c_double),
+        ("pixel_filter", ctypes.c_int32),
+        ("reserved3", ctypes.c_uint32),
+        ("filter_width", ctypes.c_double),
     ]
 
     def __init__(self) -> None:
@@ -322,6 +325,7 @@ class BakeOptions(_SizedStructure):
         self.glossy_bounces = 4
         self.transmission_bounces = 12
         self.blur_glossy = 1.0
+        self.filter_width = 1.0
 
 
 class ImageInfo(_SizedStructure):

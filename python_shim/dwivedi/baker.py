@@ -451,6 +451,7 @@ def bake_type_passes(bake_type: str, pass_filter: Any) -> Tuple[str, ...]:
 _CHANNEL_WALKS = {"auto": 0, "shared": 1, "separate": 2}
 # dwv_subsurface_after_diffuse_t: a subsurface surface met after a diffuse bounce
 _AFTER_DIFFUSE = {"by_model": 0, "lambert": 1, "walk": 2}
+_PIXEL_FILTERS = {"box": 0, "gaussian": 1, "blackman_harris": 2}
 
 
 @dataclass
@@ -498,6 +499,11 @@ class BakeSettings:
     # Cycles' Filter Glossy (scene.cycles.blur_glossy; Blender's default 1.0, 0: no blur): specular
     # layers met after a path's bounces roughened as Cycles roughens them (capi's blur_glossy).
     blur_glossy: float = 1.0
+    # Cycles' pixel filter of camera bakes (scene.cycles.pixel_filter_type and filter_width):
+    # "box", "gaussian" or "blackman_harris" (Blender's default, of width 1.5), the width in pixels
+    # (0.01 to 10). The default here is the box of one pixel, the library's.
+    pixel_filter: str = "box"
+    filter_width: float = 1.0
 
     def _to_c(self) -> _library.BakeOptions:
         out = _library.BakeOptions()
@@ -529,6 +535,8 @@ class BakeSettings:
         out.subsurface_after_diffuse = _name_code("subsurface_after_diffuse", self.subsurface_after_diffuse,
                                                   _AFTER_DIFFUSE)
         out.blur_glossy = _real("blur_glossy", self.blur_glossy)
+        out.pixel_filter = _name_code("pixel_filter", self.pixel_filter, _PIXEL_FILTERS)
+        out.filter_width = _real("filter_width", self.filter_width)
         return out
 
     @classmethod
@@ -544,6 +552,8 @@ class BakeSettings:
                    subsurface_after_diffuse={v: k for k, v in _AFTER_DIFFUSE.items()}.get(
                        c.subsurface_after_diffuse, str(c.subsurface_after_diffuse)),
                    blur_glossy=c.blur_glossy,
+                   pixel_filter={v: k for k, v in _PIXEL_FILTERS.items()}.get(c.pixel_filter, str(c.pixel_filter)),
+                   filter_width=c.filter_width,
                    channel_walks={v: k for k, v in _CHANNEL_WALKS.items()}.get(c.channel_walks, str(c.channel_walks)))
 
 

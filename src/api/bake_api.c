@@ -24,6 +24,8 @@
 #define TILES_PER_THREAD 16u /* enough that the last tiles of a pass even out between workers */
 #define DEFAULT_MAX_EVENTS 1000000u
 #define MAX_BOUNCES 1024u /* Blender's Light Paths fields stop there */
+#define MIN_FILTER_WIDTH 0.01 /* pixels: Blender's Film > Pixel Filter > Width */
+#define MAX_FILTER_WIDTH 10.0
 
 static const char *const channel_walks_names[] = {"auto", "shared", "separate"};
 #define CHANNEL_WALKS_COUNT ((uint32_t)(sizeof channel_walks_names / sizeof channel_walks_names[0]))
@@ -112,6 +114,14 @@ static dwv_result_t check_options(const char *fn, const dwvb_scene *s, const dwv
         return dwv_fail(DWV_ERROR_OUT_OF_RANGE,
                         "%s: blur_glossy = %.17g must be finite and >= 0 (Cycles' Filter Glossy; 0: no blur)", fn,
                         o->blur_glossy);
+    if (o->pixel_filter < DWV_PIXEL_FILTER_BOX || o->pixel_filter > DWV_PIXEL_FILTER_BLACKMAN_HARRIS)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
+                        "%s: pixel_filter %d is not known (0 box, 1 Gaussian, 2 Blackman-Harris)", fn, (int)o->pixel_filter);
+    if (o->reserved3 != 0u) return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: reserved3 = %u must be 0", fn, o->reserved3);
+    if (!(o->filter_width == 0.0 || (o->filter_width >= MIN_FILTER_WIDTH && o->filter_width <= MAX_FILTER_WIDTH)))
+        return dwv_fail(DWV_ERROR_OUT_OF_RANGE,
+                        "%s: filter_width = %.17g pixels must be 0 (one pixel) or in [%g, %g] (Blender's range)", fn,
+                        o->filter_width, MIN_FILTER_WIDTH, MAX_FILTER_WIDTH);
     DWV_TRY(dwv_check_range(fn, "time_limit", o->time_limit, 0.0, HUGE_VAL));
     DWV_TRY(dwv_check_range(fn, "target_error", o->target_error, 0.0, HUGE_VAL));
     if (o->threads > MAX_THREADS)

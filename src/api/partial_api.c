@@ -221,6 +221,11 @@ uint64_t dwv_options_hash(const dwv_bake_options_t *o)
         ADD(&f, o->subsurface_after_diffuse);
         if (o->blur_glossy != 0.0) ADD(&f, o->blur_glossy); /* bakes without it hash as before it */
     }
+    double filter_width = o->filter_width == 0.0 ? 1.0 : o->filter_width; /* 0 is one pixel */
+    if (o->pixel_filter != DWV_PIXEL_FILTER_BOX || filter_width != 1.0) { /* the box of one pixel hashes as before */
+        ADD(&f, o->pixel_filter);
+        ADD(&f, filter_width);
+    }
     return f.h;
 }
 

@@ -20,14 +20,19 @@
 #define PIXEL_PAIR 0u
 
 /* One camera sample through pixel (x, row). Blender's camera: local -z forward, +y up, the
- * sensor (or ortho_scale) across the larger image side; a box filter over the pixel. */
+ * sensor (or ortho_scale) across the larger image side; the sample's place by the pixel filter
+ * (pixel_filter.h: filter importance sampling, as Cycles' camera_sample), the stratified pair
+ * through the filter's inverse distribution per axis. */
 static void camera_sample(const dwvb_bake *bake, uint32_t x, uint32_t row, const dwvk_sampler *sampler,
                           dwvu_vec3 *origin, dwvu_vec3 *direction)
 {
     double u[2];
     dwvk_sampler_pair(sampler, PIXEL_PAIR, u);
-    double sx = 2.0 * ((double)x + u[0]) / bake->width - 1.0;
-    double sy = 1.0 - 2.0 * ((double)row + u[1]) / bake->height;
+    const dwvb_pixel_filter *filter = &bake->pixel_filter;
+    double px = filter->unit_box ? (double)x + u[0] : (double)x + 0.5 + dwvb_pixel_filter_sample(filter, u[0]);
+    double py = filter->unit_box ? (double)row + u[1] : (double)row + 0.5 + dwvb_pixel_filter_sample(filter, u[1]);
+    double sx = 2.0 * px / bake->width - 1.0;
+    double sy = 1.0 - 2.0 * py / bake->height;
     dwvu_vec3 offset = dwvu_add(dwvu_scale(bake->right, sx), dwvu_scale(bake->up, sy));
     if (bake->scene->camera.kind == DWV_CAMERA_PERSPECTIVE) {
         *origin = bake->eye;
@@ -377,6 +382,7 @@ static void setup_camera(dwvb_bake *bake)
     bake->right = dwvu_scale(x, half_x);
     bake->up = dwvu_scale(y, half_y);
     bake->forward = dwvu_scale(z, -1.0);
+    dwvb_pixel_filter_init(&bake->pixel_filter, bake->options.pixel_filter, bake->options.filter_width);
 }
 
 dwv_result_t dwvb_bake_start(dwvb_scene *scene, const dwv_bake_options_t *options, dwvb_bake **out,

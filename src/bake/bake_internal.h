@@ -10,6 +10,7 @@
 #include <stdint.h>
 
 #include "bake/bake.h"
+#include "bake/pixel_filter.h"
 #include "bake/shade.h"
 #include "bake/uv_raster.h"
 #include "util/clock.h"
@@ -82,6 +83,7 @@ struct dwvb_bake {
     uint32_t features;
     /* camera */
     dwvu_vec3 eye, right, up, forward; /* right/up scaled to the image's half extents */
+    dwvb_pixel_filter pixel_filter;
     /* UV */
     dwvb_uv_raster raster;
     /* accumulation */

@@ -25,7 +25,7 @@ static void help(FILE *out)
             "           [--technique T] [--channel-walks C] [--threads N] [--seed S] [--width W] [--height H]\n"
             "           [--ocio CONFIG] [--display NAME] [--view NAME] [--look NAME]\n"
             "           [--exposure E] [--gamma G] [--samples FIRST:COUNT] [--passes NAMES] [--blur-glossy B]\n"
-            "           [--quiet]\n"
+            "           [--pixel-filter F] [--filter-width W] [--quiet]\n"
             "           [--mpi [--mpi-chunk N] [--mpi-timeout SECONDS]]\n\n"
             "Bakes SCENE.json (docs/scene-format.md), or without it the built-in default scene: a thin\n"
             "back-lit leaf-like shell beside a thick front-lit wax-like shape. Writes\n"
@@ -57,6 +57,9 @@ static void help(FILE *out)
             "                 TransCol, Emit, Env (docs/output.md; a direct or indirect pass brings its colour)\n"
             "  --blur-glossy B  Cycles' Filter Glossy (default: the scene's bake.blur_glossy, else Blender's\n"
             "                 1.0; 0: none): specular layers met after a bounce roughened as Cycles does\n"
+            "  --pixel-filter F  box, gaussian or blackman_harris (Blender's default); --filter-width W\n"
+            "                 its width in pixels, 0.01 to 10 (default: the scene's bake.pixel_filter and\n"
+            "                 bake.filter_width, else the box of one pixel); camera bakes only\n"
             "  --quiet        no progress bar (it is shown only on a terminal anyway)\n"
             "  --mpi          under mpirun (docs/farm.md): the ranks bake ranges of N samples each, handed\n"
             "                 out by rank 0, which merges them exactly and writes the outputs (bit for bit\n"
@@ -98,7 +101,7 @@ static int parse_overrides(int argc, char **argv, cli_bake_flags *f, dwv_bake_op
                                             "--threads", "--seed",  "--width",   "--height",  "--ocio",
                                             "--display", "--view",  "--look",    "--exposure", "--gamma",
                                             "--channel-walks", "--samples", "--mpi-chunk", "--mpi-timeout", "--passes",
-                                            "--blur-glossy"};
+                                            "--blur-glossy", "--pixel-filter", "--filter-width"};
         int known = 0;
         for (size_t k = 0; k < sizeof flags / sizeof flags[0]; ++k) known |= strcmp(flag, flags[k]) == 0;
         if (!known) return cli_usage_error(verb, "unknown argument '%.64s'", flag);
@@ -174,6 +177,19 @@ static int parse_overrides(int argc, char **argv, cli_bake_flags *f, dwv_bake_op
             if (!isfinite(number) || number < 0.0)
                 return cli_usage_error(verb, "--blur-glossy: '%.64s' must be finite and >= 0 (0: no blur)", value);
             if (apply) o->blur_glossy = number;
+        } else if (strcmp(flag, "--pixel-filter") == 0) {
+            static const char *const names[] = {"box", "gaussian", "blackman_harris"}; /* DWV_PIXEL_FILTER_* */
+            int kind = -1;
+            for (int k = 0; k < 3; ++k)
+                if (strcmp(value, names[k]) == 0) kind = k;
+            if (kind < 0)
+                return cli_usage_error(verb, "--pixel-filter: '%.64s' is not box, gaussian or blackman_harris", value);
+            if (apply) o->pixel_filter = kind;
+        } else if (strcmp(flag, "--filter-width") == 0) {
+            if (cli_parse_double(verb, flag, value, &number)) return CLI_USAGE;
+            if (!(number >= 0.01 && number <= 10.0))
+                return cli_usage_error(verb, "--filter-width: '%.64s' pixels is outside [0.01, 10]", value);
+            if (apply) o->filter_width = number;
         } else if (strcmp(flag, "--time") == 0 || strcmp(flag, "--error") == 0) {
             if (cli_parse_double(verb, flag, value, &number)) return CLI_USAGE;
             f->budget = 1;

@@ -46,9 +46,10 @@ dwv_result_t dwvs_read_bake(dwvs_parser *ps, const cJSON *item)
                                        "max_events", "tile_size", "uv_mesh",     "uv_margin",
                                        "transparent_background", "passes", "max_bounces", "diffuse_bounces",
                                        "glossy_bounces", "transmission_bounces", "min_light_bounces",
-                                       "subsurface_after_diffuse", "blur_glossy"};
+                                       "subsurface_after_diffuse", "blur_glossy", "pixel_filter", "filter_width"};
     static const char *const after_diffuse[] = {"by_model", "lambert", "walk"};
     static const char *const targets[] = {"camera", "uv"};
+    static const char *const pixel_filters[] = {"box", "gaussian", "blackman_harris"}; /* DWV_PIXEL_FILTER_* */
     DWV_TRY(dwvs_check_keys(item, "bake", keys, sizeof keys / sizeof keys[0]));
     dwv_bake_options_t *o = &ps->options;
     const cJSON *target = dwvs_member(item, "target");
@@ -135,6 +136,18 @@ dwv_result_t dwvs_read_bake(dwvs_parser *ps, const cJSON *item)
     if (!(o->blur_glossy >= 0.0))
         return dwvs_fail_at(DWV_ERROR_OUT_OF_RANGE, "bake.blur_glossy", "%.17g is negative (0 means no blur)",
                             o->blur_glossy);
+    /* Cycles' pixel filter (scene.cycles.pixel_filter_type, filter_width): a name and pixels, 0
+     * (one pixel) or 0.01 to 10. */
+    const cJSON *pixel_filter = dwvs_member(item, "pixel_filter");
+    if (pixel_filter) {
+        size_t f = 0;
+        DWV_TRY(dwvs_read_choice(pixel_filter, "bake.pixel_filter", pixel_filters, 3, &f));
+        o->pixel_filter = (dwv_pixel_filter_t)f;
+    }
+    DWV_TRY(dwvs_opt_number(item, "bake", "filter_width", &o->filter_width));
+    if (!(o->filter_width == 0.0 || (o->filter_width >= 0.01 && o->filter_width <= 10.0)))
+        return dwvs_fail_at(DWV_ERROR_OUT_OF_RANGE, "bake.filter_width",
+                            "%.17g pixels is neither 0 (one pixel) nor in [0.01, 10] (Blender's range)", o->filter_width);
 
     const cJSON *uv_mesh = dwvs_member(item, "uv_mesh"), *uv_margin = dwvs_member(item, "uv_margin");
     if (o->target != DWV_BAKE_UV) {

@@ -135,6 +135,18 @@ class TexturesTest(harness.unittest.TestCase):
     def test_textured_diffuse(self):
         self.check(compare("textured_diffuse", lambda r, s: textured_sphere(r, s, 0.0)))
 
+    def test_blackman_harris_pixel_filter(self):
+        """Blender's default pixel filter (Film > Pixel Filter: Blackman-Harris, 1.5 px; the
+        other scenes here set the box of one pixel) in both renderers: the add-on passes the
+        scene's filter, and camera samples are placed by it as Cycles' camera rays are, so the
+        colour grid's edges and the silhouette are softened alike."""
+        def build(resolution, samples):
+            scene = textured_sphere(resolution, samples, 0.0)
+            scene.cycles.pixel_filter_type = 'BLACKMAN_HARRIS'
+            scene.cycles.filter_width = 1.5
+            return scene
+        self.check(compare("blackman_harris_filter", build))
+
     def test_textured_wax(self):
         self.check(compare("textured_wax", lambda r, s: textured_sphere(r, s, 0.5)))
 

@@ -195,9 +195,11 @@ class MpiBakeTest(unittest.TestCase):
         returns the run and the seconds from the signal to mpirun's exit."""
         # When mpirun ends a job it sends the ranks SIGTERM, and SIGKILL 1 s later: on a loaded
         # machine a rank (a stopped one just continued) may not have run by then to remove its
-        # files. 8 s here (mpirun then waits that long), so that the check of no leftovers tests
-        # dwivedi, not the scheduler: 3 s once left a stopped rank 0's folder in the ASan build.
-        command = [*mpirun_prefix(2), "--mca", "odls_base_sigkill_timeout", "8", os.environ["DWIVEDI_CLI"], "bake",
+        # files. 20 s here (mpirun waits that long at most: a rank that ends sooner ends the
+        # wait), so that the check of no leftovers tests dwivedi, not the scheduler: 3 s once, and
+        # 8 s once more (the ASan build beside another build's tests, load ~4 on 2 cores), left a
+        # stopped rank 0's folder.
+        command = [*mpirun_prefix(2), "--mca", "odls_base_sigkill_timeout", "20", os.environ["DWIVEDI_CLI"], "bake",
                    *LONG, *extra, "--mpi", "--out", self.path("out")]
         run = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=self.env)
         pid = 0
