@@ -969,6 +969,10 @@ typedef enum dwv_subsurface_after_diffuse_t {
  *   - 0.01168 cos 3t, t = 2 pi (x / (2 w) + 1/2), on |x| <= w. */
 typedef int32_t dwv_pixel_filter_t;
 enum { DWV_PIXEL_FILTER_BOX = 0, DWV_PIXEL_FILTER_GAUSSIAN = 1, DWV_PIXEL_FILTER_BLACKMAN_HARRIS = 2 };
+/* The filters' names, as the scene file (bake.pixel_filter), the CLI (--pixel-filter) and the
+ * shim spell them: "box", "gaussian", "blackman_harris"; NULL for a value that is no filter. */
+DWV_API const char *dwv_pixel_filter_name(dwv_pixel_filter_t pixel_filter);
+DWV_API dwv_result_t dwv_pixel_filter_from_name(const char *name, dwv_pixel_filter_t *pixel_filter);
 
 typedef struct dwv_bake_options_t {
     uint32_t struct_size;     /* sizeof(dwv_bake_options_t): set by DWV_BAKE_OPTIONS_INIT */

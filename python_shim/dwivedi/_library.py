@@ -425,6 +425,8 @@ _BAKER_PROTOTYPES: Dict[str, Tuple[object, Sequence[object]]] = {
     "dwv_technique_from_name": (_result_t, (ctypes.c_char_p, _p(ctypes.c_int32))),
     "dwv_channel_walks_name": (ctypes.c_char_p, (ctypes.c_uint32,)),
     "dwv_channel_walks_from_name": (_result_t, (ctypes.c_char_p, _p(ctypes.c_uint32))),
+    "dwv_pixel_filter_name": (ctypes.c_char_p, (ctypes.c_int32,)),
+    "dwv_pixel_filter_from_name": (_result_t, (ctypes.c_char_p, _p(ctypes.c_int32))),
     "dwv_feature_name": (ctypes.c_char_p, (ctypes.c_uint32,)),
     "dwv_scene_create": (_result_t, (_handle_pp,)),
     "dwv_scene_retain": (_result_t, (_handle_p,)),

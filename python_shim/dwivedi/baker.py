@@ -128,6 +128,27 @@ def _technique_name(code: int) -> str:
     return name.decode("ascii") if name else str(code)
 
 
+def _pixel_filter_code(pixel_filter: Any) -> int:
+    """DWV_PIXEL_FILTER_* of a name the library knows (any case) or of a code it names."""
+    if isinstance(pixel_filter, bool) or not isinstance(pixel_filter, (str, int)):
+        raise TypeError(f"pixel_filter must be a str such as 'box', not {type(pixel_filter).__name__}")
+    if isinstance(pixel_filter, int):  # ctypes would wrap a value beyond int32_t around
+        named = -(1 << 31) <= pixel_filter < (1 << 31) and _library.function("dwv_pixel_filter_name")(pixel_filter)
+        if not named:
+            raise Error(f"unknown pixel filter {pixel_filter}", _library.DWV_ERROR_UNKNOWN_NAME)
+        return pixel_filter
+    if "\0" in pixel_filter:
+        raise Error(f"unknown pixel filter {pixel_filter!r} (it contains a NUL)", _library.DWV_ERROR_UNKNOWN_NAME)
+    code = ctypes.c_int32()
+    _call("dwv_pixel_filter_from_name", pixel_filter.lower().encode("utf-8", "replace"), ctypes.byref(code))
+    return code.value
+
+
+def _pixel_filter_name(code: int) -> str:
+    name = _library.function("dwv_pixel_filter_name")(code)
+    return name.decode("ascii") if name else str(code)
+
+
 def feature_names(features: int) -> Tuple[str, ...]:
     """The names of the DWV_FEATURE_* bits set in `features` ("embree", "subsurface"...)."""
     name_of = _library.function("dwv_feature_name")
@@ -451,7 +472,6 @@ def bake_type_passes(bake_type: str, pass_filter: Any) -> Tuple[str, ...]:
 _CHANNEL_WALKS = {"auto": 0, "shared": 1, "separate": 2}
 # dwv_subsurface_after_diffuse_t: a subsurface surface met after a diffuse bounce
 _AFTER_DIFFUSE = {"by_model": 0, "lambert": 1, "walk": 2}
-_PIXEL_FILTERS = {"box": 0, "gaussian": 1, "blackman_harris": 2}
 
 
 @dataclass
@@ -535,7 +555,7 @@ class BakeSettings:
         out.subsurface_after_diffuse = _name_code("subsurface_after_diffuse", self.subsurface_after_diffuse,
                                                   _AFTER_DIFFUSE)
         out.blur_glossy = _real("blur_glossy", self.blur_glossy)
-        out.pixel_filter = _name_code("pixel_filter", self.pixel_filter, _PIXEL_FILTERS)
+        out.pixel_filter = _pixel_filter_code(self.pixel_filter)
         out.filter_width = _real("filter_width", self.filter_width)
         return out
 
@@ -552,7 +572,7 @@ class BakeSettings:
                    subsurface_after_diffuse={v: k for k, v in _AFTER_DIFFUSE.items()}.get(
                        c.subsurface_after_diffuse, str(c.subsurface_after_diffuse)),
                    blur_glossy=c.blur_glossy,
-                   pixel_filter={v: k for k, v in _PIXEL_FILTERS.items()}.get(c.pixel_filter, str(c.pixel_filter)),
+                   pixel_filter=_pixel_filter_name(c.pixel_filter),
                    filter_width=c.filter_width,
                    channel_walks={v: k for k, v in _CHANNEL_WALKS.items()}.get(c.channel_walks, str(c.channel_walks)))
 

@@ -3,6 +3,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stddef.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -47,6 +48,46 @@ dwv_result_t dwv_channel_walks_from_name(const char *name, dwv_channel_walks_t *
     }
     return dwv_fail(DWV_ERROR_UNKNOWN_NAME,
                     "dwv_channel_walks_from_name: unknown channel walks '%.64s' (auto, shared or separate)", name);
+}
+
+/* Indexed by DWV_PIXEL_FILTER_*: the one spelling of the names (scene file, CLI, shim). */
+static const char *const pixel_filter_names[] = {"box", "gaussian", "blackman_harris"};
+#define PIXEL_FILTER_COUNT ((int32_t)(sizeof pixel_filter_names / sizeof pixel_filter_names[0]))
+
+const char *dwv_pixel_filter_name(dwv_pixel_filter_t pixel_filter)
+{
+    return pixel_filter >= 0 && pixel_filter < PIXEL_FILTER_COUNT ? pixel_filter_names[pixel_filter] : NULL;
+}
+
+/* The filters' names for a message, "box, gaussian or blackman_harris", each after its value
+ * when numbered ("0 box, 1 gaussian or 2 blackman_harris"). */
+static const char *pixel_filter_list(char *out, size_t size, int numbered)
+{
+    size_t used = 0;
+    out[0] = '\0';
+    for (int32_t i = 0; i < PIXEL_FILTER_COUNT && used < size; ++i) {
+        const char *separator = i == 0 ? "" : i + 1 == PIXEL_FILTER_COUNT ? " or " : ", ";
+        int n = numbered ? snprintf(out + used, size - used, "%s%d %s", separator, (int)i, pixel_filter_names[i])
+                         : snprintf(out + used, size - used, "%s%s", separator, pixel_filter_names[i]);
+        if (n < 0) break;
+        used += (size_t)n;
+    }
+    return out;
+}
+
+dwv_result_t dwv_pixel_filter_from_name(const char *name, dwv_pixel_filter_t *pixel_filter)
+{
+    DWV_TRY(dwv_check_pointer("dwv_pixel_filter_from_name", "name", name));
+    DWV_TRY(dwv_check_pointer("dwv_pixel_filter_from_name", "pixel_filter", pixel_filter));
+    for (int32_t i = 0; i < PIXEL_FILTER_COUNT; ++i) {
+        if (strcmp(name, pixel_filter_names[i]) == 0) {
+            *pixel_filter = i;
+            return DWV_SUCCESS;
+        }
+    }
+    char known[64];
+    return dwv_fail(DWV_ERROR_UNKNOWN_NAME, "dwv_pixel_filter_from_name: unknown pixel filter '%.64s' (%s)", name,
+                    pixel_filter_list(known, sizeof known, 0));
 }
 
 struct dwv_bake_s {
@@ -114,9 +155,11 @@ static dwv_result_t check_options(const char *fn, const dwvb_scene *s, const dwv
         return dwv_fail(DWV_ERROR_OUT_OF_RANGE,
                         "%s: blur_glossy = %.17g must be finite and >= 0 (Cycles' Filter Glossy; 0: no blur)", fn,
                         o->blur_glossy);
-    if (o->pixel_filter < DWV_PIXEL_FILTER_BOX || o->pixel_filter > DWV_PIXEL_FILTER_BLACKMAN_HARRIS)
-        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
-                        "%s: pixel_filter %d is not known (0 box, 1 Gaussian, 2 Blackman-Harris)", fn, (int)o->pixel_filter);
+    if (!dwv_pixel_filter_name(o->pixel_filter)) {
+        char known[64];
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: pixel_filter %d is not known (%s)", fn, (int)o->pixel_filter,
+                        pixel_filter_list(known, sizeof known, 1));
+    }
     if (o->reserved3 != 0u) return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: reserved3 = %u must be 0", fn, o->reserved3);
     if (!(o->filter_width == 0.0 || (o->filter_width >= MIN_FILTER_WIDTH && o->filter_width <= MAX_FILTER_WIDTH)))
         return dwv_fail(DWV_ERROR_OUT_OF_RANGE,

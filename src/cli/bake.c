@@ -178,13 +178,10 @@ static int parse_overrides(int argc, char **argv, cli_bake_flags *f, dwv_bake_op
                 return cli_usage_error(verb, "--blur-glossy: '%.64s' must be finite and >= 0 (0: no blur)", value);
             if (apply) o->blur_glossy = number;
         } else if (strcmp(flag, "--pixel-filter") == 0) {
-            static const char *const names[] = {"box", "gaussian", "blackman_harris"}; /* DWV_PIXEL_FILTER_* */
-            int kind = -1;
-            for (int k = 0; k < 3; ++k)
-                if (strcmp(value, names[k]) == 0) kind = k;
-            if (kind < 0)
-                return cli_usage_error(verb, "--pixel-filter: '%.64s' is not box, gaussian or blackman_harris", value);
-            if (apply) o->pixel_filter = kind;
+            dwv_pixel_filter_t pixel_filter;
+            if (dwv_pixel_filter_from_name(value, &pixel_filter) != DWV_SUCCESS)
+                return cli_usage_error(verb, "--pixel-filter: %s", dwv_last_error_message());
+            if (apply) o->pixel_filter = pixel_filter;
         } else if (strcmp(flag, "--filter-width") == 0) {
             if (cli_parse_double(verb, flag, value, &number)) return CLI_USAGE;
             if (!(number >= 0.01 && number <= 10.0))

@@ -49,7 +49,6 @@ dwv_result_t dwvs_read_bake(dwvs_parser *ps, const cJSON *item)
                                        "subsurface_after_diffuse", "blur_glossy", "pixel_filter", "filter_width"};
     static const char *const after_diffuse[] = {"by_model", "lambert", "walk"};
     static const char *const targets[] = {"camera", "uv"};
-    static const char *const pixel_filters[] = {"box", "gaussian", "blackman_harris"}; /* DWV_PIXEL_FILTER_* */
     DWV_TRY(dwvs_check_keys(item, "bake", keys, sizeof keys / sizeof keys[0]));
     dwv_bake_options_t *o = &ps->options;
     const cJSON *target = dwvs_member(item, "target");
@@ -140,9 +139,10 @@ dwv_result_t dwvs_read_bake(dwvs_parser *ps, const cJSON *item)
      * (one pixel) or 0.01 to 10. */
     const cJSON *pixel_filter = dwvs_member(item, "pixel_filter");
     if (pixel_filter) {
-        size_t f = 0;
-        DWV_TRY(dwvs_read_choice(pixel_filter, "bake.pixel_filter", pixel_filters, 3, &f));
-        o->pixel_filter = (dwv_pixel_filter_t)f;
+        const char *name = NULL;
+        DWV_TRY(dwvs_read_string(pixel_filter, "bake.pixel_filter", &name));
+        dwv_result_t r = dwv_pixel_filter_from_name(name, &o->pixel_filter);
+        if (r != DWV_SUCCESS) return dwvs_prefix_capi(r, "bake.pixel_filter");
     }
     DWV_TRY(dwvs_opt_number(item, "bake", "filter_width", &o->filter_width));
     if (!(o->filter_width == 0.0 || (o->filter_width >= 0.01 && o->filter_width <= 10.0)))

@@ -175,8 +175,8 @@ static void test_edge(dwv_scene_t *scene, int kind, double w)
 static void test_options(dwv_scene_t *scene)
 {
     struct { int kind; double width; uint32_t reserved3; dwv_result_t expected; const char *named; } bad[] = {
-        {3, 1.5, 0u, DWV_ERROR_INVALID_ARGUMENT, "pixel_filter"},
-        {-1, 1.5, 0u, DWV_ERROR_INVALID_ARGUMENT, "pixel_filter"},
+        {3, 1.5, 0u, DWV_ERROR_INVALID_ARGUMENT, "pixel_filter 3 is not known (0 box, 1 gaussian or 2 blackman_harris)"},
+        {-1, 1.5, 0u, DWV_ERROR_INVALID_ARGUMENT, "pixel_filter -1 is not known (0 box"},
         {DWV_PIXEL_FILTER_GAUSSIAN, 0.005, 0u, DWV_ERROR_OUT_OF_RANGE, "filter_width"},
         {DWV_PIXEL_FILTER_GAUSSIAN, 10.5, 0u, DWV_ERROR_OUT_OF_RANGE, "filter_width"},
         {DWV_PIXEL_FILTER_BOX, NAN, 0u, DWV_ERROR_OUT_OF_RANGE, "filter_width"},

@@ -149,6 +149,30 @@ class StructLayoutTest(unittest.TestCase):
                          (0, 0, 1.5, 0.5, (1.0, 1.0, 1.0), 0, 0.0))
         self.assertEqual(_library.DisplayOptions().gamma, 1.0)
 
+    def test_pixel_filter_names_are_the_librarys(self):
+        """BakeSettings.pixel_filter takes the names of dwv_pixel_filter_name (any case) or their
+        codes, turns each code back into its name, and refuses anything else with the names listed."""
+        name_of = _library.function("dwv_pixel_filter_name")
+        names = []
+        while name_of(len(names)) is not None:
+            names.append(name_of(len(names)).decode("ascii"))
+        self.assertEqual(names, ["box", "gaussian", "blackman_harris"])  # as docs/scene-format.md
+        for code, name in enumerate(names):
+            for given in (name, name.upper(), code):
+                settings = dwivedi.BakeSettings(pixel_filter=given)
+                self.assertEqual(settings._to_c().pixel_filter, code, given)
+                self.assertEqual(dwivedi.BakeSettings._from_c(settings._to_c()).pixel_filter, name)
+        for bad in ("mitchell", "", "box\0", 3, -1, 1 << 32):
+            with self.assertRaises(dwivedi.Error) as caught:
+                dwivedi.BakeSettings(pixel_filter=bad)._to_c()
+            self.assertIn("pixel filter", str(caught.exception))
+        with self.assertRaises(dwivedi.Error) as caught:
+            dwivedi.BakeSettings(pixel_filter="Mitchell")._to_c()
+        self.assertIn("'mitchell' (box, gaussian or blackman_harris)", str(caught.exception))
+        for bad in (None, 1.0, True):
+            with self.assertRaises(TypeError):
+                dwivedi.BakeSettings(pixel_filter=bad)._to_c()
+
 
 class BufferTest(unittest.TestCase):
     """Arrays reach the library without a copy where their layout allows it."""

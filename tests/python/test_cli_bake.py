@@ -137,6 +137,58 @@ class BakeCli(unittest.TestCase):
         self.assertIn("bake.channel_walks", done.stderr)
         self.assertIn("apart", done.stderr)
 
+    def test_pixel_filter_from_the_scene_and_the_flag(self):
+        """The scene's bake.pixel_filter / filter_width are used and --pixel-filter / --filter-width
+        override them: same seed, same image for the same filter wherever it is written, another
+        image for another filter."""
+        def png(*args):
+            self.bake(*args, "--seed", "3")
+            with open(self.prefix + ".png", "rb") as handle:
+                return handle.read()
+        box = png(self.write_box_scene())
+        gaussian = png(self.write_box_scene(pixel_filter="gaussian", filter_width=2.0))
+        self.assertNotEqual(gaussian, box)
+        self.assertEqual(png(self.write_box_scene(), "--pixel-filter", "gaussian", "--filter-width", "2"), gaussian)
+        self.assertEqual(png(self.write_box_scene(pixel_filter="gaussian", filter_width=2.0),
+                             "--pixel-filter", "box", "--filter-width", "1"), box)
+
+    def test_bad_pixel_filter_flags_and_keys(self):
+        """A pixel filter that is no name and a width outside Blender's 0.01 to 10, as flags (usage,
+        exit 2) or in the scene file (exit 1, the key named), are refused before the bake, and the
+        folder is as it was: an earlier bake's outputs kept, nothing new written."""
+        for filter_flags, words in ((["--pixel-filter", "mitchell"],
+                                     ["--pixel-filter", "'mitchell'", "box, gaussian or blackman_harris"]),
+                                    (["--pixel-filter", "BOX"], ["--pixel-filter", "'BOX'"]),
+                                    (["--filter-width", "0"], ["--filter-width", "'0'", "[0.01, 10]"]),
+                                    (["--filter-width", "10.5"], ["--filter-width", "'10.5'", "[0.01, 10]"]),
+                                    (["--filter-width", "nan"], ["--filter-width", "'nan'"]),
+                                    (["--filter-width", "abc"], ["--filter-width", "'abc'", "not a number"])):
+            assert_bad_usage(self, ["bake", "--out", self.prefix, *SMALL, *filter_flags], "dwivedi bake:", words)
+            self.assertEqual(os.listdir(self.folder), [], filter_flags)
+        self.bake()
+        cases = [("pixel_filter", '"mitchell"', "'mitchell' (box, gaussian or blackman_harris)"),
+                 ("pixel_filter", "2", "expected a string, found a number"),
+                 ("pixel_filter", "null", "expected a string, found null"),
+                 ("filter_width", "0.005", "[0.01, 10]"),
+                 ("filter_width", "-1", "-1 pixels"),
+                 ("filter_width", "11", "11 pixels"),
+                 ("filter_width", '"1.5"', "expected a number, found a string"),
+                 ("filter_width", "null", "expected a number, found null"),
+                 ("filter_width", "1e400", "too large")]  # JSON has no NaN; 1e400 is beyond a double
+        for key, value, message in cases:
+            scene = self.write_box_scene(**{key: "@value@"})
+            with open(scene) as handle:
+                text = handle.read().replace('"@value@"', value)
+            with open(scene, "w") as handle:
+                handle.write(text)
+            before = snapshot(self.folder)
+            done = run_cli("bake", scene, "--out", self.prefix, *SMALL)
+            self.assertEqual(done.returncode, 1, (key, value, done.stderr))
+            self.assertEqual(done.stdout, "", (key, value))
+            for said in ("box.json", "bake." + key, message):
+                self.assertIn(said, done.stderr, (key, value))
+            self.assertEqual(snapshot(self.folder), before, (key, value))
+
     def test_look_none_is_blenders_no_look(self):
         """Blender's look menu calls "no look" None: `--look None` bakes what no --look does."""
         images = []

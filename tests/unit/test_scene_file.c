@@ -58,7 +58,11 @@ static int same_options(const dwv_bake_options_t *a, const dwv_bake_options_t *b
            a->progress == b->progress && a->max_bounces == b->max_bounces &&
            a->diffuse_bounces == b->diffuse_bounces && a->glossy_bounces == b->glossy_bounces &&
            a->transmission_bounces == b->transmission_bounces && a->min_light_bounces == b->min_light_bounces &&
-           a->subsurface_after_diffuse == b->subsurface_after_diffuse && a->progress_user == b->progress_user;
+           a->subsurface_after_diffuse == b->subsurface_after_diffuse && a->progress_user == b->progress_user &&
+           a->sample_first == b->sample_first && a->sample_count == b->sample_count &&
+           a->transparent_background == b->transparent_background && a->passes == b->passes &&
+           a->blur_glossy == b->blur_glossy && a->pixel_filter == b->pixel_filter &&
+           a->filter_width == b->filter_width;
 }
 
 /* Loads JSON text (with meshes relative to the temp folder) and expects failure with `code`, a
@@ -278,6 +282,61 @@ static void test_syntax(void)
     CHECK(load_text("\xef\xbb\xbf{\"version\": 1, " MATERIAL ", \"meshes\": [{\"material\": \"m\", " TETRA "}]}",
                     NULL) == DWV_SUCCESS,
           "BOM: %s", dwv_last_error_message());
+}
+
+/* The scene's "bake" object as JSON text around `members`. */
+#define BAKE_WITH(members) "{\"version\": 1, \"meshes\": [], " CAMERA ", \"bake\": {" members "}}"
+
+/* bake.pixel_filter and bake.filter_width: each filter's name (dwv_pixel_filter_name) read, the
+ * caller's kept when absent; a value that is no name or no width refused naming its key. */
+static void test_pixel_filter(void)
+{
+    for (dwv_pixel_filter_t f = DWV_PIXEL_FILTER_BOX; dwv_pixel_filter_name(f); ++f) {
+        char json[256];
+        snprintf(json, sizeof json, BAKE_WITH("\"pixel_filter\": \"%s\", \"filter_width\": 2.5"),
+                 dwv_pixel_filter_name(f));
+        dwv_bake_options_t o = DWV_BAKE_OPTIONS_INIT;
+        o.pixel_filter = f == DWV_PIXEL_FILTER_BOX ? DWV_PIXEL_FILTER_GAUSSIAN : DWV_PIXEL_FILTER_BOX;
+        CHECK(load_text(json, &o) == DWV_SUCCESS && o.pixel_filter == f && o.filter_width == 2.5,
+              "%s: read %d %g (%s)", dwv_pixel_filter_name(f), (int)o.pixel_filter, o.filter_width,
+              dwv_last_error_message());
+        CHECK(load_text(BAKE_WITH("\"samples\": 4"), &o) == DWV_SUCCESS && o.pixel_filter == f && o.filter_width == 2.5,
+              "%s not kept when absent: %d %g", dwv_pixel_filter_name(f), (int)o.pixel_filter, o.filter_width);
+    }
+    dwv_bake_options_t o = DWV_BAKE_OPTIONS_INIT;
+    CHECK(load_text(BAKE_WITH("\"filter_width\": 0"), &o) == DWV_SUCCESS && o.filter_width == 0.0,
+          "filter_width 0 (one pixel): %s", dwv_last_error_message());
+    CHECK(load_text(BAKE_WITH("\"filter_width\": 0.01"), &o) == DWV_SUCCESS &&
+              load_text(BAKE_WITH("\"filter_width\": 10"), &o) == DWV_SUCCESS && o.filter_width == 10.0,
+          "filter_width 0.01 and 10, Blender's ends: %s", dwv_last_error_message());
+
+    expect_failure("pixel filter mitchell", BAKE_WITH("\"pixel_filter\": \"mitchell\""), DWV_ERROR_UNKNOWN_NAME,
+                   "bake.pixel_filter: dwv_pixel_filter_from_name: unknown pixel filter 'mitchell'",
+                   "(box, gaussian or blackman_harris)");
+    expect_failure("pixel filter in Blender's capitals", BAKE_WITH("\"pixel_filter\": \"BLACKMAN_HARRIS\""),
+                   DWV_ERROR_UNKNOWN_NAME, "bake.pixel_filter: ", "'BLACKMAN_HARRIS'");
+    expect_failure("pixel filter as a number", BAKE_WITH("\"pixel_filter\": 2"), DWV_ERROR_FORMAT,
+                   "bake.pixel_filter", "expected a string, found a number");
+    expect_failure("pixel filter null", BAKE_WITH("\"pixel_filter\": null"), DWV_ERROR_FORMAT, "bake.pixel_filter",
+                   "expected a string, found null");
+    expect_failure("empty pixel filter", BAKE_WITH("\"pixel_filter\": \"\""), DWV_ERROR_FORMAT, "bake.pixel_filter",
+                   "empty");
+    static const struct {
+        const char *what, *json;
+        dwv_result_t code;
+        const char *said;
+    } widths[] = {
+        {"filter width below 0.01", BAKE_WITH("\"filter_width\": 0.005"), DWV_ERROR_OUT_OF_RANGE, "0.005"},
+        {"negative filter width", BAKE_WITH("\"filter_width\": -1"), DWV_ERROR_OUT_OF_RANGE, "-1 pixels"},
+        {"filter width 11", BAKE_WITH("\"filter_width\": 11"), DWV_ERROR_OUT_OF_RANGE, "[0.01, 10]"},
+        {"filter width as a string", BAKE_WITH("\"filter_width\": \"1.5\""), DWV_ERROR_FORMAT,
+         "expected a number, found a string"},
+        {"filter width null", BAKE_WITH("\"filter_width\": null"), DWV_ERROR_FORMAT, "expected a number, found null"},
+        {"filter width 1e400", BAKE_WITH("\"filter_width\": 1e400"), DWV_ERROR_FORMAT, "too large"},
+        {"filter width -1e400", BAKE_WITH("\"filter_width\": -1e400"), DWV_ERROR_FORMAT, "too large"},
+    };
+    for (size_t i = 0; i < sizeof widths / sizeof widths[0]; ++i)
+        expect_failure(widths[i].what, widths[i].json, widths[i].code, "bake.filter_width", widths[i].said);
 }
 
 static void test_schema(void)
@@ -534,6 +593,7 @@ static void test_schema(void)
                    DWV_ERROR_OUT_OF_RANGE, "bake.glossy_bounces", NULL);
     expect_failure("after diffuse", "{\"version\": 1, \"meshes\": [], " CAMERA ", \"bake\": {\"subsurface_after_diffuse\": \"x\"}}",
                    DWV_ERROR_UNKNOWN_NAME, "subsurface_after_diffuse", NULL);
+    test_pixel_filter();
 }
 
 static void test_numbers_and_strings(void)
