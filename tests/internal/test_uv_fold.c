@@ -14,7 +14,8 @@
  *   matches its own model (the box cut to the triangle: kept tries, after 10 the centre) within
  *   1e-3 (its retries are unstratified) and misses the folding model by more than 4 times that;
  * - bad values refused; an older options struct bakes the default rule's bits; 1 and 2 threads
- *   give the same bits. Runs in about a second. */
+ *   give the same bits; the scene file's bake.uv_jitter read and a bad name refused; a UV bake's
+ *   rule changes the partial files' options hash, a camera bake's does not. Runs in 0.5 s. */
 #include <float.h>
 #include <math.h>
 #include <stddef.h>
@@ -23,6 +24,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "api/partial.h"
 #include "bake/uv_raster.h"
 #include "check.h"
 #include <dwivedi.h>
@@ -387,6 +389,36 @@ static void test_options(dwv_scene_t *scene)
         if (all[i]) dwv_image_release(all[i]);
 }
 
+/* The scene file's bake.uv_jitter, and the partial files' options hash: a UV bake's rule changes
+ * it (its partials must not merge with the other rule's), RETRY and camera bakes hash as before. */
+static void test_scene_key_and_hash(void)
+{
+#define SCENE_HEAD                                                                                       \
+    "{\"version\": 1, \"materials\": {\"m\": {\"kind\": \"diffuse\", \"subsurface_weight\": 0}},"            \
+    " \"meshes\": [{\"name\": \"tri\", \"material\": \"m\", \"positions\": [0,0,0, 1,0,0, 0,1,0],"              \
+    " \"indices\": [0,1,2], \"uvs\": [0,0, 1,0, 0,1]}], "
+    static const char good[] = SCENE_HEAD "\"bake\": {\"target\": \"uv\", \"uv_mesh\": \"tri\", \"uv_jitter\": \"mirror\"}}";
+    static const char bad[] = SCENE_HEAD "\"bake\": {\"target\": \"uv\", \"uv_mesh\": \"tri\", \"uv_jitter\": \"clamp\"}}";
+#undef SCENE_HEAD
+    dwv_scene_t *scene = NULL;
+    dwv_bake_options_t o = DWV_BAKE_OPTIONS_INIT;
+    dwv_result_t r = dwv_scene_load_json(good, sizeof good - 1u, NULL, &scene, &o);
+    CHECK(r == DWV_SUCCESS && o.uv_jitter == DWV_UV_JITTER_MIRROR, "scene file uv_jitter mirror: %d, %d, '%s'", (int)r,
+          (int)o.uv_jitter, dwv_last_error_message());
+    dwv_scene_release(scene);
+    scene = NULL;
+    o = (dwv_bake_options_t)DWV_BAKE_OPTIONS_INIT;
+    r = dwv_scene_load_json(bad, sizeof bad - 1u, NULL, &scene, &o);
+    CHECK(r != DWV_SUCCESS && !scene && strstr(dwv_last_error_message(), "bake.uv_jitter"),
+          "scene file uv_jitter clamp: %d, '%s'", (int)r, dwv_last_error_message());
+    dwv_scene_release(scene);
+
+    dwv_bake_options_t retry = fold_options(DWV_UV_JITTER_RETRY, 16u, 1u), mirror = fold_options(DWV_UV_JITTER_MIRROR, 16u, 1u);
+    CHECK(dwv_options_hash(&retry) != dwv_options_hash(&mirror), "a UV bake's rule does not change the options hash");
+    retry.target = mirror.target = DWV_BAKE_CAMERA;
+    CHECK(dwv_options_hash(&retry) == dwv_options_hash(&mirror), "the rule changes a camera bake's options hash");
+}
+
 int main(void)
 {
     test_mirror_repeat();
@@ -395,5 +427,6 @@ int main(void)
     test_bake_distribution(scene);
     test_options(scene);
     dwv_scene_release(scene);
+    test_scene_key_and_hash();
     return check_report("test_uv_fold");
 }
