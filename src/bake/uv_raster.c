@@ -277,7 +277,7 @@ int dwvb_uv_jitter(const dwvb_uv_steps *step, double b1, double b2, double r0, d
 
 double dwvb_uv_mirror_repeat(double x, double m)
 {
-    if (!(m > 0.0)) return 0.0; /* [0, 0] holds one point (1 - u' = 0: u' is the corner) */
+    if (!(m > 0.0)) return 0.0; /* [0, 0] holds one point (m = 1 - u' = 0: the point is corner 0) */
     double t = x / m, period = floor(t), f = t - period;
     return (fmod(period, 2.0) != 0.0 ? 1.0 - f : f) * m; /* odd periods run backwards */
 }
