@@ -974,6 +974,21 @@ enum { DWV_PIXEL_FILTER_BOX = 0, DWV_PIXEL_FILTER_GAUSSIAN = 1, DWV_PIXEL_FILTER
 DWV_API const char *dwv_pixel_filter_name(dwv_pixel_filter_t pixel_filter);
 DWV_API dwv_result_t dwv_pixel_filter_from_name(const char *name, dwv_pixel_filter_t *pixel_filter);
 
+/* Where a UV bake's samples sit in their texel (issue 18), as Cycles' bake places them
+ * (integrator_init_from_bake). Blender hands each texel's centre to Cycles as barycentrics (u, v)
+ * of its triangle's corners 0 and 1 (corner 2: 1 - u - v) and their half-texel differentials
+ * du/dx, du/dy, dv/dx, dv/dy; a sample with uniforms (rx, ry) moves the centre to
+ * u + du/dx (rx - 1/2) + du/dy (ry - 1/2), and v alike:
+ *   RETRY (Cycles 3.5 and later, the default): the moved point where it lies strictly inside the
+ *     triangle, else new uniforms, up to 10 tries, then the centre;
+ *   MIRROR (Cycles up to 3.4): sample 0 at the centre; every other sample's point folded back into
+ *     the triangle, u' = fold(u moved, 1) then v' = fold(v moved, 1 - u'), where
+ *     fold(x, m) = m f(x / m), f(t) = t - floor(t) on even periods floor(t) and
+ *     1 - (t - floor(t)) on odd ones (a mirrored repeat; fold(x, 0) = 0).
+ * Camera bakes place their samples by the pixel filter whatever this says. */
+typedef int32_t dwv_uv_jitter_t;
+enum { DWV_UV_JITTER_RETRY = 0, DWV_UV_JITTER_MIRROR = 1 };
+
 typedef struct dwv_bake_options_t {
     uint32_t struct_size;     /* sizeof(dwv_bake_options_t): set by DWV_BAKE_OPTIONS_INIT */
     dwv_bake_target_t target;
@@ -1043,14 +1058,19 @@ typedef struct dwv_bake_options_t {
     dwv_pixel_filter_t pixel_filter;
     uint32_t reserved3;       /* 0 */
     double filter_width;
+    /* Added after 0.3 (issue 18; a caller whose struct_size ends before it gets 0, RETRY: the
+     * texel samples it always got). Where a UV bake's samples sit in their texel: DWV_UV_JITTER_*
+     * (the add-on passes MIRROR from Blender 3.4 and earlier). */
+    dwv_uv_jitter_t uv_jitter;
+    uint32_t reserved4;       /* 0 */
 } dwv_bake_options_t;
 /* Blender's default Light Paths (12 total, 4 diffuse, 4 glossy, 12 transmission, min 0; Filter
  * Glossy 1); the box filter of one pixel (Blender's default is Blackman-Harris of 1.5 pixels: the
- * add-on passes the scene's). */
+ * add-on passes the scene's); UV samples placed as Cycles 3.5+ places them. */
 #define DWV_BAKE_OPTIONS_INIT                                                                       \
     {sizeof(dwv_bake_options_t), DWV_BAKE_CAMERA, 256u, 256u, 0u, 16u, DWV_TECHNIQUE_AUTO, 64u, 0.0,  \
      0.0, 0u, 0u, 0u, 0u, 0u, NULL, NULL, 0u, 0u, 0, 0u, 0u, 0u, 12u, 4u, 4u, 12u, 0u,                \
-     DWV_SUBSURFACE_AFTER_DIFFUSE_BY_MODEL, 1.0, DWV_PIXEL_FILTER_BOX, 0u, 1.0}
+     DWV_SUBSURFACE_AFTER_DIFFUSE_BY_MODEL, 1.0, DWV_PIXEL_FILTER_BOX, 0u, 1.0, DWV_UV_JITTER_RETRY, 0u}
 
 /* Bake passes as Cycles' (Blender's render passes and its bake types' pass filter). Direct:
  * light from the lights and the world at the first scattering, the one at the camera ray's hit

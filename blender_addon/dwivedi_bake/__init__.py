@@ -568,7 +568,7 @@ class _Job:
             max_events=settings.walk_event_cap,
             transparent_background=settings.target == 'CAMERA' and scene.render.film_transparent,
             passes=self.passes,
-            **export.light_paths(scene), **export.pixel_filter(scene))
+            **export.light_paths(scene), **export.pixel_filter(scene), **export.uv_jitter())
         self.display = display_settings(scene, self.dwivedi)
         self.bake = None
         self.result = None  # the Blender image that holds the result, once finished

@@ -895,6 +895,16 @@ def pixel_filter(scene: Any) -> Dict[str, Any]:
     return {"pixel_filter": _PIXEL_FILTERS[kind], "filter_width": width}
 
 
+def uv_jitter(version: Optional[Tuple[int, ...]] = None) -> Dict[str, Any]:
+    """Where that Blender's Cycles places a UV bake's samples in their texel, as a
+    dwivedi.BakeSettings key: up to 3.4 sample 0 at the centre and the others folded back into
+    their triangle (bake_clamp_mirror_repeat), from 3.5 on tried again where they leave it
+    (bake_jitter_barycentric)."""
+    if version is None:
+        version = tuple(bpy.app.version) if bpy is not None else (3, 4, 0)
+    return {"uv_jitter": "mirror" if tuple(version) < (3, 5, 0) else "retry"}
+
+
 def render_size(scene: Any) -> Tuple[int, int]:
     """The render resolution times its percentage, as Blender renders it."""
     r = scene.render

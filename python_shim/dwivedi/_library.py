@@ -312,6 +312,8 @@ class BakeOptions(_SizedStructure):
         ("pixel_filter", ctypes.c_int32),
         ("reserved3", ctypes.c_uint32),
         ("filter_width", ctypes.c_double),
+        ("uv_jitter", ctypes.c_int32),
+        ("reserved4", ctypes.c_uint32),
     ]
 
     def __init__(self) -> None:

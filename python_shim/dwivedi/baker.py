@@ -472,6 +472,8 @@ def bake_type_passes(bake_type: str, pass_filter: Any) -> Tuple[str, ...]:
 _CHANNEL_WALKS = {"auto": 0, "shared": 1, "separate": 2}
 # dwv_subsurface_after_diffuse_t: a subsurface surface met after a diffuse bounce
 _AFTER_DIFFUSE = {"by_model": 0, "lambert": 1, "walk": 2}
+# dwv_uv_jitter_t: where a UV bake's samples sit in their texel
+_UV_JITTERS = {"retry": 0, "mirror": 1}
 
 
 @dataclass
@@ -524,6 +526,10 @@ class BakeSettings:
     # (0.01 to 10). The default here is the box of one pixel, the library's.
     pixel_filter: str = "box"
     filter_width: float = 1.0
+    # Where a UV bake's samples sit in their texel, as Cycles' bake places them: "retry" (Cycles
+    # 3.5 and later, the default) or "mirror" (Cycles up to 3.4: sample 0 at the centre, the others
+    # folded back into the triangle; capi's dwv_uv_jitter_t).
+    uv_jitter: str = "retry"
 
     def _to_c(self) -> _library.BakeOptions:
         out = _library.BakeOptions()
@@ -557,6 +563,7 @@ class BakeSettings:
         out.blur_glossy = _real("blur_glossy", self.blur_glossy)
         out.pixel_filter = _pixel_filter_code(self.pixel_filter)
         out.filter_width = _real("filter_width", self.filter_width)
+        out.uv_jitter = _name_code("uv_jitter", self.uv_jitter, _UV_JITTERS)
         return out
 
     @classmethod
@@ -574,6 +581,7 @@ class BakeSettings:
                    blur_glossy=c.blur_glossy,
                    pixel_filter=_pixel_filter_name(c.pixel_filter),
                    filter_width=c.filter_width,
+                   uv_jitter={v: k for k, v in _UV_JITTERS.items()}.get(c.uv_jitter, str(c.uv_jitter)),
                    channel_walks={v: k for k, v in _CHANNEL_WALKS.items()}.get(c.channel_walks, str(c.channel_walks)))
 
 

@@ -165,6 +165,11 @@ static dwv_result_t check_options(const char *fn, const dwvb_scene *s, const dwv
         return dwv_fail(DWV_ERROR_OUT_OF_RANGE,
                         "%s: filter_width = %.17g pixels must be 0 (one pixel) or in [%g, %g] (Blender's range)", fn,
                         o->filter_width, MIN_FILTER_WIDTH, MAX_FILTER_WIDTH);
+    if (o->uv_jitter != DWV_UV_JITTER_RETRY && o->uv_jitter != DWV_UV_JITTER_MIRROR)
+        return dwv_fail(DWV_ERROR_INVALID_ARGUMENT,
+                        "%s: uv_jitter %d is not known (0 retry, Cycles 3.5+; 1 mirror, Cycles up to 3.4)", fn,
+                        (int)o->uv_jitter);
+    if (o->reserved4 != 0u) return dwv_fail(DWV_ERROR_INVALID_ARGUMENT, "%s: reserved4 = %u must be 0", fn, o->reserved4);
     DWV_TRY(dwv_check_range(fn, "time_limit", o->time_limit, 0.0, HUGE_VAL));
     DWV_TRY(dwv_check_range(fn, "target_error", o->target_error, 0.0, HUGE_VAL));
     if (o->threads > MAX_THREADS)

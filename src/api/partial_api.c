@@ -226,6 +226,8 @@ uint64_t dwv_options_hash(const dwv_bake_options_t *o)
         ADD(&f, o->pixel_filter);
         ADD(&f, filter_width);
     }
+    /* Only UV bakes place samples by it; RETRY hashes as before it. */
+    if (o->target == DWV_BAKE_UV && o->uv_jitter != DWV_UV_JITTER_RETRY) ADD(&f, o->uv_jitter);
     return f.h;
 }
 

@@ -46,17 +46,22 @@ static void camera_sample(const dwvb_bake *bake, uint32_t x, uint32_t row, const
 /* The salt of the counter-based numbers of a texel sample's further tries (texel_sample). */
 #define TEXEL_RETRY_SALT 0x9e6c63d0676a9a99ull
 
-/* A UV bake's sample of texel `index`: its triangle and the point of it the sample shades, and the
- * shader it shades with. As Cycles (integrator_init_from_bake, 3.6+): the texel centre moved by
- * the sampler's pair PIXEL_PAIR (unused otherwise in UV bakes: stratified over the texel's
- * samples) over a box of the texel's differentials (dwvb_uv_jitter); where that point is not
- * inside the triangle, up to DWVB_UV_JITTER_TRIES - 1 further tries from counter-based numbers of
- * the sample, then the centre. (Cycles shades its sample 0 at the centre; here every sample is
- * jittered: the box filter's mean, to 1 / samples of it.) The shader is `shader` with the texel's
- * footprint on the surface (dwvb_uv_texel_footprint) as a constant one: Cycles' ray differential
- * for Cycles 4.0-4.3's quarter-footprint rule (dwvb_material.min_footprint). */
-static void texel_sample(const dwvb_bake *bake, const dwvg_mesh *mesh, uint32_t index, const dwvk_sampler *sampler,
-                         uint64_t key_walk, dwvg_hit *hit, dwvb_shader *texel_shader, const dwvb_shader *shader)
+/* A UV bake's sample s of texel `index`: its triangle and the point of it the sample shades, and
+ * the shader it shades with. As Cycles (integrator_init_from_bake), the texel centre moved by the
+ * sampler's pair PIXEL_PAIR (unused otherwise in UV bakes: stratified over the texel's samples)
+ * over a box of the texel's differentials, by the bake's uv_jitter rule (capi's dwv_uv_jitter_t):
+ * - RETRY (3.5+, dwvb_uv_jitter): where that point is not inside the triangle, up to
+ *   DWVB_UV_JITTER_TRIES - 1 further tries from counter-based numbers of the sample, then the
+ *   centre. (Cycles shades its sample 0 at the centre; here every sample is jittered: the box
+ *   filter's mean, to 1 / samples of it.)
+ * - MIRROR (up to 3.4, dwvb_uv_fold): sample 0 at the centre, as Cycles; the others' points
+ *   folded back into the triangle.
+ * The shader is `shader` with the texel's footprint on the surface (dwvb_uv_texel_footprint) as a
+ * constant one: Cycles' ray differential for Cycles 4.0-4.3's quarter-footprint rule
+ * (dwvb_material.min_footprint). */
+static void texel_sample(const dwvb_bake *bake, const dwvg_mesh *mesh, uint32_t index, uint64_t s,
+                         const dwvk_sampler *sampler, uint64_t key_walk, dwvg_hit *hit, dwvb_shader *texel_shader,
+                         const dwvb_shader *shader)
 {
     const dwvb_uv_texel *texel = &bake->raster.texels[index];
     hit->prim = (uint32_t)texel->triangle;
@@ -67,10 +72,14 @@ static void texel_sample(const dwvb_bake *bake, const dwvg_mesh *mesh, uint32_t 
     dwvb_uv_texel_steps(mesh->uvs + 6u * (size_t)hit->prim, bake->width, bake->height, &step);
     double r[2];
     dwvk_sampler_pair(sampler, PIXEL_PAIR, r);
-    dwvk_sampler retry = {dwvk_mix64(key_walk ^ TEXEL_RETRY_SALT), 0u, 0};
-    for (uint32_t k = 1; !dwvb_uv_jitter(&step, texel->b1, texel->b2, r[0], r[1], &hit->u, &hit->v); ++k) {
-        if (k == DWVB_UV_JITTER_TRIES) break; /* the centre, set above */
-        dwvk_sampler_pair(&retry, k - 1u, r);
+    if (bake->options.uv_jitter == DWV_UV_JITTER_MIRROR) {
+        if (s > 0u) dwvb_uv_fold(&step, texel->b1, texel->b2, r[0], r[1], &hit->u, &hit->v);
+    } else {
+        dwvk_sampler retry = {dwvk_mix64(key_walk ^ TEXEL_RETRY_SALT), 0u, 0};
+        for (uint32_t k = 1; !dwvb_uv_jitter(&step, texel->b1, texel->b2, r[0], r[1], &hit->u, &hit->v); ++k) {
+            if (k == DWVB_UV_JITTER_TRIES) break; /* the centre, set above */
+            dwvk_sampler_pair(&retry, k - 1u, r);
+        }
     }
     dwvu_vec3 p0 = dwvg_point(mesh, hit->prim, 0.0, 0.0);
     dwvu_vec3 e1 = dwvu_sub(dwvg_point(mesh, hit->prim, 1.0, 0.0), p0);
@@ -118,7 +127,7 @@ void dwvb_bake_sample(const dwvb_bake *bake, const dwvb_shader *shader, uint64_t
          * there). */
         hit.mesh = bake->options.uv_mesh;
         const dwvg_mesh *mesh = &bake->scene->meshes[hit.mesh];
-        texel_sample(bake, mesh, index, &sampler, key_walk, &hit, &texel_shader, shader);
+        texel_sample(bake, mesh, index, s, &sampler, key_walk, &hit, &texel_shader, shader);
         shader = &texel_shader;
         dwvu_vec3 ng = dwvg_geometric_normal(mesh, hit.prim);
         view = dwvu_scale(dwvg_shading_normal(mesh, hit.prim, hit.u, hit.v, ng), -1.0);

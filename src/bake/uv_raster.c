@@ -275,6 +275,23 @@ int dwvb_uv_jitter(const dwvb_uv_steps *step, double b1, double b2, double r0, d
     return 1;
 }
 
+double dwvb_uv_mirror_repeat(double x, double m)
+{
+    if (!(m > 0.0)) return 0.0; /* [0, 0] holds one point (m = 1 - u' = 0: the point is corner 0) */
+    double t = x / m, period = floor(t), f = t - period;
+    return (fmod(period, 2.0) != 0.0 ? 1.0 - f : f) * m; /* odd periods run backwards */
+}
+
+void dwvb_uv_fold(const dwvb_uv_steps *step, double b1, double b2, double r0, double r1, double *j1, double *j2)
+{
+    /* Blender's u = b0 changes by -(d b1 + d b2), its v = b1 by d b1 (the weights sum to 1). */
+    double du_dx = -(step->d[0][0] + step->d[1][0]), du_dy = -(step->d[0][1] + step->d[1][1]);
+    double u = dwvb_uv_mirror_repeat(1.0 - b1 - b2 + (r0 - 0.5) * du_dx + (r1 - 0.5) * du_dy, 1.0);
+    double v = dwvb_uv_mirror_repeat(b1 + (r0 - 0.5) * step->d[0][0] + (r1 - 0.5) * step->d[0][1], 1.0 - u);
+    *j1 = v;
+    *j2 = 1.0 - u - v; /* (1 - u') - v' >= 0 exactly: v' = f (1 - u') with f <= 1 */
+}
+
 /* ---- margin ---------------------------------------------------------------------------------- */
 
 #define PENDING (UINT32_MAX - 1u) /* found by the current pass, source not yet chosen */

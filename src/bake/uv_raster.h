@@ -76,11 +76,20 @@ double dwvb_uv_texel_footprint(const double e1[3], const double e2[3], const dwv
 
 /* The texel's sample at uniforms (r0, r1) in [0, 1)^2: the centre's barycentrics (b1, b2) moved by
  * (r0 - 1/2, r1 - 1/2) differentials, Cycles' box filter of half a texel's width about the centre
- * (bake_jitter_barycentric, Cycles 3.6+). Returns 1 and the moved point where it lies strictly
+ * (DWV_UV_JITTER_RETRY, Cycles 3.5+). Returns 1 and the moved point where it lies strictly
  * inside the triangle, else 0 (Cycles then tries new numbers, and after 10 tries the centre). */
 int dwvb_uv_jitter(const dwvb_uv_steps *step, double b1, double b2, double r0, double r1, double *j1, double *j2);
 /* Cycles' tries before it keeps the centre. */
 #define DWVB_UV_JITTER_TRIES 10u
+
+/* Cycles up to 3.4's sample (DWV_UV_JITTER_MIRROR, capi's dwv_uv_jitter_t): the same moved point,
+ * but in Blender's barycentrics (u, v) = (b0, b1) = (1 - b1 - b2, b1), folded back into the
+ * triangle coordinate by coordinate: u' = fold(u moved, 1), v' = fold(v moved, 1 - u'), with
+ * fold(x, m) = m f(x / m), f the mirrored repeat of [0, 1] (fold(x, 0) = 0). Always a point of
+ * the closed triangle: *j1 = v', *j2 = 1 - u' - v'. */
+void dwvb_uv_fold(const dwvb_uv_steps *step, double b1, double b2, double r0, double r1, double *j1, double *j2);
+/* The mirrored repeat of [0, m] (m >= 0) that dwvb_uv_fold applies to each coordinate. */
+double dwvb_uv_mirror_repeat(double x, double m);
 
 /* The margin: for every texel, the covered texel whose values it takes. A covered texel takes its
  * own; an uncovered texel at Chebyshev distance d in 1..margin from the covered ones takes those of

@@ -25,7 +25,7 @@ static void help(FILE *out)
             "           [--technique T] [--channel-walks C] [--threads N] [--seed S] [--width W] [--height H]\n"
             "           [--ocio CONFIG] [--display NAME] [--view NAME] [--look NAME]\n"
             "           [--exposure E] [--gamma G] [--samples FIRST:COUNT] [--passes NAMES] [--blur-glossy B]\n"
-            "           [--pixel-filter F] [--filter-width W] [--quiet]\n"
+            "           [--pixel-filter F] [--filter-width W] [--uv-jitter J] [--quiet]\n"
             "           [--mpi [--mpi-chunk N] [--mpi-timeout SECONDS]]\n\n"
             "Bakes SCENE.json (docs/scene-format.md), or without it the built-in default scene: a thin\n"
             "back-lit leaf-like shell beside a thick front-lit wax-like shape. Writes\n"
@@ -60,6 +60,8 @@ static void help(FILE *out)
             "  --pixel-filter F  box, gaussian or blackman_harris (Blender's default); --filter-width W\n"
             "                 its width in pixels, 0.01 to 10 (default: the scene's bake.pixel_filter and\n"
             "                 bake.filter_width, else the box of one pixel); camera bakes only\n"
+            "  --uv-jitter J  retry (Cycles 3.5+, the default) or mirror (Cycles up to 3.4): where UV bakes'\n"
+            "                 samples sit in their texel (default: the scene's bake.uv_jitter, else retry)\n"
             "  --quiet        no progress bar (it is shown only on a terminal anyway)\n"
             "  --mpi          under mpirun (docs/farm.md): the ranks bake ranges of N samples each, handed\n"
             "                 out by rank 0, which merges them exactly and writes the outputs (bit for bit\n"
@@ -101,7 +103,7 @@ static int parse_overrides(int argc, char **argv, cli_bake_flags *f, dwv_bake_op
                                             "--threads", "--seed",  "--width",   "--height",  "--ocio",
                                             "--display", "--view",  "--look",    "--exposure", "--gamma",
                                             "--channel-walks", "--samples", "--mpi-chunk", "--mpi-timeout", "--passes",
-                                            "--blur-glossy", "--pixel-filter", "--filter-width"};
+                                            "--blur-glossy", "--pixel-filter", "--filter-width", "--uv-jitter"};
         int known = 0;
         for (size_t k = 0; k < sizeof flags / sizeof flags[0]; ++k) known |= strcmp(flag, flags[k]) == 0;
         if (!known) return cli_usage_error(verb, "unknown argument '%.64s'", flag);
@@ -187,6 +189,12 @@ static int parse_overrides(int argc, char **argv, cli_bake_flags *f, dwv_bake_op
             if (!(number >= 0.01 && number <= 10.0))
                 return cli_usage_error(verb, "--filter-width: '%.64s' pixels is outside [0.01, 10]", value);
             if (apply) o->filter_width = number;
+        } else if (strcmp(flag, "--uv-jitter") == 0) {
+            int rule = strcmp(value, "retry") == 0    ? DWV_UV_JITTER_RETRY
+                       : strcmp(value, "mirror") == 0 ? DWV_UV_JITTER_MIRROR
+                                                      : -1;
+            if (rule < 0) return cli_usage_error(verb, "--uv-jitter: '%.64s' is not retry or mirror", value);
+            if (apply) o->uv_jitter = rule;
         } else if (strcmp(flag, "--time") == 0 || strcmp(flag, "--error") == 0) {
             if (cli_parse_double(verb, flag, value, &number)) return CLI_USAGE;
             f->budget = 1;

@@ -46,9 +46,11 @@ dwv_result_t dwvs_read_bake(dwvs_parser *ps, const cJSON *item)
                                        "max_events", "tile_size", "uv_mesh",     "uv_margin",
                                        "transparent_background", "passes", "max_bounces", "diffuse_bounces",
                                        "glossy_bounces", "transmission_bounces", "min_light_bounces",
-                                       "subsurface_after_diffuse", "blur_glossy", "pixel_filter", "filter_width"};
+                                       "subsurface_after_diffuse", "blur_glossy", "pixel_filter", "filter_width",
+                                       "uv_jitter"};
     static const char *const after_diffuse[] = {"by_model", "lambert", "walk"};
     static const char *const targets[] = {"camera", "uv"};
+    static const char *const uv_jitters[] = {"retry", "mirror"}; /* DWV_UV_JITTER_* */
     DWV_TRY(dwvs_check_keys(item, "bake", keys, sizeof keys / sizeof keys[0]));
     dwv_bake_options_t *o = &ps->options;
     const cJSON *target = dwvs_member(item, "target");
@@ -148,6 +150,14 @@ dwv_result_t dwvs_read_bake(dwvs_parser *ps, const cJSON *item)
     if (!(o->filter_width == 0.0 || (o->filter_width >= 0.01 && o->filter_width <= 10.0)))
         return dwvs_fail_at(DWV_ERROR_OUT_OF_RANGE, "bake.filter_width",
                             "%.17g pixels is neither 0 (one pixel) nor in [0.01, 10] (Blender's range)", o->filter_width);
+    /* Where UV samples sit in their texel: Cycles 3.5+'s tries, or up to 3.4's fold (accepted on
+     * camera bakes too, which place their samples by the pixel filter). */
+    const cJSON *uv_jitter = dwvs_member(item, "uv_jitter");
+    if (uv_jitter) {
+        size_t j = 0;
+        DWV_TRY(dwvs_read_choice(uv_jitter, "bake.uv_jitter", uv_jitters, 2, &j));
+        o->uv_jitter = (dwv_uv_jitter_t)j;
+    }
 
     const cJSON *uv_mesh = dwvs_member(item, "uv_mesh"), *uv_margin = dwvs_member(item, "uv_margin");
     if (o->target != DWV_BAKE_UV) {

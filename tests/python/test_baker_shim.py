@@ -84,7 +84,7 @@ class StructLayoutTest(unittest.TestCase):
         if ctypes.sizeof(ctypes.c_void_p) != 8:
             self.skipTest("the sizes below are those of an LP64 ABI")
         sizes = {"dwv_material_t": 192, "dwv_mesh_t": 184, "dwv_light_desc_t": 248, "dwv_camera_t": 128,
-                 "dwv_bake_progress_t": 48, "dwv_bake_options_t": 176, "dwv_image_info_t": 40,
+                 "dwv_bake_progress_t": 48, "dwv_bake_options_t": 184, "dwv_image_info_t": 40,
                  "dwv_bake_stats_t": 136, "dwv_error_point_t": 24, "dwv_display_options_t": 56,
                  "dwv_environment_t": 104, "dwv_texture_desc_t": 40, "dwv_texture_binding_t": 56}
         for name, size in sizes.items():
@@ -119,7 +119,7 @@ class StructLayoutTest(unittest.TestCase):
     def test_defaults_are_the_init_macros(self):
         options = _library.BakeOptions()
         self.assertEqual((options.struct_size, options.width, options.height, options.uv_margin, options.samples),
-                         (176, 256, 256, 16, 64))
+                         (184, 256, 256, 16, 64))
         # Issue 18's light paths: Blender's defaults, as DWV_BAKE_OPTIONS_INIT (Filter Glossy 1).
         self.assertEqual((options.max_bounces, options.diffuse_bounces, options.glossy_bounces,
                           options.transmission_bounces, options.min_light_bounces, options.subsurface_after_diffuse,
@@ -134,6 +134,13 @@ class StructLayoutTest(unittest.TestCase):
         self.assertEqual(dwivedi.BakeSettings._from_c(filtered._to_c()), filtered)
         with self.assertRaises((ValueError, TypeError)):
             dwivedi.BakeSettings(pixel_filter="mitchell")._to_c()
+        # UV samples in their texel: Cycles 3.5+'s retries by default, as DWV_BAKE_OPTIONS_INIT.
+        self.assertEqual((options.uv_jitter, options.reserved4, dwivedi.BakeSettings().uv_jitter), (0, 0, "retry"))
+        folded = dwivedi.BakeSettings(uv_jitter="mirror")
+        self.assertEqual(folded._to_c().uv_jitter, 1)
+        self.assertEqual(dwivedi.BakeSettings._from_c(folded._to_c()), folded)
+        with self.assertRaises((ValueError, TypeError)):
+            dwivedi.BakeSettings(uv_jitter="clamp")._to_c()
         settings = dwivedi.BakeSettings()
         self.assertEqual(dwivedi.BakeSettings._from_c(settings._to_c()), settings)
         self.assertEqual((settings.width, settings.height, settings.uv_margin, settings.samples, settings.technique),

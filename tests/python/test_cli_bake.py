@@ -93,6 +93,8 @@ class BakeCli(unittest.TestCase):
         for blur in ("-1", "inf", "nan", "soft"):
             assert_bad_usage(self, ["bake", "--out", self.prefix, "--blur-glossy", blur], "dwivedi bake:",
                              ["--blur-glossy", blur])
+        assert_bad_usage(self, ["bake", "--out", self.prefix, "--uv-jitter", "clamp"], "dwivedi bake:",
+                         ["--uv-jitter", "clamp"])
         done = run_cli("bake", "--out", self.prefix, "--spp", "0", "--quiet")
         self.assertEqual(done.returncode, USAGE, done.stderr)
         self.assertIn("samples", done.stderr)
