@@ -152,6 +152,7 @@ static int run_walk(const dwvb_shader *shader, uint32_t mesh, const dwvw_medium 
     }
     tally->events += walk->events;
     ++tally->walks;
+    if (tally->first_walk_mesh == 0u) tally->first_walk_mesh = mesh + 1u;
     return walk->status == DWVW_EXITED;
 }
 

@@ -118,6 +118,9 @@ typedef struct dwvb_tally {
     uint64_t path_rays;
     /* Of the walks above, those of channel walks by channel: walks, events and mixture terms. */
     uint64_t channel_walks[3], channel_events[3], channel_terms[3];
+    /* The mesh of the sample's first walk, plus one (0: none walked): auto's pilot counts a sample
+     * whose camera ray met another mesh (a mirror, the ground) for the mesh it walked. */
+    uint32_t first_walk_mesh;
 } dwvb_tally;
 
 /* Pairs of random dimensions shading uses before direct lighting starts: the entry direction. */

@@ -163,16 +163,22 @@ def dwivedi_bake(scene, seed, samples, output_dir, event_cap=None):
     return pixels, seconds
 
 
-def render_and_bake(name, scene, cycles_samples, dwivedi_samples, work, event_cap=256):
-    """Cycles' renders and the add-on's bakes of `scene` with seeds 1 and 2 (files `name`_* in
-    `work`), compared (compare_two_seeds) with their times and samples. The event cap defaults to
+def render_and_bake(name, scene, cycles_samples, dwivedi_samples, work, event_cap=256, seeds=(1, 2)):
+    """Cycles' renders and the add-on's bakes of `scene` with each of `seeds` (files `name`_* in
+    `work`), compared (compare_seeds) with their times and samples. The event cap defaults to
     Cycles' own 256 events per walk (BSSRDF_MAX_BOUNCES), as test_fidelity.py."""
-    c1, tc1 = cycles_render(scene, 1, cycles_samples, work / f"{name}_cycles_1.exr")
-    c2, tc2 = cycles_render(scene, 2, cycles_samples, work / f"{name}_cycles_2.exr")
-    o1, to1 = dwivedi_bake(scene, 1, dwivedi_samples, work / f"{name}_dwivedi_1", event_cap)
-    o2, to2 = dwivedi_bake(scene, 2, dwivedi_samples, work / f"{name}_dwivedi_2", event_cap)
-    return {**compare_two_seeds((c1, c2), (o1, o2)), "cycles_seconds": tc1 + tc2, "cycles_samples": 2 * cycles_samples,
-            "dwivedi_seconds": to1 + to2, "dwivedi_samples": 2 * dwivedi_samples}
+    cycles, ours, cycles_seconds, ours_seconds = [], [], 0.0, 0.0
+    for seed in seeds:
+        pixels, seconds = cycles_render(scene, seed, cycles_samples, work / f"{name}_cycles_{seed}.exr")
+        cycles.append(pixels)
+        cycles_seconds += seconds
+    for seed in seeds:
+        pixels, seconds = dwivedi_bake(scene, seed, dwivedi_samples, work / f"{name}_dwivedi_{seed}", event_cap)
+        ours.append(pixels)
+        ours_seconds += seconds
+    return {**compare_seeds(cycles, ours), "cycles_seconds": cycles_seconds,
+            "cycles_samples": len(seeds) * cycles_samples, "dwivedi_seconds": ours_seconds,
+            "dwivedi_samples": len(seeds) * dwivedi_samples}
 
 
 def compare_two_seeds(cycles_pair, ours_pair):
@@ -189,8 +195,14 @@ def compare_seeds(cycles_images, ours_images):
     seeds (a1 - a2)^2 / 4): 1 in expectation when both estimate the same image, larger with any
     bias; and the standard error of the difference of the means from the same variances,
     sqrt(sum (var_ours + var_cycles)) / pixels, relative to Cycles' mean (what the mean test's
-    tolerance must stand well above). More seeds steady R where a few pixels hold most of the
-    variance (each pixel's estimate has k - 1 degrees of freedom)."""
+    tolerance must stand well above). More seeds steady R's denominator (each pixel's variance
+    estimate has k - 1 degrees of freedom); its numerator is steadied only by more pixels with
+    comparable variance: `effective_pixels_rgb`, N = (sum v_i)^2 / sum v_i^2 of the per-pixel
+    variances v_i (from the seeds, so rather low), gives R's spread where the images agree: a
+    standard deviation of about sqrt(2 k / (N (k - 1))) for Gaussian pixel means (a chi-square
+    of N degrees over one of N (k - 1)), so that a bound of 1.5 is 3 of them above 1 only from
+    N = 96 with k = 4 seeds, 144 with 2. A scene whose variance sits on a few pixels needs more
+    pixels, not more samples."""
     def mean_and_variance(images):
         k = len(images)
         mean = [sum(values) / k for values in zip(*images)]
@@ -201,16 +213,19 @@ def compare_seeds(cycles_images, ours_images):
     n = len(ours) // 4
     cm = [sum(cycles[c::4]) / n for c in range(3)]
     om = [sum(ours[c::4]) / n for c in range(3)]
-    ratios, errors = [], []
+    ratios, errors, effective = [], [], []
     for c in range(3):
         num = sum((ours[i] - cycles[i]) ** 2 for i in range(c, len(ours), 4))
-        den = sum(var_ours[i] + var_cycles[i] for i in range(c, len(ours), 4))
+        variances = [var_ours[i] + var_cycles[i] for i in range(c, len(ours), 4)]
+        den = sum(variances)
+        squares = sum(v * v for v in variances)
         ratios.append(num / den if den > 0 else (0.0 if num == 0 else math.inf))
         errors.append(math.sqrt(den) / n / cm[c] if cm[c] > 0 else None)
+        effective.append(den * den / squares if squares > 0 else 0.0)
     return {
         "cycles_mean_rgb": cm, "dwivedi_mean_rgb": om,
         "relative_difference_rgb": [(o - c) / c if c > 0 else None for o, c in zip(om, cm)],
-        "noise_ratio_rgb": ratios, "relative_standard_error_rgb": errors,
+        "noise_ratio_rgb": ratios, "relative_standard_error_rgb": errors, "effective_pixels_rgb": effective,
         "nan_pixels": sum(1 for v in ours if v != v),
     }
 

@@ -58,7 +58,9 @@ SCRIPTS = tuple(sorted(p.name for p in Path(__file__).resolve().parent.glob("tes
 # Passed on to test_fidelity.py and test_indirect.py (their settings, for a diagnosis run; CI uses their defaults).
 FIDELITY_SETTINGS = ("DWIVEDI_FIDELITY_EVENT_CAP", "DWIVEDI_FIDELITY_ONLY", "DWIVEDI_FIDELITY_RESOLUTION",
                      "DWIVEDI_FIDELITY_CYCLES_SPP", "DWIVEDI_FIDELITY_DWIVEDI_SPP", "DWIVEDI_FOOTPRINT_PLANTED",
-                     "DWIVEDI_INDIRECT_ONLY", "DWIVEDI_INDIRECT_PLANTED")
+                     "DWIVEDI_INDIRECT_ONLY", "DWIVEDI_INDIRECT_PLANTED",
+                     "DWIVEDI_INDIRECT_SEEDS", "DWIVEDI_INDIRECT_RESOLUTION", "DWIVEDI_INDIRECT_CYCLES_SPP",
+                     "DWIVEDI_INDIRECT_DWIVEDI_SPP")
 
 
 def fail(message):
@@ -157,6 +159,8 @@ def main(argv=None):
                         help="run test_ui.py in Blender's UI under Xvfb instead of test_package.py headless")
     parser.add_argument("--keep-going", action="store_true",
                         help="run every step even after one failed (diagnosis; later steps build on earlier ones)")
+    parser.add_argument("--keep-scratch", action="store_true",
+                        help="keep the scratch folder (the test's images) after a pass too (diagnosis)")
     args = parser.parse_args(argv)
     build = args.build_dir.resolve()
     legacy, extension, library = build / "dwivedi_bake.zip", extension_zip(build), build / "libdwivedi.so.1"
@@ -301,7 +305,10 @@ def main(argv=None):
         return 1
     if (stage / "screenshot.png").is_file():
         shutil.copy2(stage / "screenshot.png", work / "screenshot.png")
-    shutil.rmtree(stage)
+    if args.keep_scratch:
+        print(f"run_package_tests: scratch folder kept: {stage}")
+    else:
+        shutil.rmtree(stage)
     print(f"run_package_tests: {args.blender} {test_script}: passed")
     return 0
 

@@ -81,6 +81,39 @@ static dwv_scene_t *world_lit_sphere(double color)
     return scene;
 }
 
+/* world_lit_sphere's sphere seen only in a mirror: a 3 x 3 m quad of a black Principled base of
+ * Roughness 0 (its specular layer alone, Specular 1) in the plane x + z = 0 fills the camera's view
+ * and turns every camera ray (0, 0, -1) into (1, 0, 0), toward the sphere at x = 5, out of the
+ * camera's sight. Every sample's camera ray meets the mirror, which auto does not decide: the
+ * pilot must count the samples for the sphere they walk (on the library before, it counted none
+ * and kept auto's default guide, incident patches, in every seed). */
+static dwv_scene_t *mirrored_sphere(double color)
+{
+    dwv_scene_t *scene;
+    if (dwv_scene_create(&scene) != DWV_SUCCESS) exit(2);
+    dwv_material_t m = medium(color, 0.0);
+    m.subsurface_scale = 0.5;
+    test_mesh sphere = test_sphere(5.0, 0.0, 0.0, 1.0, 24, 48);
+    test_add(scene, &sphere, &m);
+    test_mesh_free(&sphere);
+    float positions[12] = {-1.5f, -1.5f, 1.5f, 1.5f, -1.5f, -1.5f, 1.5f, 1.5f, -1.5f, -1.5f, 1.5f, 1.5f};
+    uint32_t indices[6] = {0, 1, 2, 0, 2, 3};
+    test_mesh quad = {4u, 2u, positions, indices, NULL};
+    dwv_material_t mirror = DWV_MATERIAL_INIT;
+    mirror.kind = DWV_MATERIAL_DIFFUSE;
+    mirror.base_color[0] = mirror.base_color[1] = mirror.base_color[2] = 0.0;
+    mirror.roughness = 0.0;
+    mirror.specular_model = DWV_SPECULAR_PRINCIPLED_V1;
+    mirror.specular = 1.0;
+    mirror.specular_tint[0] = 0.0;
+    test_add(scene, &quad, &mirror);
+    double white[3] = {1.0, 1.0, 1.0};
+    if (dwv_scene_set_world(scene, white, 1.0)) exit(2);
+    dwv_camera_t camera = test_ortho_camera(0.0, 0.0, 5.0, 2.4);
+    finish(scene, &camera);
+    return scene;
+}
+
 /* A 4 x 4 m slab `thickness` thick about z = 0, seen from +z, a sun of 3 W/m^2 shining down
  * (front_lit) or up. */
 static dwv_scene_t *sunlit_slab(double thickness, double color, double anisotropy, int front_lit)
@@ -184,6 +217,7 @@ int main(void)
     check_threads("front-lit wax sphere", test_wax_sphere(-1, 0, 24, 48));
     check_threads("back-lit leaf", test_leaf());
     check_choice("world-lit sphere, colour 0.5", world_lit_sphere(0.5), EXPECT_ENTRY, 0);
+    check_choice("world-lit sphere, colour 0.5, seen in a mirror", mirrored_sphere(0.5), EXPECT_ENTRY, 0);
     check_choice("thick front-lit slab, colour 0.5", sunlit_slab(2.0, 0.5, 0.0, 1), EXPECT_GUIDED, 0);
     check_choice("thin back-lit slab, colour 0.3", sunlit_slab(0.1, 0.3, 0.0, 0), EXPECT_INCIDENT, 0);
     check_choice("thin back-lit slab, g = 0.8", sunlit_slab(0.1, 0.8, 0.8, 0), EXPECT_CLASSICAL, 0);
