@@ -5,6 +5,7 @@
 #include <float.h>
 #include <math.h>
 #include <stdatomic.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "estimate_walkers.h"
@@ -112,6 +113,22 @@ static int lanes_can_permute(void)
 
 _Static_assert(DWVW_LANES % 8 == 0, "the permuted lookup takes the lanes 8 at a time");
 
+/* The keys of DWVW_KEY_BATCH walks in a row, dwvk_rng_key(seed, index, 0) for index = first, first
+ * + 1, ...: formed together (lanes_keys_fill, vectorised) where lane_begin took two hashes per walk
+ * (about an eighth of lanes_run_in's time for poe on the half-space). A thread's walks come in runs
+ * of its blocks, whose sizes (estimate.c) are multiples of the batch. */
+#define DWVW_KEY_BATCH 16u
+typedef struct lane_keys {
+    uint64_t first; /* a multiple of DWVW_KEY_BATCH, or UINT64_MAX before the first batch */
+    uint64_t key[DWVW_KEY_BATCH];
+} lane_keys;
+
+DWVW_LANE_CLONES static void lanes_keys_fill(lane_keys *keys, uint64_t seed_base, uint64_t first)
+{
+    keys->first = first;
+    for (unsigned i = 0; i < DWVW_KEY_BATCH; ++i) keys->key[i] = dwvk_rng_key_from_base(seed_base, first + i, 0);
+}
+
 /* The lanes' state. p: position; d: the direction of the last step (a step forms its own; at
  * events = 0 it is the entry direction, entry_*). log_constants and exponent as in guided_walk_in,
  * weight as in mixture_walk_in. */
@@ -127,6 +144,7 @@ typedef struct lane_state {
     double weight[DWVW_LANES];         /* the mixture's throughput (mixture_lanes_step_in) */
     lane_log_columns log_columns;      /* the log table by columns, and whether to permute it */
     int permute;                       /*   (lanes_unit_flights) */
+    lane_keys keys;                    /* the keys of the walks about the last one begun */
 } lane_state;
 
 /* What every walk of a run starts from, worked out once per run: the key's first hash (a
@@ -186,7 +204,9 @@ static void lane_begin_entry(lane_state *L, int l, const dwvw_estimate_setup *se
 static DWVW_ALWAYS_INLINE void lane_begin(lane_state *L, int l, const dwvw_estimate_setup *setup,
                                           const dwvw_fast_plan *plan, const lane_template *t, uint64_t index)
 {
-    uint64_t key = dwvk_rng_key_from_base(t->seed_base, index, 0); /* = dwvk_rng_key(seed, index, 0) */
+    uint64_t batch = index & ~(uint64_t)(DWVW_KEY_BATCH - 1u);
+    if (batch != L->keys.first) lanes_keys_fill(&L->keys, t->seed_base, batch);
+    uint64_t key = L->keys.key[index - batch]; /* = dwvk_rng_key(seed, index, 0) */
     L->key[l] = key;
     L->counter[l] = key + t->counter_offset; /* dwvk_rng_counter: the same sum mod 2^64 */
     L->px[l] = DWVW_ENTRY_POINT.x;
@@ -391,25 +411,36 @@ done:
 }
 
 /* Where the lanes' walks come from and where their ends go: a thread's blocks of a run (walks are
- * numbered in the order the thread starts them, and a ring of DWVW_LANE_RING ends adds them to
- * their blocks in that order, so a block's totals are summed in walk order as in worker()), or a
- * range of walks whose ends are all kept (dwvw_estimate_walks_lanes). */
-#define DWVW_LANE_RING 256u
+ * numbered in the order the thread starts them, and a ring of ends adds them to their blocks in
+ * that order, so a block's totals are summed in walk order as in worker()), or a range of walks
+ * whose ends are all kept (dwvw_estimate_walks_lanes).
+ * The ring holds the ends of the walks begun after the oldest one still running; when it is full,
+ * lanes wait idle. Walk lengths have a long tail (at albedo 0.99 on the half-space a walk of a few
+ * hundred events is common), and with DWVW_LANE_RING_SMALL (256) ends such a walk left lanes idle
+ * for about 7% of the lane-steps of poe on the half-space (callgrind: steps x lanes less events and
+ * ends); DWVW_LANE_RING (1024, allocated) leaves none measurable. Which ring a run has changes no
+ * result: the blocks are summed in walk order either way. */
+#define DWVW_LANE_RING 1024u
+#define DWVW_LANE_RING_SMALL 256u /* on the stack, where the allocation fails */
 /* A guided run's ends are added to their blocks DWVW_END_BATCH at a time, their exponentials
- * taken together (lanes_end_weights): one vector of doubles in the AVX-512 copy. The ring holds
- * whole batches, so a batch never wraps around it. */
+ * taken together (lanes_end_weights): one vector of doubles in the AVX-512 copy. The rings hold
+ * whole batches, so a batch never wraps around one. */
 #define DWVW_END_BATCH 8u
-_Static_assert(DWVW_LANE_RING % DWVW_END_BATCH == 0, "the end batches tile the ring");
+_Static_assert(DWVW_LANE_RING % DWVW_END_BATCH == 0 && DWVW_LANE_RING_SMALL % DWVW_END_BATCH == 0,
+               "the end batches tile the rings");
+_Static_assert((DWVW_LANE_RING & (DWVW_LANE_RING - 1u)) == 0 && (DWVW_LANE_RING_SMALL & (DWVW_LANE_RING_SMALL - 1u)) == 0,
+               "a ring's place is a mask of the sequence number");
 typedef struct lane_slot {
     dwvw_walk_end end;
     dwvw_block_totals *block;
 } lane_slot;
 
-/* A guided run's ring: its slots, and beside them by columns the ended walks' log weights and
- * exit factors (guided_lane_end), read as vectors by lanes_end_weights. */
+/* A run's ring of `size` ends (a power of two): its slots, and beside them by columns a guided
+ * walk's log weight and exit factor (guided_lane_end), read as vectors by lanes_end_weights. */
 typedef struct lane_ring {
-    lane_slot slot[DWVW_LANE_RING];
-    double log_weight[DWVW_LANE_RING], factor[DWVW_LANE_RING];
+    lane_slot *slot;
+    double *log_weight, *factor;
+    uint64_t size;
 } lane_ring;
 
 typedef struct lane_feed {
@@ -418,8 +449,7 @@ typedef struct lane_feed {
     dwvw_block_totals *block;           /* the current block */
     uint64_t started, committed;   /* walks started by this thread, and added to their blocks */
     uint64_t ended;                /* a guided run: walks before this one have all ended */
-    lane_slot *ring;
-    lane_ring *columns;            /* the ring with its columns (ring = columns->slot) */
+    lane_ring ring;                /* a run's */
     uint64_t first;                /* a range: its first walk, and where its ends go */
     dwvw_walk_end *ends;
     int exhausted;                 /* a run: no block left */
@@ -452,9 +482,9 @@ static DWVW_ALWAYS_INLINE int feed_next(lane_feed *feed, uint64_t *index, uint64
         *index = feed->next++;
         return 1;
     }
-    if (feed->started - feed->committed >= DWVW_LANE_RING) return 0;
+    if (feed->started - feed->committed >= feed->ring.size) return 0;
     if (feed->next >= feed->stop && !claim_block(feed)) return 0;
-    lane_slot *slot = &feed->ring[feed->started % DWVW_LANE_RING];
+    lane_slot *slot = &feed->ring.slot[feed->started & (feed->ring.size - 1u)];
     slot->end.status = DWVW_RUNNING;
     slot->block = feed->block;
     *sequence = feed->started++;
@@ -468,9 +498,9 @@ static void feed_done(lane_feed *feed, const dwvw_estimate_setup *setup, uint64_
         feed->ends[sequence] = *end;
         return;
     }
-    feed->ring[sequence % DWVW_LANE_RING].end = *end;
+    feed->ring.slot[sequence & (feed->ring.size - 1u)].end = *end;
     for (; feed->committed < feed->started; ++feed->committed) {
-        lane_slot *slot = &feed->ring[feed->committed % DWVW_LANE_RING];
+        lane_slot *slot = &feed->ring.slot[feed->committed & (feed->ring.size - 1u)];
         if (slot->end.status == DWVW_RUNNING) break;
         dwvw_block_add_walk(setup, &slot->end, slot->block);
     }
@@ -507,15 +537,16 @@ static void feed_done_guided(lane_feed *feed, const dwvw_estimate_setup *setup, 
         feed->ends[sequence] = *end;
         return;
     }
-    lane_ring *ring = feed->columns;
-    unsigned at = (unsigned)(sequence % DWVW_LANE_RING);
+    lane_ring *ring = &feed->ring;
+    const uint64_t mask = ring->size - 1u;
+    uint64_t at = sequence & mask;
     ring->slot[at].end = *end;
     ring->log_weight[at] = log_weight;
     ring->factor[at] = end->status == DWVW_ABSORBED ? 0.0 : factor;
     for (; feed->ended < feed->started; ++feed->ended)
-        if (ring->slot[feed->ended % DWVW_LANE_RING].end.status == DWVW_RUNNING) break;
+        if (ring->slot[feed->ended & mask].end.status == DWVW_RUNNING) break;
     while (feed->ended - feed->committed >= DWVW_END_BATCH) {
-        unsigned first = (unsigned)(feed->committed % DWVW_LANE_RING); /* a multiple of the batch */
+        uint64_t first = feed->committed & mask; /* a multiple of the batch */
         double weight[DWVW_END_BATCH];
         lanes_end_weights(ring->log_weight + first, ring->factor + first, weight);
         for (unsigned i = 0; i < DWVW_END_BATCH; ++i) {
@@ -532,9 +563,9 @@ static void feed_done_guided(lane_feed *feed, const dwvw_estimate_setup *setup, 
 static void feed_flush_guided(lane_feed *feed, const dwvw_estimate_setup *setup)
 {
     if (!feed->state) return;
-    lane_ring *ring = feed->columns;
+    lane_ring *ring = &feed->ring;
     for (; feed->committed < feed->started; ++feed->committed) {
-        unsigned at = (unsigned)(feed->committed % DWVW_LANE_RING);
+        uint64_t at = feed->committed & (ring->size - 1u);
         lane_slot *slot = &ring->slot[at];
         double w = dwvk_exp_fast(ring->log_weight[at]) * ring->factor[at];
         slot->end.weight[0] = isfinite(w) ? w : 0.0;
@@ -719,6 +750,7 @@ static inline void lanes_run_in(const dwvw_estimate_setup *setup, const dwvw_fas
     lane_state L;
     lane_log_columns_fill(&L.log_columns);
     L.permute = lanes_can_permute();
+    L.keys.first = UINT64_MAX;
     const lane_template start = lane_template_for(setup, plan);
     if (start.same_entry) lanes_fill_template(&L, &start);
     uint64_t sequence[DWVW_LANES];
@@ -779,9 +811,19 @@ static void lanes_run(const dwvw_estimate_setup *setup, const dwvw_fast_plan *pl
 
 void dwvw_lanes_run_blocks(dwvw_estimate_run_state *state)
 {
-    lane_ring ring;
-    lane_feed feed = {.state = state, .ring = ring.slot, .columns = &ring};
+    lane_slot small_slots[DWVW_LANE_RING_SMALL];
+    double small_log_weight[DWVW_LANE_RING_SMALL], small_factor[DWVW_LANE_RING_SMALL];
+    lane_ring ring = {.slot = malloc(DWVW_LANE_RING * sizeof *ring.slot),
+                      .log_weight = malloc(DWVW_LANE_RING * sizeof *ring.log_weight),
+                      .factor = malloc(DWVW_LANE_RING * sizeof *ring.factor),
+                      .size = DWVW_LANE_RING};
+    void *allocated[3] = {ring.slot, ring.log_weight, ring.factor};
+    if (!ring.slot || !ring.log_weight || !ring.factor)
+        ring = (lane_ring){.slot = small_slots, .log_weight = small_log_weight, .factor = small_factor,
+                           .size = DWVW_LANE_RING_SMALL};
+    lane_feed feed = {.state = state, .ring = ring};
     lanes_run(state->setup, &state->plan, &feed);
+    for (int i = 0; i < 3; ++i) free(allocated[i]);
 }
 
 void dwvw_lanes_run_range(const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan, uint64_t first,
