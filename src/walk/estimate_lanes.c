@@ -113,22 +113,6 @@ static int lanes_can_permute(void)
 
 _Static_assert(DWVW_LANES % 8 == 0, "the permuted lookup takes the lanes 8 at a time");
 
-/* The keys of DWVW_KEY_BATCH walks in a row, dwvk_rng_key(seed, index, 0) for index = first, first
- * + 1, ...: formed together (lanes_keys_fill, vectorised) where lane_begin took two hashes per walk
- * (about an eighth of lanes_run_in's time for poe on the half-space). A thread's walks come in runs
- * of its blocks, whose sizes (estimate.c) are multiples of the batch. */
-#define DWVW_KEY_BATCH 16u
-typedef struct lane_keys {
-    uint64_t first; /* a multiple of DWVW_KEY_BATCH, or UINT64_MAX before the first batch */
-    uint64_t key[DWVW_KEY_BATCH];
-} lane_keys;
-
-DWVW_LANE_CLONES static void lanes_keys_fill(lane_keys *keys, uint64_t seed_base, uint64_t first)
-{
-    keys->first = first;
-    for (unsigned i = 0; i < DWVW_KEY_BATCH; ++i) keys->key[i] = dwvk_rng_key_from_base(seed_base, first + i, 0);
-}
-
 /* The lanes' state. p: position; d: the direction of the last step (a step forms its own; at
  * events = 0 it is the entry direction, entry_*). log_constants and exponent as in guided_walk_in,
  * weight as in mixture_walk_in. */
@@ -144,7 +128,6 @@ typedef struct lane_state {
     double weight[DWVW_LANES];         /* the mixture's throughput (mixture_lanes_step_in) */
     lane_log_columns log_columns;      /* the log table by columns, and whether to permute it */
     int permute;                       /*   (lanes_unit_flights) */
-    lane_keys keys;                    /* the keys of the walks about the last one begun */
 } lane_state;
 
 /* What every walk of a run starts from, worked out once per run: the key's first hash (a
@@ -204,9 +187,7 @@ static void lane_begin_entry(lane_state *L, int l, const dwvw_estimate_setup *se
 static DWVW_ALWAYS_INLINE void lane_begin(lane_state *L, int l, const dwvw_estimate_setup *setup,
                                           const dwvw_fast_plan *plan, const lane_template *t, uint64_t index)
 {
-    uint64_t batch = index & ~(uint64_t)(DWVW_KEY_BATCH - 1u);
-    if (batch != L->keys.first) lanes_keys_fill(&L->keys, t->seed_base, batch);
-    uint64_t key = L->keys.key[index - batch]; /* = dwvk_rng_key(seed, index, 0) */
+    uint64_t key = dwvk_rng_key_from_base(t->seed_base, index, 0); /* = dwvk_rng_key(seed, index, 0) */
     L->key[l] = key;
     L->counter[l] = key + t->counter_offset; /* dwvk_rng_counter: the same sum mod 2^64 */
     L->px[l] = DWVW_ENTRY_POINT.x;
@@ -750,7 +731,6 @@ static inline void lanes_run_in(const dwvw_estimate_setup *setup, const dwvw_fas
     lane_state L;
     lane_log_columns_fill(&L.log_columns);
     L.permute = lanes_can_permute();
-    L.keys.first = UINT64_MAX;
     const lane_template start = lane_template_for(setup, plan);
     if (start.same_entry) lanes_fill_template(&L, &start);
     uint64_t sequence[DWVW_LANES];
