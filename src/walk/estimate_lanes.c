@@ -2,12 +2,15 @@
  * mixture_walk_in (estimate_fast.c), DWVW_LANES (16) at a time. Their step pieces are step.h's and
  * estimate_walkers.h's, as there; what is written out here is the lanes' form of a step (a loop
  * over the lanes per stage, selects for branches). */
+#include <float.h>
 #include <math.h>
 #include <stdatomic.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "estimate_walkers.h"
 #include "geometry.h"
+#include "kernel/exp_batch.h"
 #include "step.h"
 
 /* ---- lock-step: several walks advanced together ---------------------------------------------
@@ -347,10 +350,13 @@ DWVW_LANE_CLONES static uint32_t guided_lanes_step_sphere(lane_state *L, const d
     return guided_lanes_step_in(L, setup, plan, DWVW_SPHERE);
 }
 
-/* The branches of guided_walk_in after a flagged step of lane l: 1 and *end filled if its walk
- * ended, else 0 (the walk goes on, its weight perhaps raised by the roulette). */
+/* The branches of guided_walk_in after a flagged step of lane l: 1 if its walk ended, else 0 (the
+ * walk goes on, its weight perhaps raised by the roulette). An ended walk's status, events and
+ * exit normal are in *end, and its weight is exp(*log_weight) x *last_factor, 0 if absorbed
+ * (dwvw_guided_end): left to the caller, which takes the exponentials of several ends together
+ * (lanes_end_weights). */
 static int guided_lane_end(lane_state *L, int l, const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan,
-                    dwvw_shape_kind kind, dwvw_walk_end *end)
+                           dwvw_shape_kind kind, dwvw_walk_end *end, double *log_weight_out, double *last_factor_out)
 {
     double last_factor = 1.0;
     uint32_t events = L->events[l];
@@ -379,26 +385,52 @@ static int guided_lane_end(lane_state *L, int l, const dwvw_estimate_setup *setu
         end->status = DWVW_TRUNCATED;
     }
 done:
-    dwvw_guided_end(end, events, L->log_weight[l], last_factor);
+    end->events = events;
+    *log_weight_out = L->log_weight[l];
+    *last_factor_out = last_factor;
     return 1;
 }
 
 /* Where the lanes' walks come from and where their ends go: a thread's blocks of a run (walks are
- * numbered in the order the thread starts them, and a ring of DWVW_LANE_RING ends adds them to
- * their blocks in that order, so a block's totals are summed in walk order as in worker()), or a
- * range of walks whose ends are all kept (dwvw_estimate_walks_lanes). */
-#define DWVW_LANE_RING 256u
+ * numbered in the order the thread starts them, and a ring of ends adds them to their blocks in
+ * that order, so a block's totals are summed in walk order as in worker()), or a range of walks
+ * whose ends are all kept (dwvw_estimate_walks_lanes).
+ * The ring holds the ends of the walks begun after the oldest one still running; when it is full,
+ * lanes wait idle. Walk lengths have a long tail (at albedo 0.99 on the half-space a walk of a few
+ * hundred events is common), and with DWVW_LANE_RING_SMALL (256) ends such a walk left lanes idle
+ * for about 7% of the lane-steps of poe on the half-space (callgrind: steps x lanes less events and
+ * ends); DWVW_LANE_RING (1024, allocated) leaves none measurable. Which ring a run has changes no
+ * result: the blocks are summed in walk order either way. */
+#define DWVW_LANE_RING 1024u
+#define DWVW_LANE_RING_SMALL 256u /* on the stack, where the allocation fails */
+/* A guided run's ends are added to their blocks DWVW_END_BATCH at a time, their exponentials
+ * taken together (lanes_end_weights): one vector of doubles in the AVX-512 copy. The rings hold
+ * whole batches, so a batch never wraps around one. */
+#define DWVW_END_BATCH 8u
+_Static_assert(DWVW_LANE_RING % DWVW_END_BATCH == 0 && DWVW_LANE_RING_SMALL % DWVW_END_BATCH == 0,
+               "the end batches tile the rings");
+_Static_assert((DWVW_LANE_RING & (DWVW_LANE_RING - 1u)) == 0 && (DWVW_LANE_RING_SMALL & (DWVW_LANE_RING_SMALL - 1u)) == 0,
+               "a ring's place is a mask of the sequence number");
 typedef struct lane_slot {
     dwvw_walk_end end;
     dwvw_block_totals *block;
 } lane_slot;
+
+/* A run's ring of `size` ends (a power of two): its slots, and beside them by columns a guided
+ * walk's log weight and exit factor (guided_lane_end), read as vectors by lanes_end_weights. */
+typedef struct lane_ring {
+    lane_slot *slot;
+    double *log_weight, *factor;
+    uint64_t size;
+} lane_ring;
 
 typedef struct lane_feed {
     dwvw_estimate_run_state *state;       /* a run's blocks, or NULL for a range */
     uint64_t next, stop;           /* the next walk index and the end of the current block / range */
     dwvw_block_totals *block;           /* the current block */
     uint64_t started, committed;   /* walks started by this thread, and added to their blocks */
-    lane_slot *ring;
+    uint64_t ended;                /* a guided run: walks before this one have all ended */
+    lane_ring ring;                /* a run's */
     uint64_t first;                /* a range: its first walk, and where its ends go */
     dwvw_walk_end *ends;
     int exhausted;                 /* a run: no block left */
@@ -431,9 +463,9 @@ static DWVW_ALWAYS_INLINE int feed_next(lane_feed *feed, uint64_t *index, uint64
         *index = feed->next++;
         return 1;
     }
-    if (feed->started - feed->committed >= DWVW_LANE_RING) return 0;
+    if (feed->started - feed->committed >= feed->ring.size) return 0;
     if (feed->next >= feed->stop && !claim_block(feed)) return 0;
-    lane_slot *slot = &feed->ring[feed->started % DWVW_LANE_RING];
+    lane_slot *slot = &feed->ring.slot[feed->started & (feed->ring.size - 1u)];
     slot->end.status = DWVW_RUNNING;
     slot->block = feed->block;
     *sequence = feed->started++;
@@ -447,10 +479,78 @@ static void feed_done(lane_feed *feed, const dwvw_estimate_setup *setup, uint64_
         feed->ends[sequence] = *end;
         return;
     }
-    feed->ring[sequence % DWVW_LANE_RING].end = *end;
+    feed->ring.slot[sequence & (feed->ring.size - 1u)].end = *end;
     for (; feed->committed < feed->started; ++feed->committed) {
-        lane_slot *slot = &feed->ring[feed->committed % DWVW_LANE_RING];
+        lane_slot *slot = &feed->ring.slot[feed->committed & (feed->ring.size - 1u)];
         if (slot->end.status == DWVW_RUNNING) break;
+        dwvw_block_add_walk(setup, &slot->end, slot->block);
+    }
+}
+
+/* The weights of DWVW_END_BATCH guided ends, dwvw_guided_end's exp(log weight) x factor (0 where
+ * not finite), bit for bit: dwvk_exp_fast_inner for every end, vectorised, and dwvk_exp_fast
+ * itself where an argument is an edge (exp_batch.h). An absorbed walk's factor is 0, so that its
+ * weight is +0 (or not finite, then 0), as dwvw_guided_end gives it. */
+DWVW_LANE_CLONES static void lanes_end_weights(const double *log_weight, const double *factor, double *weight)
+{
+    int edges = 0;
+    for (unsigned i = 0; i < DWVW_END_BATCH; ++i) {
+        weight[i] = dwvk_exp_fast_inner(log_weight[i]);
+        edges |= dwvk_exp_fast_is_edge(log_weight[i]);
+    }
+    if (edges) {
+        for (unsigned i = 0; i < DWVW_END_BATCH; ++i)
+            if (dwvk_exp_fast_is_edge(log_weight[i])) weight[i] = dwvk_exp_fast(log_weight[i]);
+    }
+    for (unsigned i = 0; i < DWVW_END_BATCH; ++i) {
+        double w = weight[i] * factor[i];
+        weight[i] = fabs(w) <= DBL_MAX ? w : 0.0; /* isfinite, as a select */
+    }
+}
+
+/* A guided walk's end (guided_lane_end): in a range, its weight formed at once; in a run, put in
+ * the ring, and every whole batch of ended walks at the ring's front added to its blocks. */
+static void feed_done_guided(lane_feed *feed, const dwvw_estimate_setup *setup, uint64_t sequence,
+                             dwvw_walk_end *end, double log_weight, double factor)
+{
+    if (!feed->state) {
+        dwvw_guided_end(end, end->events, log_weight, factor);
+        feed->ends[sequence] = *end;
+        return;
+    }
+    lane_ring *ring = &feed->ring;
+    const uint64_t mask = ring->size - 1u;
+    uint64_t at = sequence & mask;
+    ring->slot[at].end = *end;
+    ring->log_weight[at] = log_weight;
+    ring->factor[at] = end->status == DWVW_ABSORBED ? 0.0 : factor;
+    for (; feed->ended < feed->started; ++feed->ended)
+        if (ring->slot[feed->ended & mask].end.status == DWVW_RUNNING) break;
+    while (feed->ended - feed->committed >= DWVW_END_BATCH) {
+        uint64_t first = feed->committed & mask; /* a multiple of the batch */
+        double weight[DWVW_END_BATCH];
+        lanes_end_weights(ring->log_weight + first, ring->factor + first, weight);
+        for (unsigned i = 0; i < DWVW_END_BATCH; ++i) {
+            lane_slot *slot = &ring->slot[first + i];
+            slot->end.weight[0] = weight[i];
+            slot->end.weight[1] = slot->end.weight[2] = 0.0;
+            dwvw_block_add_walk(setup, &slot->end, slot->block);
+        }
+        feed->committed += DWVW_END_BATCH;
+    }
+}
+
+/* The guided ends left in the ring when a thread's walks are done (less than a batch), one by one. */
+static void feed_flush_guided(lane_feed *feed, const dwvw_estimate_setup *setup)
+{
+    if (!feed->state) return;
+    lane_ring *ring = &feed->ring;
+    for (; feed->committed < feed->started; ++feed->committed) {
+        uint64_t at = feed->committed & (ring->size - 1u);
+        lane_slot *slot = &ring->slot[at];
+        double w = dwvk_exp_fast(ring->log_weight[at]) * ring->factor[at];
+        slot->end.weight[0] = isfinite(w) ? w : 0.0;
+        slot->end.weight[1] = slot->end.weight[2] = 0.0;
         dwvw_block_add_walk(setup, &slot->end, slot->block);
     }
 }
@@ -653,10 +753,14 @@ static inline void lanes_run_in(const dwvw_estimate_setup *setup, const dwvw_fas
         for (uint32_t pending = flagged & live; pending; pending &= pending - 1u) {
             int l = __builtin_ctz(pending);
             dwvw_walk_end end;
-            int ended = plan->walker == DWVW_WALKER_MIXTURE ? mixture_lane_end(&L, l, setup, kind, &end)
-                                                            : guided_lane_end(&L, l, setup, plan, kind, &end);
-            if (!ended) continue;
-            feed_done(feed, setup, sequence[l], &end);
+            if (plan->walker == DWVW_WALKER_MIXTURE) {
+                if (!mixture_lane_end(&L, l, setup, kind, &end)) continue;
+                feed_done(feed, setup, sequence[l], &end);
+            } else {
+                double log_weight, factor;
+                if (!guided_lane_end(&L, l, setup, plan, kind, &end, &log_weight, &factor)) continue;
+                feed_done_guided(feed, setup, sequence[l], &end, log_weight, factor);
+            }
             freed |= 1u << l;
         }
         if (!freed) continue;
@@ -672,6 +776,7 @@ static inline void lanes_run_in(const dwvw_estimate_setup *setup, const dwvw_fas
             live |= 1u << l;
         }
     }
+    if (plan->walker != DWVW_WALKER_MIXTURE) feed_flush_guided(feed, setup);
 }
 
 /* Runs every walk of the feed in lanes. */
@@ -686,9 +791,19 @@ static void lanes_run(const dwvw_estimate_setup *setup, const dwvw_fast_plan *pl
 
 void dwvw_lanes_run_blocks(dwvw_estimate_run_state *state)
 {
-    lane_slot ring[DWVW_LANE_RING];
+    lane_slot small_slots[DWVW_LANE_RING_SMALL];
+    double small_log_weight[DWVW_LANE_RING_SMALL], small_factor[DWVW_LANE_RING_SMALL];
+    lane_ring ring = {.slot = malloc(DWVW_LANE_RING * sizeof *ring.slot),
+                      .log_weight = malloc(DWVW_LANE_RING * sizeof *ring.log_weight),
+                      .factor = malloc(DWVW_LANE_RING * sizeof *ring.factor),
+                      .size = DWVW_LANE_RING};
+    void *allocated[3] = {ring.slot, ring.log_weight, ring.factor};
+    if (!ring.slot || !ring.log_weight || !ring.factor)
+        ring = (lane_ring){.slot = small_slots, .log_weight = small_log_weight, .factor = small_factor,
+                           .size = DWVW_LANE_RING_SMALL};
     lane_feed feed = {.state = state, .ring = ring};
     lanes_run(state->setup, &state->plan, &feed);
+    for (int i = 0; i < 3; ++i) free(allocated[i]);
 }
 
 void dwvw_lanes_run_range(const dwvw_estimate_setup *setup, const dwvw_fast_plan *plan, uint64_t first,
